@@ -1,0 +1,100 @@
+// Pair batches (structure of arrays), query options and per-pair results.
+//
+// Conventions (all results): witness points are in the world frame; the normal is a unit vector pointing from
+// shape a to shape b; the signed distance is negative when the shapes overlap (its magnitude is the penetration
+// depth, computed only at QueryLevel::penetration). Every pair satisfies witness_b - witness_a = distance * normal.
+// Values a query level does not compute are NaN (the CLI prints them as empty fields).
+#pragma once
+
+#include "batchcol/errors.hpp"
+#include "batchcol/pose.hpp"
+#include "batchcol/shapes.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace batchcol {
+
+/// What to compute per pair; each level includes the previous ones and costs more.
+enum class QueryLevel : std::uint8_t {
+  boolean,      // collide only; stops as soon as a separating plane (or an overlap) is proven
+  distance,     // + signed distance for separated pairs (overlapping pairs: collide, distance NaN)
+  witness,      // + witness points and normal for separated pairs
+  penetration,  // + EPA depth, normal and witness points for overlapping pairs
+};
+
+enum class Solver : std::uint8_t {
+  gjk,       // GJK = fully-corrective Frank-Wolfe on the Minkowski difference
+  nesterov,  // Nesterov-accelerated GJK (Montaut et al. 2022), falls back to gjk when momentum stalls
+  polyak,    // heavy-ball (Polyak) momentum on the support direction, same fallback
+};
+
+enum class Precision : std::uint8_t { float64, float32 };
+
+enum class Status : std::uint8_t {
+  converged,       // the duality-gap criterion (or a closed form) certified the result
+  max_iterations,  // the iteration budget ran out; the result is the last iterate
+  degenerate,      // numerical breakdown (e.g. EPA on a flat Minkowski difference); collide is still valid
+  invalid_input,   // bad pair (shape index out of range, non-finite or non-unit pose); nothing else computed
+};
+
+const char* to_string(QueryLevel level);
+const char* to_string(Solver solver);
+const char* to_string(Precision precision);
+const char* to_string(Status status);
+
+struct QueryOptions {
+  QueryLevel level = QueryLevel::witness;
+  Solver solver = Solver::nesterov;
+  Precision precision = Precision::float64;
+  /// Absolute bound on the distance error in metres, certified by the Frank-Wolfe duality gap:
+  /// GJK stops when (|x|^2 - <x, s>) / |x| <= max(tolerance, relative_tolerance * |x|).
+  double tolerance = 1e-8;
+  double relative_tolerance = 0.0;
+  /// Security margin: a pair collides when its distance is <= margin (boolean queries stop once that is decided).
+  double margin = 0.0;
+  int max_iterations = 128;       // GJK iterations per pair
+  int epa_max_iterations = 256;   // EPA expansions per pair
+  bool closed_forms = true;       // use analytic kernels where they exist (sphere/capsule/box pairs, halfspaces)
+  int threads = 0;                // 0 = all cores
+};
+
+/// A batch of pairs in structure-of-arrays layout. `warm_start`, when not empty, holds one support direction per
+/// pair (world frame, e.g. the `direction` output of the previous frame) used to start GJK.
+struct PairBatch {
+  std::vector<std::uint32_t> shape_a, shape_b;
+  Vec3Array translation_a, translation_b;
+  QuatArray rotation_a, rotation_b;
+  Vec3Array warm_start;
+
+  std::size_t size() const { return shape_a.size(); }
+  void reserve(std::size_t n);
+  /// Appends a pair and returns its index.
+  std::size_t add(std::uint32_t a, const Pose& pose_a, std::uint32_t b, const Pose& pose_b);
+  Pose pose_a(std::size_t i) const { return {translation_a[i], rotation_a[i]}; }
+  Pose pose_b(std::size_t i) const { return {translation_b[i], rotation_b[i]}; }
+};
+
+/// Per-pair results in input order (structure of arrays).
+struct PairResults {
+  std::vector<Status> status;
+  std::vector<std::uint8_t> collide;
+  std::vector<double> distance;
+  Vec3Array witness_a, witness_b, normal;
+  Vec3Array direction;  // final support direction (world frame); feed it back as PairBatch::warm_start
+  std::vector<std::int32_t> iterations;  // GJK iterations plus EPA expansions
+
+  std::size_t size() const { return status.size(); }
+  void resize(std::size_t n);
+};
+
+/// Runs every pair of `batch` against `shapes`. Per-pair problems become Status::invalid_input; the function
+/// throws InputError only for problems with the call itself (mismatched array sizes, invalid options).
+/// Results are bitwise identical for any thread count.
+void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results);
+
+/// Throws InputError naming the option when `options` is invalid (non-finite or negative tolerance, ...).
+void validate(const QueryOptions& options);
+
+}  // namespace batchcol

@@ -1,0 +1,8 @@
+// Umbrella header of batchcol: a data-parallel batched collision engine for convex shapes.
+#pragma once
+
+#include "batchcol/batch.hpp"
+#include "batchcol/errors.hpp"
+#include "batchcol/io.hpp"
+#include "batchcol/pose.hpp"
+#include "batchcol/shapes.hpp"

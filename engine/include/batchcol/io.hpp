@@ -1,0 +1,46 @@
+// Batch files (JSON), mesh files and result output. Every function here validates its input completely before
+// returning and throws InputError with a message naming the file, the field (JSON pointer such as
+// /pairs/3/pose_a/quaternion) and, for parse errors, the line.
+#pragma once
+
+#include "batchcol/batch.hpp"
+#include "batchcol/shapes.hpp"
+
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+namespace batchcol {
+
+/// Everything a batch file holds. The optional top-level settings are applied by apply_to(); command-line flags
+/// override them.
+struct BatchFile {
+  ShapeTable shapes;
+  PairBatch pairs;
+  std::optional<QueryLevel> query;
+  std::optional<Solver> solver;
+  std::optional<double> tolerance;
+  std::optional<Precision> precision;
+  std::optional<double> margin;
+
+  void apply_to(QueryOptions& options) const;
+};
+
+/// Reads a batch file; mesh paths inside it are relative to the file's folder.
+BatchFile load_batch_file(const std::string& path);
+/// Parses batch-file text; `source` names it in messages and `base_dir` resolves mesh paths.
+BatchFile parse_batch_json(const std::string& text, const std::string& source, const std::string& base_dir);
+
+/// Loads a mesh file (OBJ, STL, PLY, COLLADA, ... through assimp) and returns its vertices.
+std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path);
+
+QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
+Solver parse_solver(const std::string& name);
+Precision parse_precision(const std::string& name);
+
+/// Result rows: pair,status,collide,distance,pa_x,pa_y,pa_z,pb_x,pb_y,pb_z,n_x,n_y,n_z,iterations.
+/// Values the query level did not compute are empty (CSV) or null (JSON). Numbers use 17 significant digits.
+void write_results_csv(const PairResults& results, std::ostream& out);
+void write_results_json(const PairResults& results, std::ostream& out);
+
+}  // namespace batchcol

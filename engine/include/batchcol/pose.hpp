@@ -1,0 +1,47 @@
+// Rigid poses and small SoA vector arrays shared by batches and results.
+// Conventions: metres, right-handed frames, quaternions written [w, x, y, z].
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <vector>
+
+namespace batchcol {
+
+/// A rigid transform x_world = rotation * x_local + translation.
+struct Pose {
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  // Eigen's constructor takes (w, x, y, z)
+
+  static Pose identity() { return {}; }
+  static Pose from_translation(const Eigen::Vector3d& t) { return {t, Eigen::Quaterniond::Identity()}; }
+};
+
+/// Structure-of-arrays storage of 3-vectors: one contiguous array per component.
+struct Vec3Array {
+  std::vector<double> x, y, z;
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  void resize(std::size_t n, double value = 0.0) { x.resize(n, value); y.resize(n, value); z.resize(n, value); }
+  void reserve(std::size_t n) { x.reserve(n); y.reserve(n); z.reserve(n); }
+  void push_back(const Eigen::Vector3d& v) { x.push_back(v.x()); y.push_back(v.y()); z.push_back(v.z()); }
+  void set(std::size_t i, const Eigen::Vector3d& v) { x[i] = v.x(); y[i] = v.y(); z[i] = v.z(); }
+  Eigen::Vector3d operator[](std::size_t i) const { return {x[i], y[i], z[i]}; }
+};
+
+/// Structure-of-arrays storage of quaternions [w, x, y, z].
+struct QuatArray {
+  std::vector<double> w, x, y, z;
+
+  std::size_t size() const { return w.size(); }
+  void resize(std::size_t n) { w.resize(n, 1.0); x.resize(n, 0.0); y.resize(n, 0.0); z.resize(n, 0.0); }
+  void reserve(std::size_t n) { w.reserve(n); x.reserve(n); y.reserve(n); z.reserve(n); }
+  void push_back(const Eigen::Quaterniond& q) { w.push_back(q.w()); x.push_back(q.x()); y.push_back(q.y()); z.push_back(q.z()); }
+  void set(std::size_t i, const Eigen::Quaterniond& q) { w[i] = q.w(); x[i] = q.x(); y[i] = q.y(); z[i] = q.z(); }
+  Eigen::Quaterniond operator[](std::size_t i) const { return {w[i], x[i], y[i], z[i]}; }
+};
+
+}  // namespace batchcol

@@ -1,0 +1,94 @@
+// Convex shapes and the shape table that stores each shape once.
+//
+// Conventions: metres; every shape lives in its own local frame; capsule, cylinder and cone axes are the local z
+// axis and the cone apex is at +half_length. Any shape may carry an `inflation` radius: the shape becomes its
+// Minkowski sum with a ball of that radius (a "swept sphere"). Spheres and capsules are stored the same way, as a
+// point and a segment inflated by their radius, so GJK iterates on the core and the radius is added afterwards.
+#pragma once
+
+#include "batchcol/errors.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace batchcol {
+
+enum class ShapeType : std::uint8_t { sphere, capsule, box, cylinder, cone, ellipsoid, convex, triangle, halfspace };
+constexpr int kShapeTypeCount = 9;
+
+const char* to_string(ShapeType type);
+
+/// A convex polytope computed by qhull: only the hull vertices are kept, with triangulated faces (outward normals)
+/// and vertex adjacency (compressed rows) for hill-climbing support queries on large hulls.
+struct ConvexHull {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<std::uint32_t, 3>> faces;  // counter-clockwise seen from outside
+  std::vector<Eigen::Vector3d> face_normals;        // unit, outward
+  std::vector<std::uint32_t> neighbor_offsets;      // size vertices+1
+  std::vector<std::uint32_t> neighbors;             // vertex indices adjacent through a hull edge
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mean of the hull vertices (inside the hull)
+};
+
+/// Computes the convex hull of `points` with qhull. Throws InputError (naming `what`) when a point is not finite or
+/// when fewer than 4 non-coplanar points remain.
+std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
+                                                      const std::string& what = "convex");
+
+/// One shape. Build it with the factories below: they validate sizes (finite, strictly positive) and throw
+/// InputError naming the offending field.
+struct Shape {
+  ShapeType type = ShapeType::sphere;
+  /// sphere: (radius, 0, 0); capsule, cylinder, cone: (radius, half_length, 0); box: half extents;
+  /// ellipsoid: radii; halfspace: unit outward normal (the solid is {x : normal.x <= offset}).
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  double offset = 0.0;                             // halfspace only
+  double inflation = 0.0;                          // extra swept-sphere radius, >= 0
+  std::array<Eigen::Vector3d, 3> triangle{};       // triangle only
+  std::shared_ptr<const ConvexHull> hull;          // convex only
+
+  static Shape sphere(double radius);
+  static Shape capsule(double radius, double half_length);
+  static Shape box(double hx, double hy, double hz);
+  static Shape box(const Eigen::Vector3d& half_extents) { return box(half_extents.x(), half_extents.y(), half_extents.z()); }
+  static Shape cylinder(double radius, double half_length);
+  static Shape cone(double radius, double half_length);
+  static Shape ellipsoid(double rx, double ry, double rz);
+  static Shape convex(const std::vector<Eigen::Vector3d>& points);
+  static Shape convex(std::shared_ptr<const ConvexHull> hull);
+  static Shape triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+  static Shape halfspace(const Eigen::Vector3d& normal, double offset);
+
+  /// Returns a copy with the given inflation radius (must be finite and >= 0).
+  Shape inflated(double radius) const;
+
+  /// Radius of a ball centred at the local origin that contains the shape (inflation included); infinite for halfspaces.
+  double bounding_radius() const;
+};
+
+/// Axis-aligned bounding box in the world frame.
+struct Aabb {
+  Eigen::Vector3d min, max;
+};
+
+/// Tight world AABB of `shape` under the pose (rotation, translation); infinite extents for halfspaces.
+Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
+
+/// Stores each shape once; pairs refer to shapes by index, so many instances of one mesh cost one mesh.
+class ShapeTable {
+ public:
+  std::uint32_t add(Shape shape);
+  std::size_t size() const { return shapes_.size(); }
+  const Shape& operator[](std::size_t i) const { return shapes_[i]; }
+  const std::vector<Shape>& shapes() const { return shapes_; }
+
+ private:
+  std::vector<Shape> shapes_;
+};
+
+}  // namespace batchcol

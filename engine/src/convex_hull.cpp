@@ -1,0 +1,123 @@
+// Convex hulls through qhull's reentrant C library (Barber, Dobkin, Huhdanpaa, "The Quickhull algorithm for
+// convex hulls", ACM TOMS 1996). Option Qt triangulates the facets so every face is a triangle.
+#include "batchcol/shapes.hpp"
+
+extern "C" {
+#include <libqhull_r/qhull_ra.h>
+}
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <unordered_map>
+
+namespace batchcol {
+namespace {
+
+/// qhull writes its diagnostics to a FILE*; collect them in memory to put them in our error message.
+class MemoryStream {
+ public:
+  MemoryStream() : file_(open_memstream(&buffer_, &size_)) {}
+  ~MemoryStream() {
+    if (file_) std::fclose(file_);
+    std::free(buffer_);
+  }
+  MemoryStream(const MemoryStream&) = delete;
+  MemoryStream& operator=(const MemoryStream&) = delete;
+  FILE* file() const { return file_; }
+  std::string text() {
+    if (file_) std::fflush(file_);
+    return buffer_ ? std::string(buffer_, size_) : std::string();
+  }
+
+ private:
+  char* buffer_ = nullptr;
+  std::size_t size_ = 0;
+  FILE* file_;
+};
+
+std::string first_line(const std::string& s) {
+  const auto start = s.find_first_not_of(" \n");
+  if (start == std::string::npos) return "no message";
+  return s.substr(start, s.find('\n', start) - start);
+}
+
+void build_adjacency(ConvexHull& hull) {
+  std::vector<std::vector<std::uint32_t>> adj(hull.vertices.size());
+  for (const auto& f : hull.faces)
+    for (int e = 0; e < 3; ++e) {
+      adj[f[e]].push_back(f[(e + 1) % 3]);
+      adj[f[(e + 1) % 3]].push_back(f[e]);
+    }
+  hull.neighbor_offsets.assign(1, 0);
+  for (auto& list : adj) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    hull.neighbors.insert(hull.neighbors.end(), list.begin(), list.end());
+    hull.neighbor_offsets.push_back(static_cast<std::uint32_t>(hull.neighbors.size()));
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
+                                                      const std::string& what) {
+  if (points.size() < 4)
+    throw InputError(what + ": a convex hull needs at least 4 non-coplanar points, got " +
+                     std::to_string(points.size()));
+  std::vector<coordT> coords;
+  coords.reserve(points.size() * 3);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) throw InputError(what + ": point " + std::to_string(i) + " is not finite");
+    coords.insert(coords.end(), {points[i].x(), points[i].y(), points[i].z()});
+  }
+
+  qhT qh_storage;
+  qhT* qh = &qh_storage;
+  MemoryStream err;
+  qh_zero(qh, err.file());
+  char options[] = "qhull Qt";
+  const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, options, nullptr,
+                                     err.file());
+  auto hull = std::make_shared<ConvexHull>();
+  if (exit_code == 0) {
+    std::unordered_map<int, std::uint32_t> index;  // qhull point id -> hull vertex index
+    vertexT* vertex;
+    FORALLvertices {
+      index[qh_pointid(qh, vertex->point)] = static_cast<std::uint32_t>(hull->vertices.size());
+      hull->vertices.push_back(points[static_cast<std::size_t>(qh_pointid(qh, vertex->point))]);
+    }
+    facetT* facet;
+    FORALLfacets {
+      std::array<std::uint32_t, 3> f{};
+      int k = 0;
+      vertexT** vertexp;
+      FOREACHvertex_(facet->vertices) {
+        if (k < 3) f[k] = index[qh_pointid(qh, vertex->point)];
+        ++k;
+      }
+      if (k != 3) continue;  // cannot happen with Qt; skip rather than read garbage
+      const Eigen::Vector3d n(facet->normal[0], facet->normal[1], facet->normal[2]);
+      const auto& v = hull->vertices;
+      if ((v[f[1]] - v[f[0]]).cross(v[f[2]] - v[f[0]]).dot(n) < 0.0) std::swap(f[1], f[2]);
+      hull->faces.push_back(f);
+      hull->face_normals.push_back(n.normalized());
+    }
+  }
+  const std::string message = err.text();
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong = 0, totlong = 0;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  if (exit_code != 0)
+    throw InputError(what + ": fewer than 4 non-coplanar points, no 3D convex hull (qhull: " + first_line(message) +
+                     ")");
+  if (hull->vertices.size() < 4 || hull->faces.size() < 4)
+    throw InputError(what + ": the convex hull is degenerate (fewer than 4 vertices)");
+  for (const auto& v : hull->vertices) hull->centroid += v;
+  hull->centroid /= static_cast<double>(hull->vertices.size());
+  build_adjacency(*hull);
+  return hull;
+}
+
+}  // namespace batchcol

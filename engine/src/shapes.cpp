@@ -1,0 +1,134 @@
+#include "batchcol/shapes.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace batchcol {
+namespace {
+
+void require_positive(double v, const char* field) {
+  if (!std::isfinite(v)) throw InputError(std::string(field) + " must be a finite number, got " + std::to_string(v));
+  if (!(v > 0.0)) throw InputError(std::string(field) + " must be > 0, got " + std::to_string(v));
+}
+
+void require_finite(const Eigen::Vector3d& v, const std::string& field) {
+  if (!v.allFinite()) throw InputError(field + " must be finite");
+}
+
+Shape make(ShapeType type, const Eigen::Vector3d& size) {
+  Shape s;
+  s.type = type;
+  s.size = size;
+  return s;
+}
+
+}  // namespace
+
+Shape Shape::sphere(double radius) {
+  require_positive(radius, "radius");
+  return make(ShapeType::sphere, {radius, 0, 0});
+}
+
+Shape Shape::capsule(double radius, double half_length) {
+  require_positive(radius, "radius");
+  require_positive(half_length, "half_length");
+  return make(ShapeType::capsule, {radius, half_length, 0});
+}
+
+Shape Shape::box(double hx, double hy, double hz) {
+  require_positive(hx, "half_extents[0]");
+  require_positive(hy, "half_extents[1]");
+  require_positive(hz, "half_extents[2]");
+  return make(ShapeType::box, {hx, hy, hz});
+}
+
+Shape Shape::cylinder(double radius, double half_length) {
+  require_positive(radius, "radius");
+  require_positive(half_length, "half_length");
+  return make(ShapeType::cylinder, {radius, half_length, 0});
+}
+
+Shape Shape::cone(double radius, double half_length) {
+  require_positive(radius, "radius");
+  require_positive(half_length, "half_length");
+  return make(ShapeType::cone, {radius, half_length, 0});
+}
+
+Shape Shape::ellipsoid(double rx, double ry, double rz) {
+  require_positive(rx, "radii[0]");
+  require_positive(ry, "radii[1]");
+  require_positive(rz, "radii[2]");
+  return make(ShapeType::ellipsoid, {rx, ry, rz});
+}
+
+Shape Shape::convex(const std::vector<Eigen::Vector3d>& points) { return convex(compute_convex_hull(points, "vertices")); }
+
+Shape Shape::convex(std::shared_ptr<const ConvexHull> hull) {
+  if (!hull || hull->vertices.size() < 4) throw InputError("vertices: a convex hull needs at least 4 vertices");
+  Shape s;
+  s.type = ShapeType::convex;
+  s.hull = std::move(hull);
+  return s;
+}
+
+Shape Shape::triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  require_finite(a, "vertices[0]");
+  require_finite(b, "vertices[1]");
+  require_finite(c, "vertices[2]");
+  // A triangle without area has no normal; reject it rather than let the kernels meet a zero-length cross product.
+  const double area2 = (b - a).cross(c - a).norm();
+  const double scale = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+  if (!(area2 > 1e-12 * scale * scale))
+    throw InputError("vertices: the triangle is degenerate (its three points are collinear or coincide)");
+  Shape s;
+  s.type = ShapeType::triangle;
+  s.triangle = {a, b, c};
+  return s;
+}
+
+Shape Shape::halfspace(const Eigen::Vector3d& normal, double offset) {
+  require_finite(normal, "normal");
+  if (!std::isfinite(offset)) throw InputError("offset must be a finite number");
+  const double n = normal.norm();
+  if (!(n > 0.0)) throw InputError("normal must be non-zero");
+  Shape s = make(ShapeType::halfspace, normal / n);
+  s.offset = offset / n;  // {x : normal.x <= offset} is unchanged by scaling both sides
+  return s;
+}
+
+Shape Shape::inflated(double radius) const {
+  if (!std::isfinite(radius) || radius < 0.0)
+    throw InputError("inflation must be a finite number >= 0, got " + std::to_string(radius));
+  Shape s = *this;
+  s.inflation = radius;
+  return s;
+}
+
+double Shape::bounding_radius() const {
+  double core = 0.0;
+  switch (type) {
+    case ShapeType::sphere: core = size.x(); break;
+    case ShapeType::capsule: core = size.x() + size.y(); break;
+    case ShapeType::box: core = size.norm(); break;
+    case ShapeType::cylinder:
+    case ShapeType::cone: core = std::hypot(size.x(), size.y()); break;
+    case ShapeType::ellipsoid: core = size.maxCoeff(); break;
+    case ShapeType::convex:
+      for (const auto& v : hull->vertices) core = std::max(core, v.norm());
+      break;
+    case ShapeType::triangle:
+      for (const auto& v : triangle) core = std::max(core, v.norm());
+      break;
+    case ShapeType::halfspace: return std::numeric_limits<double>::infinity();
+  }
+  return core + inflation;
+}
+
+std::uint32_t ShapeTable::add(Shape shape) {
+  if (shapes_.size() >= std::numeric_limits<std::uint32_t>::max()) throw InputError("shape table is full");
+  shapes_.push_back(std::move(shape));
+  return static_cast<std::uint32_t>(shapes_.size() - 1);
+}
+
+}  // namespace batchcol

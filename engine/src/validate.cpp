@@ -1,0 +1,57 @@
+#include "validate.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace batchcol {
+namespace detail {
+
+namespace {
+constexpr std::size_t kRagged = static_cast<std::size_t>(-1);  // component arrays of different lengths
+std::size_t length(const Vec3Array& v) {
+  return v.y.size() == v.x.size() && v.z.size() == v.x.size() ? v.x.size() : kRagged;
+}
+std::size_t length(const QuatArray& q) {
+  return q.x.size() == q.w.size() && q.y.size() == q.w.size() && q.z.size() == q.w.size() ? q.w.size() : kRagged;
+}
+}  // namespace
+
+void validate_batch_layout(const PairBatch& b) {
+  const std::size_t n = b.shape_a.size();
+  const auto check = [n](std::size_t size, const char* name) {
+    if (size == n) return;
+    throw InputError(std::string("PairBatch::") + name + (size == kRagged ? " has component arrays of different "
+                     "lengths" : " has " + std::to_string(size) + " entries, expected " + std::to_string(n)));
+  };
+  check(b.shape_b.size(), "shape_b");
+  check(length(b.translation_a), "translation_a");
+  check(length(b.translation_b), "translation_b");
+  check(length(b.rotation_a), "rotation_a");
+  check(length(b.rotation_b), "rotation_b");
+  if (!b.warm_start.empty()) check(length(b.warm_start), "warm_start");
+}
+
+std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
+  if (!q.coeffs().allFinite()) return std::nullopt;
+  const double norm = q.norm();
+  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) return std::nullopt;
+  return q.normalized();
+}
+
+}  // namespace detail
+
+void validate(const QueryOptions& o) {
+  const auto fail = [](const std::string& what) { throw InputError("QueryOptions::" + what); };
+  if (!std::isfinite(o.tolerance) || o.tolerance < 0.0) fail("tolerance must be a finite number >= 0");
+  if (!std::isfinite(o.relative_tolerance) || o.relative_tolerance < 0.0)
+    fail("relative_tolerance must be a finite number >= 0");
+  if (!std::isfinite(o.margin) || o.margin < 0.0) fail("margin must be a finite number >= 0");
+  if (o.max_iterations < 1) fail("max_iterations must be >= 1");
+  if (o.epa_max_iterations < 1) fail("epa_max_iterations must be >= 1");
+  if (o.threads < 0) fail("threads must be >= 0 (0 = all cores)");
+  if (static_cast<int>(o.level) > static_cast<int>(QueryLevel::penetration)) fail("level is not a QueryLevel");
+  if (static_cast<int>(o.solver) > static_cast<int>(Solver::polyak)) fail("solver is not a Solver");
+  if (static_cast<int>(o.precision) > static_cast<int>(Precision::float32)) fail("precision is not a Precision");
+}
+
+}  // namespace batchcol

@@ -1,0 +1,216 @@
+// Expanding Polytope Algorithm: penetration depth of two overlapping cores.
+//   van den Bergen, "Proximity queries and penetration depth computation on 3D game objects", GDC 2001.
+// Starting from a tetrahedron of D = A - B that contains the origin, repeatedly take the face closest to the
+// origin, ask D's support in its normal, and replace the faces that see the new point by a cone over the horizon.
+// The closest face distance is a lower bound on the depth and the support value h_D(n) an upper bound; we stop
+// when they are within the tolerance. D may be flat (e.g. two crossing segments): its depth is then 0 and the
+// normal is the plane's normal, which is the exact answer for the cores (the swept radii are added by the caller).
+#pragma once
+
+#include "kernels/gjk.hpp"
+
+#include <functional>
+#include <queue>
+#include <vector>
+
+namespace batchcol::kernels {
+
+enum class EpaStatus : std::uint8_t { converged, flat, max_iterations, degenerate };
+
+template <class T> struct EpaResult {
+  EpaStatus status = EpaStatus::degenerate;
+  T depth = T(0);                      // penetration depth of the cores (>= 0)
+  Vec3<T> normal = Vec3<T>::UnitX();   // unit, from A to B (outward normal of D at the closest boundary point)
+  Vec3<T> witness_a = Vec3<T>::Zero(), witness_b = Vec3<T>::Zero();  // witness_a - witness_b = depth * normal
+  int iterations = 0;
+};
+
+namespace detail {
+
+template <class T> struct EpaFace {
+  std::array<int, 3> v{};
+  std::array<int, 3> adj{};  // adj[e] = face across edge (v[e], v[e+1])
+  Vec3<T> n = Vec3<T>::Zero();
+  T dist = T(0);
+  bool obsolete = false;
+};
+
+template <class T> class EpaPolytope {
+ public:
+  std::vector<SupportPoint<T>> verts;
+  std::vector<EpaFace<T>> faces;
+
+  /// Adds face (a, b, c), counter-clockwise seen from outside; returns false if it has no usable normal.
+  bool add_face(int a, int b, int c) {
+    EpaFace<T> f;
+    f.v = {a, b, c};
+    const Vec3<T> n = (verts[b].w - verts[a].w).cross(verts[c].w - verts[a].w);
+    const T len = n.norm();
+    if (!(len > T(0))) return false;
+    f.n = n / len;
+    f.dist = f.n.dot(verts[a].w);
+    faces.push_back(f);
+    return true;
+  }
+
+  int edge_index(const EpaFace<T>& f, int from, int to) const {
+    for (int e = 0; e < 3; ++e)
+      if (f.v[e] == from && f.v[(e + 1) % 3] == to) return e;
+    return -1;
+  }
+
+  /// Links face fi's edges to the other live faces sharing them (reverse direction).
+  void link(int fi) {
+    for (int e = 0; e < 3; ++e) {
+      const int a = faces[fi].v[e], b = faces[fi].v[(e + 1) % 3];
+      for (int g = 0; g < static_cast<int>(faces.size()); ++g) {
+        if (g == fi || faces[g].obsolete) continue;
+        const int k = edge_index(faces[g], b, a);
+        if (k >= 0) { faces[fi].adj[e] = g; faces[g].adj[k] = fi; break; }
+      }
+    }
+  }
+
+  /// Depth-first horizon search (van den Bergen's silhouette). We arrive at face gi through the edge a->b of a
+  /// removed face (gi holds it as b->a). If gi does not see w, a->b is on the horizon and the new face (a, b, w)
+  /// keeps the removed face's winding; otherwise gi is removed too and the search continues over its other edges.
+  void silhouette(int gi, int a, int b, const Vec3<T>& w, std::vector<std::pair<int, int>>& horizon) {
+    EpaFace<T>& g = faces[gi];
+    if (g.obsolete) return;
+    if (g.n.dot(w) - g.dist <= T(0)) {
+      horizon.emplace_back(a, b);
+      return;
+    }
+    g.obsolete = true;
+    const int e = edge_index(g, b, a);
+    for (int k = 1; k <= 2; ++k) {
+      const int ek = (e + k) % 3;
+      silhouette(g.adj[ek], g.v[ek], g.v[(ek + 1) % 3], w, horizon);
+    }
+  }
+};
+
+template <class T> Vec3<T> face_barycentric(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, const Vec3<T>& p,
+                                            const Vec3<T>& n) {
+  const T total = (b - a).cross(c - a).dot(n);
+  const T la = (b - p).cross(c - p).dot(n) / total;
+  const T lb = (c - p).cross(a - p).dot(n) / total;
+  return Vec3<T>(la, lb, T(1) - la - lb);
+}
+
+/// Completes GJK's final simplex (which contains the origin, possibly on its boundary) to a tetrahedron of
+/// positive volume. Returns false if D is flat; then `flat_normal` is its plane normal (or any normal).
+template <class T>
+bool blow_up(const MinkowskiDifference<T>& D, std::vector<SupportPoint<T>>& v, T min_len, Vec3<T>& flat_normal) {
+  const auto try_add = [&](const Vec3<T>& dir, auto&& far_enough) {
+    const SupportPoint<T> p = D.support(dir);
+    if (far_enough(p.w)) { v.push_back(p); return true; }
+    return false;
+  };
+  // Drop a last vertex that adds no dimension (GJK can end on a nearly collinear triangle or a tiny segment).
+  if (v.size() == 3 && !((v[1].w - v[0].w).cross(v[2].w - v[0].w).norm() > min_len * min_len)) v.pop_back();
+  if (v.size() == 2 && !((v[1].w - v[0].w).norm() > min_len)) v.pop_back();
+  if (v.size() == 1) {
+    bool added = false;
+    for (int axis = 0; axis < 3 && !added; ++axis)
+      for (T sgn : {T(1), T(-1)}) {
+        Vec3<T> dir = Vec3<T>::Zero();
+        dir[axis] = sgn;
+        if (try_add(dir, [&](const Vec3<T>& w) { return (w - v[0].w).norm() > min_len; })) { added = true; break; }
+      }
+    if (!added) { flat_normal = Vec3<T>::UnitX(); return false; }
+  }
+  if (v.size() == 2) {
+    const Vec3<T> axis = (v[1].w - v[0].w).normalized();
+    const Vec3<T> u = any_orthogonal(axis), u2 = axis.cross(u);
+    bool added = false;
+    for (int i = 0; i < 6 && !added; ++i) {  // six directions 60 degrees apart around the segment
+      const T angle = T(i) * T(1.0471975511965976);
+      const Vec3<T> dir = std::cos(angle) * u + std::sin(angle) * u2;
+      added = try_add(dir, [&](const Vec3<T>& w) { return (w - v[0].w).cross(axis).norm() > min_len; });
+    }
+    if (!added) { flat_normal = u; return false; }
+  }
+  if (v.size() == 3) {
+    const Vec3<T> n = (v[1].w - v[0].w).cross(v[2].w - v[0].w).normalized();
+    const SupportPoint<T> up = D.support(n), down = D.support(-n);
+    const T hu = n.dot(up.w - v[0].w), hd = -n.dot(down.w - v[0].w);
+    if (std::max(hu, hd) <= min_len) { flat_normal = n; return false; }
+    v.push_back(hu >= hd ? up : down);
+  }
+  return true;
+}
+
+}  // namespace detail
+
+/// EPA from GJK's final simplex (GjkStatus::overlap). `tolerance` bounds the depth error; `scale` is the size
+/// of the problem, below 1e3 epsilon of which two support points count as the same point.
+template <class T>
+EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tolerance, T scale, int max_iterations) {
+  EpaResult<T> r;
+  detail::EpaPolytope<T> P;
+  for (int i = 0; i < start.count; ++i) P.verts.push_back(start.v[i]);
+  const T min_len = T(1000) * machine_epsilon<T>() * scale;
+  Vec3<T> flat_normal;
+  if (!detail::blow_up(D, P.verts, min_len, flat_normal)) {
+    r.status = EpaStatus::flat;
+    r.normal = flat_normal;
+    // GJK's weights put the origin in the simplex: they give a point common to A and B (depth 0).
+    for (int i = 0; i < start.count; ++i) r.witness_a += start.lambda[i] * start.v[i].a;
+    r.witness_b = r.witness_a;
+    return r;
+  }
+  auto& V = P.verts;
+  const T vol = (V[1].w - V[0].w).cross(V[2].w - V[0].w).dot(V[3].w - V[0].w);
+  if (vol < T(0)) std::swap(V[1], V[2]);
+  if (vol == T(0) || !P.add_face(0, 2, 1) || !P.add_face(0, 1, 3) || !P.add_face(0, 3, 2) || !P.add_face(1, 2, 3)) {
+    r.status = EpaStatus::degenerate;
+    return r;
+  }
+  for (int f = 0; f < 4; ++f) P.link(f);
+
+  using Entry = std::pair<T, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  for (int f = 0; f < 4; ++f) heap.emplace(P.faces[f].dist, f);
+  int closest = 0;
+  r.status = EpaStatus::max_iterations;
+  std::vector<std::pair<int, int>> horizon;
+  for (int it = 0; it < max_iterations; ++it) {
+    while (!heap.empty() && P.faces[heap.top().second].obsolete) heap.pop();
+    if (heap.empty()) { r.status = EpaStatus::degenerate; break; }
+    closest = heap.top().second;
+    r.iterations = it + 1;
+    const detail::EpaFace<T> f = P.faces[closest];
+    const SupportPoint<T> s = D.support(f.n);
+    const T upper = f.n.dot(s.w);  // h_D(n) >= depth >= f.dist
+    if (upper - f.dist <= tolerance) { r.status = EpaStatus::converged; break; }
+
+    const int wi = static_cast<int>(V.size());
+    V.push_back(s);
+    horizon.clear();
+    P.faces[closest].obsolete = true;
+    for (int e = 0; e < 3; ++e)
+      P.silhouette(f.adj[e], f.v[e], f.v[(e + 1) % 3], s.w, horizon);
+    const int first_new = static_cast<int>(P.faces.size());
+    bool ok = !horizon.empty();
+    for (const auto& [a, b] : horizon) ok = ok && P.add_face(a, b, wi);
+    if (!ok) {  // a cone face without a normal: the polytope can no longer be trusted; keep the last face
+      r.status = EpaStatus::degenerate;
+      break;
+    }
+    for (int g = first_new; g < static_cast<int>(P.faces.size()); ++g) {
+      P.link(g);
+      heap.emplace(P.faces[g].dist, g);
+    }
+  }
+  const detail::EpaFace<T>& f = P.faces[closest];
+  r.depth = std::max(f.dist, T(0));
+  r.normal = f.n;
+  const Vec3<T> p = f.n * f.dist;
+  const Vec3<T> lam = detail::face_barycentric(V[f.v[0]].w, V[f.v[1]].w, V[f.v[2]].w, p, f.n);
+  r.witness_a = lam[0] * V[f.v[0]].a + lam[1] * V[f.v[1]].a + lam[2] * V[f.v[2]].a;
+  r.witness_b = lam[0] * V[f.v[0]].b + lam[1] * V[f.v[1]].b + lam[2] * V[f.v[2]].b;
+  return r;
+}
+
+}  // namespace batchcol::kernels

@@ -1,0 +1,143 @@
+// GJK as fully-corrective Frank-Wolfe on the Minkowski difference D = A - B, with optional Nesterov or Polyak
+// momentum on the support direction.
+//   Gilbert, Johnson, Keerthi, "A fast procedure for computing the distance between complex objects", 1988.
+//   Montaut, Le Lidec, Petrik, Sivic, Carpentier, "Collision detection accelerated: an optimization
+//   perspective", RSS 2022 (Nesterov momentum delta_k = (k+1)/(k+3), normalised directions for shapes that are not
+//   strictly convex, fallback to plain GJK when momentum stops helping).
+// Minimising f(x) = |x|^2 / 2 over D: the gradient at x is x, a Frank-Wolfe step asks the support of D in
+// direction -d, and the support point s gives the certified lower bound <s, d>/|d| on dist(0, D). We stop when
+// |x| minus the best lower bound (an upper bound on the distance error) is below the tolerance; with d = x this is
+// the duality gap (|x|^2 - <x, s>) / |x|.
+#pragma once
+
+#include "batchcol/batch.hpp"
+#include "kernels/minkowski.hpp"
+#include "kernels/simplex_projection.hpp"
+
+#include <algorithm>
+#include <array>
+
+namespace batchcol::kernels {
+
+enum class GjkStatus : std::uint8_t {
+  converged,          // distance certified within tolerance (shapes separated or touching)
+  overlap,            // the origin lies in the current simplex: the cores intersect
+  separated_proven,   // boolean query: a separating plane beyond the margin was found
+  collision_proven,   // boolean query: a point of D within the margin was found
+  max_iterations,
+  stalled,            // no progress in working precision before the tolerance was reached
+};
+
+template <class T> struct Simplex {
+  std::array<SupportPoint<T>, 4> v;
+  std::array<T, 4> lambda{};
+  int count = 0;
+};
+
+template <class T> struct GjkParams {
+  Solver solver = Solver::nesterov;
+  T tolerance = T(1e-8);           // absolute, on the core distance (already raised to the precision floor)
+  T relative_tolerance = T(0);
+  int max_iterations = 128;
+  bool boolean_only = false;
+  T core_margin = T(0);            // boolean: the cores collide when their distance is <= core_margin
+  bool normalize_momentum = true;  // normalised Nesterov directions (shapes not strictly convex)
+};
+
+template <class T> struct GjkResult {
+  GjkStatus status = GjkStatus::max_iterations;
+  Vec3<T> x = Vec3<T>::Zero();      // closest point of D found: witness_a - witness_b (A's frame)
+  Simplex<T> simplex;
+  Vec3<T> direction = Vec3<T>::Zero();  // last search direction (warm start for the next query)
+  T lower_bound = T(0);             // best certified lower bound on the core distance (may be <= 0)
+  int iterations = 0;
+
+  Vec3<T> witness_a() const { return combine(&SupportPoint<T>::a); }
+  Vec3<T> witness_b() const { return combine(&SupportPoint<T>::b); }
+
+ private:
+  Vec3<T> combine(Vec3<T> SupportPoint<T>::*member) const {
+    Vec3<T> p = Vec3<T>::Zero();
+    for (int i = 0; i < simplex.count; ++i) p += simplex.lambda[i] * (simplex.v[i].*member);
+    return p;
+  }
+};
+
+template <class T>
+GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
+  GjkResult<T> r;
+  if (!(initial_direction.squaredNorm() > T(0))) initial_direction = Vec3<T>::UnitX();
+  Simplex<T>& S = r.simplex;
+  S.v[0] = D.support(-initial_direction);
+  S.lambda[0] = T(1);
+  S.count = 1;
+  Vec3<T> x = S.v[0].w;
+  Vec3<T> d_prev = initial_direction;
+  Vec3<T> last_s = x;
+  bool momentum = params.solver != Solver::gjk;
+  T lower_bound = -std::numeric_limits<T>::infinity();
+
+  for (int k = 0; k < params.max_iterations; ++k) {
+    r.iterations = k + 1;
+    const T xx = x.squaredNorm();
+    const T xn = std::sqrt(xx);
+    if (xx == T(0)) { r.status = GjkStatus::overlap; break; }
+    if (params.boolean_only && xn <= params.core_margin) { r.status = GjkStatus::collision_proven; break; }
+
+    Vec3<T> d = x;
+    if (momentum && params.solver == Solver::nesterov) {
+      const T delta = T(k + 1) / T(k + 3);
+      const Vec3<T> y = delta * x + (T(1) - delta) * last_s;
+      const T yn = y.norm(), dn = d_prev.norm();
+      if (params.normalize_momentum && yn > T(0) && dn > T(0)) d = delta * d_prev / dn + (T(1) - delta) * y / yn;
+      else if (!params.normalize_momentum) d = delta * d_prev + (T(1) - delta) * y;
+    } else if (momentum) {  // Polyak heavy ball: running average of the gradients with weight 1/(k+2)
+      const T beta = T(1) / T(k + 2);
+      d = (T(1) - beta) * x + beta * d_prev;
+    }
+    const T dn = d.norm();
+    if (!(dn > T(0))) d = x;  // momentum cancelled out: use the gradient
+    const bool plain_step = (d == x);
+
+    const SupportPoint<T> s = D.support(-d);
+    const T lb = s.w.dot(d) / d.norm();  // every y in D has <y, d/|d|> >= lb
+    lower_bound = std::max(lower_bound, lb);
+    r.direction = d;
+    if (params.boolean_only && lb > params.core_margin) { r.status = GjkStatus::separated_proven; break; }
+
+    const T tol = std::max(params.tolerance, params.relative_tolerance * xn);
+    if (xn - lower_bound <= tol) { r.status = GjkStatus::converged; break; }
+    if (!plain_step && xx - x.dot(s.w) <= tol * xn) {
+      // The momentum support point would not move x: switch to plain GJK, whose gap certifies convergence.
+      momentum = false;
+      continue;
+    }
+
+    S.v[S.count++] = s;
+    std::array<Vec3<T>, 4> pts;
+    for (int i = 0; i < S.count; ++i) pts[i] = S.v[i].w;
+    const SimplexProjection<T> proj = project_origin(pts.data(), S.count);
+    Simplex<T> next;
+    next.count = proj.count;
+    for (int i = 0; i < proj.count; ++i) { next.v[i] = S.v[proj.index[i]]; next.lambda[i] = proj.lambda[i]; }
+    const T next_xx = proj.x.squaredNorm();
+    if (proj.contains_origin) { S = next; x = proj.x; r.status = GjkStatus::overlap; break; }
+    if (!(next_xx < xx)) {
+      // No decrease although conv(W + s) contains x: we are at the resolution of the arithmetic.
+      S.count -= 1;
+      if (!plain_step) { momentum = false; continue; }
+      r.status = GjkStatus::stalled;
+      break;
+    }
+    S = next;
+    x = proj.x;
+    d_prev = d;
+    last_s = s.w;
+  }
+  r.x = x;
+  r.lower_bound = lower_bound;
+  if (r.status == GjkStatus::overlap) r.x = Vec3<T>::Zero();
+  return r;
+}
+
+}  // namespace batchcol::kernels

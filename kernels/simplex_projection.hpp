@@ -1,0 +1,140 @@
+// Projection of the origin onto the convex hull of 1-4 points: the "fully corrective" step of GJK seen as
+// Frank-Wolfe. Signed-volume sub-algorithm after Montanari, Petrinic, Barbieri, "Improving the GJK algorithm for
+// faster and more reliable distance queries between convex objects", ACM TOG 36(3), 2017: barycentric coordinates
+// are ratios of signed sub-volumes (sub-areas projected on the best-conditioned plane), so whenever the origin is
+// classified inside, the weights are non-negative and sum to one: the result is a convex combination even on
+// nearly degenerate simplices, and exactly degenerate ones (zero volume / area / length) fall back to their faces.
+#pragma once
+
+#include "kernels/math.hpp"
+
+#include <array>
+
+namespace batchcol::kernels {
+
+/// Closest point of a simplex to the origin as a convex combination of a subset of its vertices.
+template <class T> struct SimplexProjection {
+  Vec3<T> x = Vec3<T>::Zero();
+  int count = 0;                    // size of the support set
+  std::array<int, 4> index{};       // input indices of the support set
+  std::array<T, 4> lambda{};        // their weights (>= 0, sum 1)
+  bool contains_origin = false;     // only for 4 points: origin inside the tetrahedron
+};
+
+namespace detail {
+
+template <class T> SimplexProjection<T> vertex(const Vec3<T>* p, int i) {
+  SimplexProjection<T> r;
+  r.x = p[i];
+  r.count = 1;
+  r.index[0] = i;
+  r.lambda[0] = T(1);
+  return r;
+}
+
+template <class T> SimplexProjection<T> segment(const Vec3<T>* p, int i, int j) {
+  const Vec3<T> t = p[j] - p[i];
+  const T tt = t.squaredNorm();
+  if (tt == T(0)) return vertex(p, i);  // duplicate points
+  const T u = -p[i].dot(t) / tt;        // parameter of the origin's projection on the line
+  if (u <= T(0)) return vertex(p, i);
+  if (u >= T(1)) return vertex(p, j);
+  SimplexProjection<T> r;
+  r.count = 2;
+  r.index = {i, j, 0, 0};
+  r.lambda = {T(1) - u, u, T(0), T(0)};
+  r.x = r.lambda[0] * p[i] + r.lambda[1] * p[j];
+  return r;
+}
+
+template <class T> const SimplexProjection<T>& closer(const SimplexProjection<T>& a, const SimplexProjection<T>& b) {
+  return b.x.squaredNorm() < a.x.squaredNorm() ? b : a;
+}
+
+template <class T> bool opposite_sign(T a, T b) { return (a > T(0) && b < T(0)) || (a < T(0) && b > T(0)); }
+
+template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j, int k) {
+  const Vec3<T> n = (p[j] - p[i]).cross(p[k] - p[i]);
+  const T nn = n.squaredNorm();
+  const auto edges = [&] { return closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k)); };
+  if (nn == T(0)) return edges();  // collinear: the closest point lies on one of the edges
+  // Origin projected on the triangle's plane, then 2D signed areas on the coordinate plane where the triangle's
+  // projection is largest (drop the axis of the largest |n| component: best conditioned).
+  const Vec3<T> p0 = n * (p[i].dot(n) / nn);
+  int drop = 0;
+  if (std::abs(n.y()) > std::abs(n[drop])) drop = 1;
+  if (std::abs(n.z()) > std::abs(n[drop])) drop = 2;
+  const int u = (drop + 1) % 3, v = (drop + 2) % 3;
+  const auto area = [&](const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
+    return (b[u] - a[u]) * (c[v] - a[v]) - (b[v] - a[v]) * (c[u] - a[u]);
+  };
+  const std::array<T, 3> C = {area(p0, p[j], p[k]), area(p[i], p0, p[k]), area(p[i], p[j], p0)};
+  const T total = area(p[i], p[j], p[k]);
+  if (total == T(0)) return edges();
+  const std::array<int, 3> id = {i, j, k};
+  bool inside = true;
+  for (T c : C) inside = inside && !opposite_sign(c, total);
+  const T sum = C[0] + C[1] + C[2];
+  if (inside && sum != T(0)) {
+    SimplexProjection<T> r;
+    r.count = 3;
+    for (int m = 0; m < 3; ++m) { r.index[m] = id[m]; r.lambda[m] = C[m] / sum; }
+    r.x = r.lambda[0] * p[i] + r.lambda[1] * p[j] + r.lambda[2] * p[k];
+    return r;
+  }
+  // Outside: the closest point is on an edge whose opposite vertex has a weight of the wrong sign.
+  SimplexProjection<T> best;
+  bool have = false;
+  for (int m = 0; m < 3; ++m) {
+    if (inside || !opposite_sign(C[m], total)) continue;
+    const SimplexProjection<T> e = segment(p, id[(m + 1) % 3], id[(m + 2) % 3]);
+    best = have ? closer(best, e) : e;
+    have = true;
+  }
+  return have ? best : edges();
+}
+
+template <class T> T det3(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) { return a.dot(b.cross(c)); }
+
+template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
+  // V[m] = signed volume of the tetrahedron with vertex m replaced by the origin; their sum is the full volume.
+  const std::array<T, 4> V = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]),
+                              -det3(p[0], p[1], p[2])};
+  const T total = V[0] + V[1] + V[2] + V[3];
+  const std::array<std::array<int, 3>, 4> face = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
+  bool inside = total != T(0);
+  for (T vm : V) inside = inside && !opposite_sign(vm, total);
+  if (inside) {
+    SimplexProjection<T> r;
+    r.count = 4;
+    r.contains_origin = true;
+    for (int m = 0; m < 4; ++m) { r.index[m] = m; r.lambda[m] = V[m] / total; }
+    r.x = Vec3<T>::Zero();
+    return r;
+  }
+  // Outside (or flat): the closest point lies on a face the origin sees, i.e. whose opposite weight is negative;
+  // a flat tetrahedron (total == 0) has no orientation, so all four faces are candidates.
+  SimplexProjection<T> best;
+  bool have = false;
+  for (int m = 0; m < 4; ++m) {
+    if (total != T(0) && !opposite_sign(V[m], total)) continue;
+    const SimplexProjection<T> f = triangle(p, face[m][0], face[m][1], face[m][2]);
+    best = have ? closer(best, f) : f;
+    have = true;
+  }
+  return best;
+}
+
+}  // namespace detail
+
+/// Projects the origin onto conv(p[0..n-1]), 1 <= n <= 4.
+template <class T> SimplexProjection<T> project_origin(const Vec3<T>* p, int n) {
+  switch (n) {
+    case 1: return detail::vertex(p, 0);
+    case 2: return detail::segment(p, 0, 1);
+    case 3: return detail::triangle(p, 0, 1, 2);
+    default: return detail::tetrahedron(p);
+  }
+}
+
+}  // namespace batchcol::kernels

@@ -1,0 +1,91 @@
+#include "support/generators.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace batchcol::testing {
+
+double uniform(Rng& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+
+Eigen::Vector3d random_unit_vector(Rng& rng) {
+  std::normal_distribution<double> g;
+  Eigen::Vector3d v;
+  do v = {g(rng), g(rng), g(rng)};
+  while (v.norm() < 1e-6);
+  return v.normalized();
+}
+
+Eigen::Quaterniond random_rotation(Rng& rng) {
+  std::normal_distribution<double> g;
+  Eigen::Quaterniond q(g(rng), g(rng), g(rng), g(rng));
+  return q.normalized();
+}
+
+std::vector<ShapeType> bounded_shape_types() {
+  return {ShapeType::sphere,    ShapeType::capsule,  ShapeType::box,     ShapeType::cylinder,
+          ShapeType::cone,      ShapeType::ellipsoid, ShapeType::convex, ShapeType::triangle};
+}
+
+std::vector<Eigen::Vector3d> random_hull_points(Rng& rng, int n, double min_size, double max_size) {
+  const Eigen::Vector3d radii(uniform(rng, min_size, max_size), uniform(rng, min_size, max_size),
+                              uniform(rng, min_size, max_size));
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(random_unit_vector(rng).cwiseProduct(radii));
+  return pts;
+}
+
+Shape random_shape(Rng& rng, ShapeType type, double lo, double hi) {
+  const auto u = [&] { return uniform(rng, lo, hi) / 2; };  // sizes are diameters in [lo, hi]
+  switch (type) {
+    case ShapeType::sphere: return Shape::sphere(u());
+    case ShapeType::capsule: return Shape::capsule(u(), u());
+    case ShapeType::box: return Shape::box(u(), u(), u());
+    case ShapeType::cylinder: return Shape::cylinder(u(), u());
+    case ShapeType::cone: return Shape::cone(u(), u());
+    case ShapeType::ellipsoid: return Shape::ellipsoid(u(), u(), u());
+    case ShapeType::convex: return Shape::convex(random_hull_points(rng, 24, lo / 2, hi / 2));
+    case ShapeType::triangle: {
+      const double s = u();
+      return Shape::triangle_shape(s * random_unit_vector(rng), s * random_unit_vector(rng),
+                                   s * random_unit_vector(rng));
+    }
+    case ShapeType::halfspace: return Shape::halfspace(random_unit_vector(rng), 0.0);
+  }
+  return Shape::sphere(u());
+}
+
+double extent(const Shape& s, const Eigen::Vector3d& d) {
+  const double n = d.norm();
+  const double rho = std::hypot(d.x(), d.y());
+  double core = 0;
+  switch (s.type) {
+    case ShapeType::sphere: core = s.size.x() * n; break;
+    case ShapeType::capsule: core = s.size.y() * std::abs(d.z()) + s.size.x() * n; break;
+    case ShapeType::box: core = s.size.cwiseProduct(d.cwiseAbs()).sum(); break;
+    case ShapeType::cylinder: core = s.size.x() * rho + s.size.y() * std::abs(d.z()); break;
+    case ShapeType::cone: core = std::max(s.size.y() * d.z(), -s.size.y() * d.z() + s.size.x() * rho); break;
+    case ShapeType::ellipsoid: core = s.size.cwiseProduct(d).norm(); break;
+    case ShapeType::convex:
+      core = -1e300;
+      for (const auto& v : s.hull->vertices) core = std::max(core, v.dot(d));
+      break;
+    case ShapeType::triangle:
+      core = std::max({s.triangle[0].dot(d), s.triangle[1].dot(d), s.triangle[2].dot(d)});
+      break;
+    case ShapeType::halfspace: core = 1e300; break;
+  }
+  return core + s.inflation * n;
+}
+
+SingleResult run_pair(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const QueryOptions& options) {
+  ShapeTable table;
+  const auto ia = table.add(a), ib = table.add(b);
+  PairBatch batch;
+  batch.add(ia, pa, ib, pb);
+  PairResults r;
+  collide(table, batch, options, r);
+  return {r.status[0], r.collide[0] != 0, r.distance[0], r.witness_a[0], r.witness_b[0], r.normal[0],
+          r.iterations[0]};
+}
+
+}  // namespace batchcol::testing

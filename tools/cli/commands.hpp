@@ -1,0 +1,19 @@
+// Subcommands of the batchcol CLI. Each add_*_command registers its options on `parent` and returns the
+// subcommand with a runner to call when that subcommand was parsed.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace batchcol::cli {
+
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;  // returns the exit code; throws InputError / std::exception on failure
+};
+
+Command add_demo_command(CLI::App& parent);
+Command add_query_command(CLI::App& parent);
+
+}  // namespace batchcol::cli

@@ -1,0 +1,42 @@
+// batchcol command-line tool. Exit codes: 0 success, 2 any error (bad flags, bad input, failed output).
+#include "cli/commands.hpp"
+
+#include <batchcol/errors.hpp>
+
+#include <exception>
+#include <iostream>
+#include <vector>
+
+namespace {
+
+int fail(const char* message) {
+  std::cerr << "batchcol: error: " << message << '\n';
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    CLI::App app{"batchcol: batched convex collision queries"};
+    app.require_subcommand(1);
+    const std::vector<batchcol::cli::Command> commands = {batchcol::cli::add_demo_command(app),
+                                                          batchcol::cli::add_query_command(app)};
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
+      return fail(e.what());
+    }
+    for (const auto& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
+    return fail("no subcommand given");
+  } catch (const batchcol::InputError& e) {
+    return fail(e.what());
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  } catch (...) {
+    return fail("unknown failure");
+  }
+}
