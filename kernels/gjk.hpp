@@ -63,6 +63,18 @@ template <class T> struct GjkResult {
   }
 };
 
+/// The gradient direction when x lies inside a triangle of the simplex. Rounding leaves x with an absolute error
+/// of a few ulps of the vertices, so its direction is off by ~eps |w| / |x| (large when the shapes nearly touch);
+/// the triangle's normal is off by ~eps |w|^2 / |n| instead. Return whichever is better conditioned, scaled to
+/// |x| (both are the same direction in exact arithmetic).
+template <class T> Vec3<T> face_direction(const Simplex<T>& S, const Vec3<T>& x) {
+  const Vec3<T> n = (S.v[1].w - S.v[0].w).cross(S.v[2].w - S.v[0].w);
+  const T w = std::max({S.v[0].w.norm(), S.v[1].w.norm(), S.v[2].w.norm()});
+  const T xn = x.norm(), nn = n.norm();
+  if (!(nn > xn * w)) return x;
+  return (n.dot(x) < T(0) ? -n : n) * (xn / nn);
+}
+
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -98,6 +110,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     const T dn = d.norm();
     if (!(dn > T(0))) d = x;  // momentum cancelled out: use the gradient
     const bool plain_step = (d == x);
+    if (plain_step && S.count == 3) d = face_direction(S, x);
 
     const SupportPoint<T> s = D.support(-d);
     const T lb = s.w.dot(d) / d.norm();  // every y in D has <y, d/|d|> >= lb
@@ -129,6 +142,9 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       r.status = GjkStatus::stalled;
       break;
     }
+    // Momentum whose step moves |x| by less than the tolerance is lagging behind the gradient (delta_k -> 1
+    // makes the direction sluggish near a flat contact): finish with plain GJK steps, as Montaut et al. do.
+    if (!plain_step && xn - std::sqrt(next_xx) <= tol) momentum = false;
     S = next;
     x = proj.x;
     d_prev = d;

@@ -5,13 +5,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
-#include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -40,7 +41,7 @@ std::string pointer_token(const std::string& key) {
 // the byte offset and JSON pointer of a parse error.
 class DomBuilder final : public nlohmann::json_sax<json> {
  public:
-  explicit DomBuilder(json& root) : root_(root) {}
+  DomBuilder(const std::string& text, json& root) : text_(text), root_(root) {}
 
   bool null() override { return add(json(nullptr)); }
   bool boolean(bool v) override { return add(json(v)); }
@@ -65,21 +66,27 @@ class DomBuilder final : public nlohmann::json_sax<json> {
     return true;
   }
 
-  bool parse_error(std::size_t position, const std::string&, const json::exception& ex) override {
-    error_offset = position;
+  bool parse_error(std::size_t position, const std::string& last_token, const json::exception& ex) override {
+    // `position` counts the characters read, i.e. it is just past the offending token; point at the token's start.
+    error_index = position > 0 ? position - 1 : 0;
+    if (!last_token.empty() && position >= last_token.size() &&
+        text_.compare(position - last_token.size(), last_token.size(), last_token) == 0) {
+      error_index = position - last_token.size();
+    }
     // A number overflow is a complete value, so the pointer of that value is exact; other errors name the container.
     error_pointer = ex.id == 406 ? value_pointer() : container_pointer();
-    error_message = ex.what();
-    const auto bracket = error_message.find("] ");
-    if (bracket != std::string::npos) error_message.erase(0, bracket + 2);
-    if (error_message.rfind("parse error", 0) == 0) {  // drop nlohmann's own "parse error at line L, column C: "
-      const auto colon = error_message.find(": ");
-      if (colon != std::string::npos) error_message.erase(0, colon + 2);
+    std::string what = ex.what();
+    const auto bracket = what.find("] ");
+    if (bracket != std::string::npos) what.erase(0, bracket + 2);
+    if (what.rfind("parse error", 0) == 0) {  // drop nlohmann's own "parse error at line L, column C: "
+      const auto colon = what.find(": ");
+      if (colon != std::string::npos) what.erase(0, colon + 2);
     }
+    error_message = "invalid JSON: " + what;
     return false;
   }
 
-  std::optional<std::size_t> error_offset;  // set for syntax errors only
+  std::optional<std::size_t> error_index;  // index into the text, for syntax errors only
   std::string error_pointer;
   std::string error_message;
 
@@ -129,14 +136,14 @@ class DomBuilder final : public nlohmann::json_sax<json> {
     return stack_.empty() ? std::string() : container_pointer() + "/" + child_token(stack_.back(), true);
   }
 
+  const std::string& text_;
   json& root_;
   std::vector<Frame> stack_;
 };
 
-// 1-based line and column of the character at `offset` (nlohmann reports the count of characters read, so the
-// offending character is the one before it).
-std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t offset) {
-  const std::size_t index = std::min(offset > 0 ? offset - 1 : 0, text.size());
+// 1-based line and column of the character at `index` (index == size means the end of the text).
+std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t index) {
+  index = std::min(index, text.size());
   std::size_t line = 1, line_start = 0;
   for (std::size_t i = 0; i < index; ++i) {
     if (text[i] == '\n') {
@@ -174,8 +181,11 @@ class BatchReader {
     throw InputError(source_ + ": " + (pointer.empty() ? std::string("top level") : pointer) + ": " + message);
   }
 
+  // "string \"nan\"", "array of 2 elements", ... (containers are not printed: they may be huge).
   static std::string describe(const json& v) {
-    std::string text = v.dump();
+    if (v.is_array()) return "array of " + std::to_string(v.size()) + " elements";
+    if (v.is_object()) return "object";
+    std::string text = v.dump(-1, ' ', false, json::error_handler_t::replace);
     if (text.size() > 40) text = text.substr(0, 37) + "...";
     return std::string(v.type_name()) + " " + text;
   }
@@ -270,13 +280,17 @@ class BatchReader {
     }
   }
 
-  // Runs a Shape factory, prefixing its InputError with the pointer it concerns.
+  // Runs a Shape factory, prefixing its InputError with the pointer it concerns (and dropping the factory's own
+  // "field: " prefix when it repeats the pointer's last token).
   template <typename Make>
-  Shape build(const std::string& pointer, Make make) const {
+  Shape build(const std::string& pointer, Make make, const std::string& context = "") const {
     try {
       return make();
     } catch (const InputError& e) {
-      fail(pointer, e.what());
+      std::string message = e.what();
+      const std::string field = pointer.substr(pointer.rfind('/') + 1) + ": ";
+      if (message.rfind(field, 0) == 0) message.erase(0, field.size());
+      fail(pointer, context + message);
     }
   }
 
@@ -347,7 +361,7 @@ class BatchReader {
     } catch (const InputError& e) {
       fail(pointer, e.what());
     }
-    return build(pointer, [&] { return Shape::convex(pts); });
+    return build(pointer, [&] { return Shape::convex(pts); }, "mesh '" + path + "': ");
   }
 
   std::uint32_t shape_index(const json& v, const std::string& pointer, std::size_t shape_count) const {
@@ -423,15 +437,15 @@ void BatchFile::apply_to(QueryOptions& options) const {
 
 BatchFile parse_batch_json(const std::string& text, const std::string& source, const std::string& base_dir) {
   json root;
-  DomBuilder builder(root);
+  DomBuilder builder(text, root);
   if (!json::sax_parse(text, &builder)) {
     std::string where;
-    if (builder.error_offset) {
-      const auto [line, column] = line_and_column(text, *builder.error_offset);
+    if (builder.error_index) {
+      const auto [line, column] = line_and_column(text, *builder.error_index);
       where = "line " + std::to_string(line) + ", column " + std::to_string(column) + ": ";
     }
     if (!builder.error_pointer.empty()) where += builder.error_pointer + ": ";
-    throw InputError(source + ": " + where + "invalid JSON: " + builder.error_message);
+    throw InputError(source + ": " + where + builder.error_message);
   }
   return BatchReader(source, base_dir).read(root);
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace batchcol {
@@ -435,6 +436,32 @@ TEST(BatchFileErrors, DirectoryInsteadOfBatchFile) {
     EXPECT_THAT(e.what(), HasSubstr(path));
     EXPECT_THAT(e.what(), HasSubstr("is a directory"));
   }
+}
+
+TEST(BatchFileErrors, NonRegularBatchFile) {
+  const fs::path fifo = make_temp_dir("fifo") / "batch.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    load_batch_file(fifo.string());  // must not block reading the pipe
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(fifo.string() + ": not a regular file"));
+  }
+  fs::remove_all(fifo.parent_path());
+}
+
+TEST(BatchFileErrors, UnreadableBatchFile) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root reads files regardless of their permissions";
+  const fs::path path = make_temp_dir("unreadable") / "batch.json";
+  write_text(path, with_pairs("[]"));
+  fs::permissions(path, fs::perms::none);
+  try {
+    load_batch_file(path.string());
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(path.string() + ": cannot open"));
+  }
+  fs::remove_all(path.parent_path());
 }
 
 TEST(BatchFileErrors, ErrorInLoadedFileNamesThePath) {

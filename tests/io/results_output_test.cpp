@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -82,7 +83,7 @@ TEST(ResultsOutput, CsvNumbersRoundTripExactly) {
   for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
   ASSERT_EQ(fields.size(), 14u);
   for (int k = 0; k < 4; ++k) {
-    EXPECT_EQ(std::stod(fields[3 + k]), values[k]) << fields[3 + k];
+    EXPECT_EQ(std::strtod(fields[3 + k].c_str(), nullptr), values[k]) << fields[3 + k];
     EXPECT_LE(significant_digits(fields[3 + k]), 17) << fields[3 + k];
   }
 }

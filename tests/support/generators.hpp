@@ -3,6 +3,7 @@
 
 #include "batchcol/batchcol.hpp"
 
+#include <ostream>
 #include <random>
 #include <vector>
 
@@ -40,3 +41,11 @@ struct SingleResult {
 SingleResult run_pair(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const QueryOptions& options);
 
 }  // namespace batchcol::testing
+
+namespace batchcol {
+// Readable enum values in GoogleTest messages (found by argument-dependent lookup).
+inline void PrintTo(Status s, std::ostream* os) { *os << to_string(s); }
+inline void PrintTo(Solver s, std::ostream* os) { *os << to_string(s); }
+inline void PrintTo(ShapeType s, std::ostream* os) { *os << to_string(s); }
+inline void PrintTo(QueryLevel s, std::ostream* os) { *os << to_string(s); }
+}  // namespace batchcol

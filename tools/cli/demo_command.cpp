@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -75,9 +76,11 @@ int run_demo(const DemoSettings& settings) {
 Command add_demo_command(CLI::App& parent) {
   auto settings = std::make_shared<DemoSettings>();
   CLI::App* app = parent.add_subcommand("demo", "Time collision queries on a built-in scene of random convex pairs");
-  app->add_option("--pairs", settings->pairs, "Number of pairs")->check(CLI::PositiveNumber)->capture_default_str();
+  app->add_option("--pairs", settings->pairs, "Number of pairs")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))
+      ->capture_default_str();
   app->add_option("--threads", settings->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
       ->capture_default_str();
   app->add_option("--query", settings->query, "boolean, distance, witness or penetration")->capture_default_str();
   app->add_option("--precision", settings->precision, "double or float")->capture_default_str();

@@ -5,7 +5,10 @@
 #include <batchcol/batch.hpp>
 #include <batchcol/io.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -20,6 +23,18 @@ struct QuerySettings {
   CLI::Option *query_flag = nullptr, *solver_flag = nullptr, *precision_flag = nullptr, *tolerance_flag = nullptr,
               *margin_flag = nullptr, *max_iterations_flag = nullptr;
 };
+
+// CLI11's own range check prints its bounds with 300 digits; this one names the rule.
+CLI::Validator finite_non_negative() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        const bool ok = !text.empty() && *end == '\0' && std::isfinite(value) && value >= 0.0;
+        return ok ? std::string() : "must be a finite number >= 0, got '" + text + "'";
+      },
+      "NUMBER>=0");
+}
 
 enum class Format { csv, json };
 
@@ -72,12 +87,14 @@ Command add_query_command(CLI::App& parent) {
   s->query_flag = app->add_option("--query", s->query, "boolean, distance, witness or penetration");
   s->solver_flag = app->add_option("--solver", s->solver, "gjk, nesterov or polyak");
   s->tolerance_flag = app->add_option("--tolerance", s->tolerance, "Distance tolerance in metres")
-                          ->check(CLI::NonNegativeNumber);
+                          ->check(finite_non_negative());
   s->max_iterations_flag = app->add_option("--max-iterations", s->max_iterations, "GJK iterations per pair")
-                               ->check(CLI::PositiveNumber);
+                               ->check(CLI::Range(1, std::numeric_limits<int>::max()));
   s->precision_flag = app->add_option("--precision", s->precision, "double or float");
-  s->margin_flag = app->add_option("--margin", s->margin, "Security margin in metres")->check(CLI::NonNegativeNumber);
-  app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  s->margin_flag = app->add_option("--margin", s->margin, "Security margin in metres")
+                        ->check(finite_non_negative());
+  app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
   app->add_option("--out", s->out, "Output file (.csv or .json); standard output (CSV) when absent");
   return {app, [s] { return run_query(*s); }};
 }

@@ -33,7 +33,8 @@ enum class Solver : std::uint8_t {
 enum class Precision : std::uint8_t { float64, float32 };
 
 enum class Status : std::uint8_t {
-  converged,       // the duality-gap criterion (or a closed form) certified the result
+  converged,       // the duality gap (or a closed form) certified the result to the tolerance, or to the
+                   // arithmetic's limit when that is larger (GJK stalled: see kernels/narrowphase.cpp)
   max_iterations,  // the iteration budget ran out; the result is the last iterate
   degenerate,      // numerical breakdown (e.g. EPA on a flat Minkowski difference); collide is still valid
   invalid_input,   // bad pair (shape index out of range, non-finite or non-unit pose); nothing else computed

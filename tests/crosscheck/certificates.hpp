@@ -1,0 +1,35 @@
+// Independent checks of a pair's signed distance, computed from the shape definitions (testing::extent and the
+// membership tests below), never from the kernels. They settle disagreements between batchcol and a peer:
+//   lower bound: for any unit direction n, sd >= min_{y in b} <n, y> - max_{x in a} <n, x> (equality at the optimal
+//                n; this holds for overlapping pairs too, where -sd is the penetration depth);
+//   upper bound: for separated pairs, sd <= |q - p| for any p in a and q in b;
+//   overlap:     a point in both shapes proves sd <= 0.
+#pragma once
+
+#include "batchcol/batchcol.hpp"
+
+namespace batchcol::crosscheck {
+
+/// max_{x in s} <n, x> for a world direction n (bounded shapes).
+double world_extent(const Shape& s, const Pose& p, const Eigen::Vector3d& n);
+
+/// A halfspace solid in the world frame: {x : <normal, x> <= offset}.
+struct WorldPlane {
+  Eigen::Vector3d normal;
+  double offset;
+};
+WorldPlane world_plane(const Shape& halfspace, const Pose& p);
+
+/// Exact signed distance between a halfspace solid and a bounded shape: min_{x in s} <normal, x> - offset.
+double halfspace_signed_distance(const WorldPlane& plane, const Shape& s, const Pose& p);
+
+/// The lower bound above for direction n (any length > 0; normalised here). Exact for pairs with a halfspace.
+double certified_lower_bound(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d n);
+
+/// Distance from world point x to the shape (0 inside), exact for every type except the ellipsoid, where it is
+/// the distance along the ray from the centre (an upper bound, equal to the distance on the surface), and the
+/// polytope, where it is the largest face-plane excess (a lower bound, exact in front of a face). Inflation is
+/// ignored (the cross-checks use none).
+double outside_distance(const Shape& s, const Pose& p, const Eigen::Vector3d& x);
+
+}  // namespace batchcol::crosscheck

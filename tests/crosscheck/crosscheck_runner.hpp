@@ -1,0 +1,52 @@
+// Runs a batch of random pairs through batchcol and through a peer library, checks batchcol against the
+// independent certificates (certificates.hpp) and compares it with the peer. Every disagreement beyond the
+// tolerances is settled by the certificates: the peer is proven wrong, batchcol is proven wrong, or it stays
+// undecided. The tests assert that batchcol is never proven wrong and nothing stays undecided; proven peer
+// errors are counted and printed (the first few in full) so they stay visible without failing batchcol's suite.
+#pragma once
+
+#include "crosscheck/agreement.hpp"
+#include "crosscheck/crosscheck_pairs.hpp"
+#include "crosscheck/peer_answer.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace batchcol::crosscheck {
+
+using PeerQuery = std::function<PeerAnswer(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb)>;
+
+struct RunConfig {
+  std::string label;        // printed before every statistic, e.g. "fcl/libccd cone"
+  QueryOptions options;     // batchcol's query (penetration level, tight tolerance)
+  PeerQuery peer_collide;   // boolean (may be empty)
+  PeerQuery peer_distance;  // signed distance and witness points (may be empty)
+  double band = 1e-6;       // booleans are compared only when |batchcol distance| > band
+  double distance_tolerance = 1e-6;  // |batchcol - peer| above this on a separated pair is a disagreement
+};
+
+/// A count of disagreements and how the certificates settled them.
+struct Verdicts {
+  std::size_t compared = 0, disagree = 0, peer_wrong = 0, batchcol_wrong = 0, undecided = 0;
+};
+
+struct RunSummary {
+  std::size_t pairs = 0, separated = 0, overlapping = 0, not_converged = 0, peer_failures = 0;
+  ErrorStats identity;        // |witness_b - witness_a - distance * normal| and ||normal| - 1|, all pairs
+  ErrorStats containment;     // distance of batchcol's witness points to their shapes (separated pairs)
+  ErrorStats certified_gap;   // batchcol distance - certified lower bound from batchcol's normal (separated)
+  ErrorStats depth_gap;       // the same for overlapping pairs: how far EPA's depth is from certified
+  double min_certified_gap = 0;  // most negative (distance below its certified lower bound: impossible)
+  ErrorStats distance_diff;   // |batchcol - peer| on separated pairs
+  ErrorStats depth_diff;      // |batchcol - peer| on overlapping pairs (information only)
+  Verdicts booleans, distances, depths;
+  std::vector<std::string> examples;  // descriptions of the first disagreements
+};
+
+RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& config);
+
+/// Prints the summary (statistics and verdict counts) and the examples.
+void print_summary(const std::string& label, const RunSummary& s);
+
+}  // namespace batchcol::crosscheck
