@@ -21,7 +21,7 @@ namespace batchcol::kernels {
 
 enum class GjkStatus : std::uint8_t {
   converged,          // distance certified within tolerance (shapes separated or touching)
-  overlap,            // the origin lies in the current simplex: the cores intersect
+  overlap,            // the origin lies in the current simplex (up to touch_tolerance): the cores intersect
   separated_proven,   // boolean query: a separating plane beyond the margin was found
   collision_proven,   // boolean query: a point of D within the margin was found
   max_iterations,
@@ -42,6 +42,9 @@ template <class T> struct GjkParams {
   bool boolean_only = false;
   T core_margin = T(0);            // boolean: the cores collide when their distance is <= core_margin
   bool normalize_momentum = true;  // normalised Nesterov directions (shapes not strictly convex)
+  /// |x| at or below this is indistinguishable from 0 in the working precision: the cores touch or overlap and
+  /// the sign of their distance is decided by EPA, not by GJK.
+  T touch_tolerance = T(0);
 };
 
 template <class T> struct GjkResult {
@@ -62,6 +65,9 @@ template <class T> struct GjkResult {
     return p;
   }
 };
+
+/// Momentum steps allowed in a row without closing a tenth of the certified gap before plain GJK takes over.
+constexpr int kMaxStaleMomentumSteps = 4;
 
 /// The gradient direction when x lies inside a triangle of the simplex. Rounding leaves x with an absolute error
 /// of a few ulps of the vertices, so its direction is off by ~eps |w| / |x| (large when the shapes nearly touch);
@@ -88,12 +94,13 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   bool momentum = params.solver != Solver::gjk;
   T lower_bound = -std::numeric_limits<T>::infinity();
+  int stale = 0;  // consecutive iterations without real progress of the lower bound
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
     const T xx = x.squaredNorm();
     const T xn = std::sqrt(xx);
-    if (xx == T(0)) { r.status = GjkStatus::overlap; break; }
+    if (xn <= params.touch_tolerance) { r.status = GjkStatus::overlap; break; }
     if (params.boolean_only && xn <= params.core_margin) { r.status = GjkStatus::collision_proven; break; }
 
     Vec3<T> d = x;
@@ -114,6 +121,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
 
     const SupportPoint<T> s = D.support(-d);
     const T lb = s.w.dot(d) / d.norm();  // every y in D has <y, d/|d|> >= lb
+    // Progress = closing at least a tenth of the certified gap |x| - lower_bound.
+    stale = lb > lower_bound + T(0.1) * (xn - lower_bound) ? 0 : stale + 1;
     lower_bound = std::max(lower_bound, lb);
     r.direction = d;
     if (params.boolean_only && lb > params.core_margin) { r.status = GjkStatus::separated_proven; break; }
@@ -139,12 +148,14 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       // No decrease although conv(W + s) contains x: we are at the resolution of the arithmetic.
       S.count -= 1;
       if (!plain_step) { momentum = false; continue; }
-      r.status = GjkStatus::stalled;
+      r.status = xn <= T(2) * params.touch_tolerance ? GjkStatus::overlap : GjkStatus::stalled;
       break;
     }
     // Momentum whose step moves |x| by less than the tolerance is lagging behind the gradient (delta_k -> 1
     // makes the direction sluggish near a flat contact): finish with plain GJK steps, as Montaut et al. do.
-    if (!plain_step && xn - std::sqrt(next_xx) <= tol) momentum = false;
+    // Likewise when its support points stopped improving the lower bound (a simple adaptive restart, after
+    // O'Donoghue and Candes, "Adaptive restart for accelerated gradient schemes", 2015).
+    if (!plain_step && (xn - std::sqrt(next_xx) <= tol || stale >= kMaxStaleMomentumSteps)) momentum = false;
     S = next;
     x = proj.x;
     d_prev = d;

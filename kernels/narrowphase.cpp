@@ -81,6 +81,7 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
   params.boolean_only = opt.level == QueryLevel::boolean;
   params.core_margin = T(opt.margin) + radii;
   params.normalize_momentum = !(A.strictly_convex() && B.strictly_convex());
+  params.touch_tolerance = T(64) * floor;  // ~1e3 ulps of the problem size
   const MinkowskiDifference<T> D{&A, &B, X, {}, {}};
   const Vec3<T> warm = warm_direction.cast<T>();
   const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);

@@ -56,9 +56,10 @@ CrossPairs make_pairs(std::uint64_t seed, ShapeType primary, const std::vector<S
       const double width_a = world_extent(a, pa, u) + world_extent(a, pa, -u);
       const double width_b = world_extent(b, pb, u) + world_extent(b, pb, -u);
       gap = draw_gap(rng, width_a, width_b);
-      // With pb.translation = 0: min_{y in b} <u, y> = -world_extent(b, pb, -u); shift b along u so that it equals
-      // max_{x in a} <u, x> + gap.
-      pb.translation = (world_extent(a, pa, u) + gap + world_extent(b, pb, -u)) * u;
+      // Start b at a's position, where min_{y in b} <u, y> = -world_extent(b, pb, -u), then shift it along u so
+      // that this minimum becomes max_{x in a} <u, x> + gap.
+      pb.translation = pa.translation;
+      pb.translation += (world_extent(a, pa, u) + gap + world_extent(b, pb, -u)) * u;
     }
     const auto ia = out.shapes.add(a), ib = out.shapes.add(b);
     out.batch.add(ia, pa, ib, pb);

@@ -11,7 +11,7 @@
 namespace batchcol::crosscheck {
 namespace {
 
-constexpr std::size_t kMaxExamples = 8;
+constexpr std::size_t kMaxExamplesPerKind = 3;
 /// Slack for rounding when comparing a distance with a certificate computed along a different code path
 /// (a few ulps of the 1 m scale of the scenes).
 constexpr double kRounding = 1e-12;
@@ -46,6 +46,7 @@ struct PairState {
   Pose pa;
   const Shape& b;
   Pose pb;
+  Status status;                 // batchcol
   double distance;               // batchcol
   Eigen::Vector3d wa, wb, normal;  // batchcol
   double lower;                  // certified lower bound from batchcol's normal
@@ -69,10 +70,12 @@ double peer_lower_bound(const PairState& p, const PeerAnswer& peer) {
 }
 
 void add_example(RunSummary& s, const std::string& what, const PairState& p, const PeerAnswer& peer) {
-  if (s.examples.size() >= kMaxExamples) return;
+  const std::size_t same_kind = static_cast<std::size_t>(std::count_if(
+      s.examples.begin(), s.examples.end(), [&](const std::string& e) { return e.rfind(what, 0) == 0; }));
+  if (same_kind >= kMaxExamplesPerKind) return;
   std::ostringstream o;
   o.precision(17);
-  o << what << " (pair " << p.index << "): a=" << describe(p.a) << " " << describe(p.pa) << "; b=" << describe(p.b)
+  o << what << " (pair " << p.index << ", status " << to_string(p.status) << "): a=" << describe(p.a) << " " << describe(p.pa) << "; b=" << describe(p.b)
     << " " << describe(p.pb) << "; batchcol d=" << p.distance << " peer d=" << peer.distance
     << " peer collide=" << peer.collide << " certified [" << p.lower << ", " << p.upper << "]";
   s.examples.push_back(o.str());
@@ -99,7 +102,7 @@ void compare_boolean(RunSummary& s, const RunConfig& c, const PairState& p) {
   } else {
     ++v.undecided;
   }
-  add_example(s, std::string(c.label) + " boolean disagreement", p, peer);
+  add_example(s, "boolean disagreement", p, peer);
 }
 
 /// Settles |batchcol - peer| > tolerance for a signed distance with the certified interval [lower, upper].
@@ -112,17 +115,14 @@ void settle_distance(RunSummary& s, Verdicts& v, const RunConfig& c, const PairS
   if (batchcol_out) ++v.batchcol_wrong;
   else if (peer_out) ++v.peer_wrong;
   else ++v.undecided;
-  add_example(s, std::string(c.label) + " " + what + " disagreement", p, peer);
+  add_example(s, std::string(what) + " disagreement", p, peer);
 }
 
 void compare_distance(RunSummary& s, const RunConfig& c, const PairState& p) {
   if (std::abs(p.distance) <= c.band) return;
   const PeerAnswer peer = c.peer_distance(p.a, p.pa, p.b, p.pb);
-  if (!peer.ok || !std::isfinite(peer.distance)) {
-    // Peers compute no depth for some pairs (FCL's triangle functions, its independent solver).
-    if (p.distance > 0) ++s.peer_failures;
-    return;
-  }
+  if (!peer.ok) { ++s.peer_failures; return; }
+  if (!std::isfinite(peer.distance)) return;  // e.g. FCL computes no depth with triangles or its own GJK
   const bool separated = p.distance > 0;
   Verdicts& v = separated ? s.distances : s.depths;
   ++v.compared;
@@ -144,11 +144,16 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
   for (std::size_t i = 0; i < r.size(); ++i) {
     const Shape& a = pairs.shapes[pairs.batch.shape_a[i]];
     const Shape& b = pairs.shapes[pairs.batch.shape_b[i]];
-    PairState p{i, a, pairs.batch.pose_a(i), b, pairs.batch.pose_b(i), r.distance[i], r.witness_a[i],
+    PairState p{i, a, pairs.batch.pose_a(i), b, pairs.batch.pose_b(i), r.status[i], r.distance[i], r.witness_a[i],
                 r.witness_b[i], r.normal[i], 0.0, std::numeric_limits<double>::infinity()};
     if (r.status[i] != Status::converged) ++s.not_converged;
     s.identity.add(std::max((p.wb - p.wa - p.distance * p.normal).norm(), std::abs(p.normal.norm() - 1.0)));
+    // Batchcol certifies its distance with its last support direction (world frame, D = A - B, so pointing from
+    // b to a); the reported normal is the direction of the closest point, usually as good. Both bound it.
+    const Eigen::Vector3d direction = r.direction[i];
     p.lower = certified_lower_bound(a, p.pa, b, p.pb, p.normal);
+    if (direction.allFinite() && direction.norm() > 0)
+      p.lower = std::max(p.lower, certified_lower_bound(a, p.pa, b, p.pb, -direction));
     if (p.distance > 0) {
       ++s.separated;
       const double ca = outside_distance(a, p.pa, p.wa), cb = outside_distance(b, p.pb, p.wb);
@@ -160,6 +165,9 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
       s.depth_gap.add(std::max(p.distance - p.lower, 0.0));
     }
     s.min_certified_gap = std::min(s.min_certified_gap, p.distance - p.lower);
+    if (p.distance - p.lower > 1e-7)
+      add_example(s, p.distance > 0 ? "batchcol distance not certified by its normal"
+                                     : "batchcol depth not certified by its normal", p, PeerAnswer{});
     if (c.peer_collide) compare_boolean(s, c, p);
     if (c.peer_distance) compare_distance(s, c, p);
   }

@@ -1,0 +1,27 @@
+#include "crosscheck/expectations.hpp"
+
+#include <gtest/gtest.h>
+
+namespace batchcol::crosscheck {
+
+void expect_batchcol_certified(const RunSummary& s, double certified) {
+  EXPECT_LE(s.identity.max(), 1e-9) << "witness_b - witness_a != distance * normal (or normal not unit)";
+  EXPECT_LE(s.containment.max(), 1e-9) << "a witness point is off its shape";
+  EXPECT_LE(s.certified_gap.max(), certified) << "a distance is not certified by batchcol's own normal";
+  EXPECT_GE(s.min_certified_gap, -1e-12) << "a signed distance is below its certified lower bound";
+  EXPECT_EQ(s.not_converged, 0u);
+  EXPECT_GE(s.separated, s.pairs * 3 / 10) << "the sampler should give about half separated pairs";
+  EXPECT_GE(s.overlapping, s.pairs * 3 / 10) << "the sampler should give about half overlapping pairs";
+}
+
+void expect_peer_settled(const RunSummary& s, double max_peer_wrong) {
+  for (const Verdicts* v : {&s.booleans, &s.distances, &s.depths}) {
+    EXPECT_EQ(v->batchcol_wrong, 0u) << "the certificates prove batchcol wrong (see the examples above)";
+    EXPECT_LE(static_cast<double>(v->peer_wrong), max_peer_wrong * static_cast<double>(v->compared));
+  }
+  EXPECT_EQ(s.booleans.undecided, 0u) << "a boolean disagreement the certificates cannot settle";
+  EXPECT_EQ(s.distances.undecided, 0u) << "a distance disagreement the certificates cannot settle";
+  EXPECT_EQ(s.peer_failures, 0u) << "the peer failed or threw on some pairs";
+}
+
+}  // namespace batchcol::crosscheck

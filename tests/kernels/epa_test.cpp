@@ -1,0 +1,117 @@
+// Penetration depths with known answers: polytope pairs (exact EPA) and curved shapes (EPA converges on a
+// polytope approximation, with the error bounded by its tolerance).
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+namespace batchcol {
+namespace {
+
+using testing::Rng;
+
+QueryOptions depth_options(double tolerance = 1e-10) {
+  QueryOptions o;
+  o.level = QueryLevel::penetration;
+  o.tolerance = tolerance;
+  o.closed_forms = false;
+  o.max_iterations = 1000;
+  o.epa_max_iterations = 2000;
+  return o;
+}
+
+/// Checks a penetration result against the expected depth and normal (world frame).
+void expect_depth(const testing::SingleResult& r, double depth, const Eigen::Vector3d& normal, double tol) {
+  EXPECT_EQ(r.status, Status::converged);
+  EXPECT_TRUE(r.collide);
+  EXPECT_NEAR(r.distance, -depth, tol);
+  EXPECT_GT(r.normal.dot(normal), 1 - 1e-6) << r.normal.transpose();
+  EXPECT_LT((r.witness_b - r.witness_a - r.distance * r.normal).norm(), 1e-9);
+}
+
+TEST(Epa, AxisAlignedBoxesUnderACommonRotation) {
+  Rng rng(3);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Eigen::Vector3d ha = Eigen::Vector3d::Random().cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
+    const Eigen::Vector3d hb = Eigen::Vector3d::Random().cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
+    const Eigen::Vector3d c = Eigen::Vector3d::Random().cwiseProduct(ha + hb) * 0.95;  // overlapping centres
+    // D is the box of half extents ha + hb centred at -c: the depth is the smallest exit distance.
+    Eigen::Vector3d room = (ha + hb) - c.cwiseAbs();
+    int axis;
+    const double depth = room.minCoeff(&axis);
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    n[axis] = c[axis] < 0 ? -1 : 1;
+    const Eigen::Quaterniond Q = testing::random_rotation(rng);
+    const Eigen::Vector3d T = Eigen::Vector3d::Random() * 100;
+    const auto r = testing::run_pair(Shape::box(ha), Pose{T, Q}, Shape::box(hb), Pose{T + Q * c, Q}, depth_options());
+    // Ties between axes make the normal ambiguous; only compare it when the minimum is clear.
+    room[axis] = 1e9;
+    SCOPED_TRACE(trial);
+    if (room.minCoeff() - depth > 1e-6) expect_depth(r, depth, Q * n, 1e-9);
+    else EXPECT_NEAR(r.distance, -depth, 1e-9);
+  }
+}
+
+TEST(Epa, SphereInsideBoxThroughGjkAndEpa) {
+  const Shape box = Shape::box(0.3, 0.2, 0.1);
+  for (double z : {0.0, 0.05, 0.09, -0.099}) {
+    const Shape ball = Shape::sphere(0.05);
+    const auto r = testing::run_pair(box, Pose{}, ball, Pose::from_translation({0.01, -0.02, z}), depth_options());
+    const double depth = (0.1 - std::abs(z)) + 0.05;
+    // At z = 0 leaving up or down is equally short: the normal is +z or -z.
+    const Eigen::Vector3d n(0, 0, z < 0 || (z == 0 && r.normal.z() < 0) ? -1 : 1);
+    expect_depth(r, depth, n, 1e-9);
+  }
+}
+
+TEST(Epa, CrossingCapsulesHaveDepthOfTheirRadii) {
+  // Cores are crossing segments: D is flat, its depth 0, and the normal is perpendicular to both axes.
+  const Shape a = Shape::capsule(0.05, 0.3), b = Shape::capsule(0.03, 0.2);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+  const auto r = testing::run_pair(a, Pose{}, b, Pose{Eigen::Vector3d(0.02, 0, 0.1), turn}, depth_options());
+  expect_depth(r, 0.08 - 0.02 + 0.0, Eigen::Vector3d::UnitX(), 1e-12);
+}
+
+TEST(Epa, CurvedShapesDeepAndShallow) {
+  Rng rng(8);
+  const QueryOptions opt = depth_options(1e-9);
+  for (double depth : {1e-6, 1e-4, 1e-2, 0.1}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::Quaterniond Q = testing::random_rotation(rng);
+      const Eigen::Vector3d T = Eigen::Vector3d::Random();
+      const Eigen::Vector3d e = Q * Eigen::Vector3d::UnitZ();
+      SCOPED_TRACE("depth " + std::to_string(depth) + " trial " + std::to_string(trial));
+      {  // Two ellipsoids with equal radii are balls: depth = ra + rb - d.
+        const double ra = testing::uniform(rng, 0.05, 0.2), rb = testing::uniform(rng, 0.05, 0.2);
+        const auto r = testing::run_pair(Shape::ellipsoid(ra, ra, ra), Pose{T, Q}, Shape::ellipsoid(rb, rb, rb),
+                                         Pose{T + e * (ra + rb - depth), testing::random_rotation(rng)}, opt);
+        expect_depth(r, depth, e, 1e-7);
+      }
+      {  // Coaxial cylinders stacked along their axis: the axial overlap is the shallowest exit.
+        const auto r = testing::run_pair(Shape::cylinder(0.2, 0.1), Pose{T, Q}, Shape::cylinder(0.15, 0.2),
+                                         Pose{T + e * (0.3 - depth), Q}, opt);
+        if (depth < 0.15) expect_depth(r, depth, e, 1e-7);
+      }
+      {  // A cone's apex pushed into a large box face: the apex depth.
+        const auto r = testing::run_pair(Shape::box(2, 2, 0.5), Pose{T, Q}, Shape::cone(0.1, 0.1),
+                                         Pose{T + e * (0.5 + 0.1 - depth), Q * Eigen::Quaterniond(0, 1, 0, 0)}, opt);
+        expect_depth(r, depth, e, 1e-7);
+      }
+      {  // An ellipsoid pressed into a large box face along one of its axes.
+        const auto r = testing::run_pair(Shape::box(2, 2, 0.5), Pose{T, Q}, Shape::ellipsoid(0.1, 0.05, 0.2),
+                                         Pose{T + e * (0.5 + 0.2 - depth), Q}, opt);
+        expect_depth(r, depth, e, 1e-7);
+      }
+    }
+  }
+}
+
+TEST(Epa, TouchingPolytopesHaveZeroDepth) {
+  const auto r = testing::run_pair(Shape::box(0.1, 0.1, 0.1), Pose{}, Shape::box(0.1, 0.1, 0.1),
+                                   Pose::from_translation({0.2, 0.05, 0}), depth_options());
+  EXPECT_EQ(r.status, Status::converged);
+  EXPECT_NEAR(r.distance, 0.0, 1e-12);
+  EXPECT_TRUE(r.collide);
+}
+
+}  // namespace
+}  // namespace batchcol
