@@ -26,10 +26,22 @@ double halfspace_signed_distance(const WorldPlane& plane, const Shape& s, const 
 /// The lower bound above for direction n (any length > 0; normalised here). Exact for pairs with a halfspace.
 double certified_lower_bound(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d n);
 
-/// Distance from world point x to the shape (0 inside), exact for every type except the ellipsoid, where it is
-/// the distance along the ray from the centre (an upper bound, equal to the distance on the surface), and the
-/// polytope, where it is the largest face-plane excess (a lower bound, exact in front of a face). Inflation is
-/// ignored (the cross-checks use none).
-double outside_distance(const Shape& s, const Pose& p, const Eigen::Vector3d& x);
+/// The largest certified_lower_bound found by a compass search over unit directions started at n (step 1e-3
+/// down to 1e-13 rad, at most `evaluations` evaluations). Any value it returns is a valid lower bound; it tightens
+/// the bound when n is close to, but not exactly, the optimal direction.
+double refined_lower_bound(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d n,
+                           int evaluations = 600);
+
+/// Signed distance from world point x to the shape's boundary, positive outside. Outside it is exact for every
+/// type except the ellipsoid (distance along the ray from the centre: an upper bound, exact on the surface) and the
+/// polytope (largest face-plane excess: a lower bound, exact in front of a face; both are only used for points
+/// within rounding of the surface). Inside it is a lower bound on the depth (exact for sphere, capsule, box,
+/// cylinder, polytope and halfspace), so a negative value -r certifies that the ball of radius r around x is
+/// inside the shape. Triangles are flat: never negative. Inflation is ignored (the cross-checks use none).
+double signed_outside(const Shape& s, const Pose& p, const Eigen::Vector3d& x);
+
+/// x proves that the shapes overlap: x is within delta of one shape and deeper than delta inside the other, so the
+/// nearest point of the first shape is an interior point of the second.
+bool proves_overlap(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const Eigen::Vector3d& x);
 
 }  // namespace batchcol::crosscheck

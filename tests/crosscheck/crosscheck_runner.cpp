@@ -15,6 +15,8 @@ constexpr std::size_t kMaxExamplesPerKind = 3;
 /// Slack for rounding when comparing a distance with a certificate computed along a different code path
 /// (a few ulps of the 1 m scale of the scenes).
 constexpr double kRounding = 1e-12;
+/// Lower bounds further than this below batchcol's distance are tightened by a local search (refined_lower_bound).
+constexpr double kRefineAbove = 1e-10;
 
 std::string describe(const Shape& s) {
   std::ostringstream o;
@@ -53,10 +55,10 @@ struct PairState {
   double upper;                  // certified upper bound (separated: witness distance + containment), else +inf
 };
 
-/// A point inside both shapes among batchcol's witness points and their midpoint: proves the overlap.
+/// Batchcol's witness points, their midpoint and the quarter points: one proving the overlap settles it.
 bool overlap_proven(const PairState& p) {
-  for (const Eigen::Vector3d& x : {p.wa, p.wb, Eigen::Vector3d(0.5 * (p.wa + p.wb))})
-    if (outside_distance(p.a, p.pa, x) == 0.0 && outside_distance(p.b, p.pb, x) == 0.0) return true;
+  for (double t : {0.0, 0.25, 0.5, 0.75, 1.0})
+    if (proves_overlap(p.a, p.pa, p.b, p.pb, p.wa + t * (p.wb - p.wa))) return true;
   return false;
 }
 
@@ -154,9 +156,10 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
     p.lower = certified_lower_bound(a, p.pa, b, p.pb, p.normal);
     if (direction.allFinite() && direction.norm() > 0)
       p.lower = std::max(p.lower, certified_lower_bound(a, p.pa, b, p.pb, -direction));
+    if (p.distance - p.lower > kRefineAbove) p.lower = refined_lower_bound(a, p.pa, b, p.pb, p.normal);
     if (p.distance > 0) {
       ++s.separated;
-      const double ca = outside_distance(a, p.pa, p.wa), cb = outside_distance(b, p.pb, p.wb);
+      const double ca = std::max(signed_outside(a, p.pa, p.wa), 0.0), cb = std::max(signed_outside(b, p.pb, p.wb), 0.0);
       s.containment.add(std::max(ca, cb));
       p.upper = (p.wb - p.wa).norm() + ca + cb;
       s.certified_gap.add(std::max(p.distance - p.lower, 0.0));
@@ -165,7 +168,7 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
       s.depth_gap.add(std::max(p.distance - p.lower, 0.0));
     }
     s.min_certified_gap = std::min(s.min_certified_gap, p.distance - p.lower);
-    if (p.distance - p.lower > 1e-7)
+    if (p.distance - p.lower > 1e-9)
       add_example(s, p.distance > 0 ? "batchcol distance not certified by its normal"
                                      : "batchcol depth not certified by its normal", p, PeerAnswer{});
     if (c.peer_collide) compare_boolean(s, c, p);
