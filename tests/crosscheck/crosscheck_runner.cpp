@@ -17,6 +17,8 @@ constexpr std::size_t kMaxExamplesPerKind = 3;
 constexpr double kRounding = 1e-12;
 /// Lower bounds further than this below batchcol's distance are tightened by a local search (refined_lower_bound).
 constexpr double kRefineAbove = 1e-10;
+/// Pairs whose certified interval is wider than this are printed as examples.
+constexpr double kCertifiedReportAbove = 1e-8;
 
 std::string describe(const Shape& s) {
   std::ostringstream o;
@@ -53,6 +55,7 @@ struct PairState {
   Eigen::Vector3d wa, wb, normal;  // batchcol
   double lower;                  // certified lower bound from batchcol's normal
   double upper;                  // certified upper bound (separated: witness distance + containment), else +inf
+  bool known_bug = false;        // the pair hits a documented peer bug (RunConfig::known_peer_bug)
 };
 
 /// Batchcol's witness points, their midpoint and the quarter points: one proving the overlap settles it.
@@ -87,7 +90,7 @@ void compare_boolean(RunSummary& s, const RunConfig& c, const PairState& p) {
   if (std::abs(p.distance) <= c.band) return;
   const PeerAnswer peer = c.peer_collide(p.a, p.pa, p.b, p.pb);
   if (!peer.ok) { ++s.peer_failures; return; }
-  Verdicts& v = s.booleans;
+  Verdicts& v = p.known_bug ? s.known_bug : s.booleans;
   ++v.compared;
   const bool separated = p.distance > 0;
   if (peer.collide != separated) return;  // agreement
@@ -104,7 +107,7 @@ void compare_boolean(RunSummary& s, const RunConfig& c, const PairState& p) {
   } else {
     ++v.undecided;
   }
-  add_example(s, "boolean disagreement", p, peer);
+  add_example(s, p.known_bug ? "known peer bug, boolean disagreement" : "boolean disagreement", p, peer);
 }
 
 /// Settles |batchcol - peer| > tolerance for a signed distance with the certified interval [lower, upper].
@@ -117,16 +120,16 @@ void settle_distance(RunSummary& s, Verdicts& v, const RunConfig& c, const PairS
   if (batchcol_out) ++v.batchcol_wrong;
   else if (peer_out) ++v.peer_wrong;
   else ++v.undecided;
-  add_example(s, std::string(what) + " disagreement", p, peer);
+  add_example(s, std::string(p.known_bug ? "known peer bug, " : "") + what + " disagreement", p, peer);
 }
 
 void compare_distance(RunSummary& s, const RunConfig& c, const PairState& p) {
-  if (std::abs(p.distance) <= c.band) return;
+  if (std::abs(p.distance) <= c.band || (p.distance < 0 && !c.peer_depths)) return;
   const PeerAnswer peer = c.peer_distance(p.a, p.pa, p.b, p.pb);
   if (!peer.ok) { ++s.peer_failures; return; }
   if (!std::isfinite(peer.distance)) return;  // e.g. FCL computes no depth with triangles or its own GJK
   const bool separated = p.distance > 0;
-  Verdicts& v = separated ? s.distances : s.depths;
+  Verdicts& v = p.known_bug ? s.known_bug : separated ? s.distances : s.depths;
   ++v.compared;
   const double diff = std::abs(p.distance - peer.distance);
   (separated ? s.distance_diff : s.depth_diff).add(diff);
@@ -148,6 +151,12 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
     const Shape& b = pairs.shapes[pairs.batch.shape_b[i]];
     PairState p{i, a, pairs.batch.pose_a(i), b, pairs.batch.pose_b(i), r.status[i], r.distance[i], r.witness_a[i],
                 r.witness_b[i], r.normal[i], 0.0, std::numeric_limits<double>::infinity()};
+    if (c.known_peer_bug) {
+      if (const char* bug = c.known_peer_bug(a, p.pa, b, p.pb)) {
+        p.known_bug = true;
+        s.known_bug_description = bug;
+      }
+    }
     if (r.status[i] != Status::converged) ++s.not_converged;
     s.identity.add(std::max((p.wb - p.wa - p.distance * p.normal).norm(), std::abs(p.normal.norm() - 1.0)));
     // Batchcol certifies its distance with its last support direction (world frame, D = A - B, so pointing from
@@ -168,7 +177,7 @@ RunSummary run_crosscheck(const CrossPairs& pairs, const RunConfig& c) {
       s.depth_gap.add(std::max(p.distance - p.lower, 0.0));
     }
     s.min_certified_gap = std::min(s.min_certified_gap, p.distance - p.lower);
-    if (p.distance - p.lower > 1e-9)
+    if (p.distance - p.lower > kCertifiedReportAbove)
       add_example(s, p.distance > 0 ? "batchcol distance not certified by its normal"
                                      : "batchcol depth not certified by its normal", p, PeerAnswer{});
     if (c.peer_collide) compare_boolean(s, c, p);
@@ -197,6 +206,7 @@ void print_summary(const std::string& label, const RunSummary& s) {
   verdicts("booleans", s.booleans);
   verdicts("distances", s.distances);
   verdicts("depths (info)", s.depths);
+  if (s.known_bug.compared > 0) verdicts(("pairs hitting a known peer bug (" + s.known_bug_description + ")").c_str(), s.known_bug);
   for (const auto& e : s.examples) note(label, e);
 }
 

@@ -22,6 +22,10 @@ struct RunConfig {
   QueryOptions options;     // batchcol's query (penetration level, tight tolerance)
   PeerQuery peer_collide;   // boolean (may be empty)
   PeerQuery peer_distance;  // signed distance and witness points (may be empty)
+  bool peer_depths = true;  // also ask peer_distance for overlapping pairs (FCL's EPA can abort on an assert)
+  /// Pairs hitting a documented bug of the peer: returns its description, or nullptr. They are still compared, but
+  /// their verdicts are tallied apart (RunSummary::known_bug) so they neither hide nor drown the other results.
+  std::function<const char*(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb)> known_peer_bug;
   double band = 1e-6;       // booleans are compared only when |batchcol distance| > band
   double distance_tolerance = 1e-6;  // |batchcol - peer| above this on a separated pair is a disagreement
 };
@@ -41,6 +45,8 @@ struct RunSummary {
   ErrorStats distance_diff;   // |batchcol - peer| on separated pairs
   ErrorStats depth_diff;      // |batchcol - peer| on overlapping pairs (information only)
   Verdicts booleans, distances, depths;
+  Verdicts known_bug;          // all comparisons of pairs matching RunConfig::known_peer_bug
+  std::string known_bug_description;
   std::vector<std::string> examples;  // descriptions of the first disagreements
 };
 

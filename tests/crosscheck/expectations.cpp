@@ -15,13 +15,15 @@ void expect_batchcol_certified(const RunSummary& s, double certified) {
 }
 
 void expect_peer_settled(const RunSummary& s, double max_peer_wrong) {
+  EXPECT_EQ(s.known_bug.batchcol_wrong, 0u) << "the certificates prove batchcol wrong (see the examples above)";
   for (const Verdicts* v : {&s.booleans, &s.distances, &s.depths}) {
     EXPECT_EQ(v->batchcol_wrong, 0u) << "the certificates prove batchcol wrong (see the examples above)";
     EXPECT_LE(static_cast<double>(v->peer_wrong), max_peer_wrong * static_cast<double>(v->compared));
   }
   EXPECT_EQ(s.booleans.undecided, 0u) << "a boolean disagreement the certificates cannot settle";
   EXPECT_EQ(s.distances.undecided, 0u) << "a distance disagreement the certificates cannot settle";
-  EXPECT_EQ(s.peer_failures, 0u) << "the peer failed or threw on some pairs";
+  EXPECT_LE(static_cast<double>(s.peer_failures), max_peer_wrong * static_cast<double>(s.pairs))
+      << "the peer failed or threw on many pairs";
 }
 
 }  // namespace batchcol::crosscheck

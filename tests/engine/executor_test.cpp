@@ -1,0 +1,184 @@
+// The batch executor: results in input order, bitwise identical for any thread count, per-pair statuses for bad
+// pairs, exceptions only for a malformed call, warm start.
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+namespace batchcol {
+namespace {
+
+using testing::Rng;
+
+struct Scene {
+  ShapeTable shapes;
+  PairBatch batch;
+};
+
+Scene mixed_scene(std::size_t pairs, std::uint64_t seed) {
+  Rng rng(seed);
+  Scene s;
+  for (ShapeType t : testing::bounded_shape_types())
+    for (int k = 0; k < 3; ++k) s.shapes.add(testing::random_shape(rng, t));
+  s.shapes.add(Shape::halfspace({0, 0, 1}, -0.5));
+  for (std::size_t i = 0; i < pairs; ++i) {
+    const auto a = static_cast<std::uint32_t>(rng() % s.shapes.size());
+    const auto b = static_cast<std::uint32_t>(rng() % s.shapes.size());
+    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
+                  testing::random_rotation(rng)};
+    s.batch.add(a, pa, b, pb);
+  }
+  return s;
+}
+
+bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(Executor, BitwiseIdenticalForOneAndTwoThreadsAtEveryLevelAndPrecision) {
+  const Scene s = mixed_scene(5000, 1);
+  for (Precision p : {Precision::float64, Precision::float32})
+    for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
+      QueryOptions o;
+      o.level = level;
+      o.precision = p;
+      o.threads = 1;
+      PairResults one, two;
+      collide(s.shapes, s.batch, o, one);
+      o.threads = 2;
+      collide(s.shapes, s.batch, o, two);
+      EXPECT_EQ(one.status, two.status);
+      EXPECT_EQ(one.collide, two.collide);
+      EXPECT_EQ(one.iterations, two.iterations);
+      EXPECT_TRUE(bitwise_equal(one.distance, two.distance));
+      for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
+        EXPECT_TRUE(bitwise_equal((one.*m).x, (two.*m).x) && bitwise_equal((one.*m).z, (two.*m).z));
+    }
+}
+
+TEST(Executor, ResultsComeBackInInputOrder) {
+  const Scene s = mixed_scene(3000, 2);
+  QueryOptions o;
+  o.level = QueryLevel::penetration;
+  PairResults all;
+  collide(s.shapes, s.batch, o, all);
+  for (std::size_t i = 0; i < s.batch.size(); i += 97) {
+    const auto r = testing::run_pair(s.shapes[s.batch.shape_a[i]], s.batch.pose_a(i), s.shapes[s.batch.shape_b[i]],
+                                     s.batch.pose_b(i), o);
+    EXPECT_EQ(r.distance, all.distance[i]) << i;
+    EXPECT_EQ(r.witness_a, all.witness_a[i]) << i;
+  }
+}
+
+TEST(Executor, QueryLevelsComputeOnlyWhatTheyAsk) {
+  const Scene s = mixed_scene(2000, 3);
+  QueryOptions o;
+  PairResults b, d, w, p;
+  o.level = QueryLevel::boolean;
+  collide(s.shapes, s.batch, o, b);
+  o.level = QueryLevel::distance;
+  collide(s.shapes, s.batch, o, d);
+  o.level = QueryLevel::witness;
+  collide(s.shapes, s.batch, o, w);
+  o.level = QueryLevel::penetration;
+  collide(s.shapes, s.batch, o, p);
+  int overlapping = 0;
+  for (std::size_t i = 0; i < s.batch.size(); ++i) {
+    EXPECT_TRUE(std::isnan(b.distance[i]));
+    EXPECT_TRUE(std::isnan(d.witness_a.x[i]));
+    EXPECT_EQ(b.collide[i], p.collide[i]) << i;
+    EXPECT_EQ(d.collide[i], p.collide[i]) << i;
+    if (p.distance[i] > 1e-7) {
+      EXPECT_NEAR(d.distance[i], p.distance[i], 1e-7) << i;
+      EXPECT_NEAR(w.witness_a.x[i], p.witness_a.x[i], 1e-6) << i;
+    }
+    if (p.collide[i]) ++overlapping;
+    EXPECT_FALSE(std::isnan(p.distance[i])) << i;  // penetration computes every pair
+  }
+  EXPECT_GT(overlapping, 300);
+}
+
+TEST(Executor, BadPairsGetInvalidInputAndTheRestIsComputed) {
+  Scene s = mixed_scene(10, 4);
+  const Pose ok{Eigen::Vector3d(1, 0, 0), Eigen::Quaterniond::Identity()};
+  const std::size_t out_of_range = s.batch.add(0, Pose{}, 999, ok);
+  const std::size_t nan_pose = s.batch.add(0, Pose{Eigen::Vector3d(std::nan(""), 0, 0), Eigen::Quaterniond::Identity()}, 1, ok);
+  const std::size_t bad_quat = s.batch.add(0, Pose{Eigen::Vector3d::Zero(), Eigen::Quaterniond(1, 0.1, 0, 0)}, 1, ok);
+  const std::size_t near_unit = s.batch.add(0, Pose{Eigen::Vector3d::Zero(), Eigen::Quaterniond(1 + 5e-7, 0, 0, 0)}, 1, ok);
+  PairResults r;
+  collide(s.shapes, s.batch, QueryOptions{}, r);
+  EXPECT_EQ(r.status[out_of_range], Status::invalid_input);
+  EXPECT_EQ(r.status[nan_pose], Status::invalid_input);
+  EXPECT_EQ(r.status[bad_quat], Status::invalid_input);
+  EXPECT_TRUE(std::isnan(r.distance[bad_quat]));
+  EXPECT_EQ(r.status[near_unit], Status::converged);  // normalised: within 1e-6 of unit norm
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_NE(r.status[i], Status::invalid_input);
+}
+
+TEST(Executor, MalformedCallsThrowInputError) {
+  Scene s = mixed_scene(10, 5);
+  PairResults r;
+  QueryOptions bad;
+  bad.tolerance = -1;
+  EXPECT_THROW(collide(s.shapes, s.batch, bad, r), InputError);
+  bad = QueryOptions{};
+  bad.margin = std::nan("");
+  EXPECT_THROW(collide(s.shapes, s.batch, bad, r), InputError);
+  bad = QueryOptions{};
+  bad.max_iterations = 0;
+  EXPECT_THROW(collide(s.shapes, s.batch, bad, r), InputError);
+  PairBatch ragged = s.batch;
+  ragged.translation_b.x.pop_back();
+  try {
+    collide(s.shapes, ragged, QueryOptions{}, r);
+    ADD_FAILURE() << "ragged batch accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("translation_b"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Executor, WarmStartFromThePreviousFrameSavesIterations) {
+  Scene s = mixed_scene(3000, 6);
+  QueryOptions o;
+  o.level = QueryLevel::witness;
+  o.closed_forms = false;
+  PairResults first, second;
+  collide(s.shapes, s.batch, o, first);
+  s.batch.warm_start = first.direction;
+  collide(s.shapes, s.batch, o, second);
+  long cold = 0, warm = 0;
+  for (std::size_t i = 0; i < s.batch.size(); ++i) {
+    cold += first.iterations[i];
+    warm += second.iterations[i];
+    if (first.distance[i] > 0) EXPECT_NEAR(first.distance[i], second.distance[i], 1e-7) << i;
+  }
+  EXPECT_LT(warm, cold * 0.8) << "cold " << cold << " warm " << warm;
+}
+
+TEST(Executor, MarginMakesNearPairsCollide) {
+  const Shape a = Shape::box(0.1, 0.1, 0.1);
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::witness})
+    for (bool closed : {true, false}) {
+      QueryOptions o;
+      o.level = level;
+      o.closed_forms = closed;
+      o.margin = 0.01;
+      const auto near = testing::run_pair(a, Pose{}, a, Pose::from_translation({0.205, 0.02, 0}), o);
+      const auto far = testing::run_pair(a, Pose{}, a, Pose::from_translation({0.215, 0.02, 0}), o);
+      EXPECT_TRUE(near.collide);
+      EXPECT_FALSE(far.collide);
+    }
+}
+
+TEST(Executor, EmptyBatchIsFine) {
+  ShapeTable shapes;
+  PairBatch batch;
+  PairResults r;
+  collide(shapes, batch, QueryOptions{}, r);
+  EXPECT_EQ(r.size(), 0u);
+}
+
+}  // namespace
+}  // namespace batchcol

@@ -1,0 +1,87 @@
+// Shape factories validate their sizes; AABBs are tight (they equal the extent formula along each world axis);
+// bounding radii contain the shape; hulls keep only their vertices, with consistent faces and adjacency.
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <limits>
+
+namespace batchcol {
+namespace {
+
+void expect_rejected(const std::function<void()>& make, const std::string& field) {
+  try {
+    make();
+    ADD_FAILURE() << "accepted bad " << field;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  }
+}
+
+TEST(Shapes, FactoriesRejectNonPositiveAndNonFiniteSizes) {
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  for (double bad : {0.0, -1.0, inf, nan}) {
+    expect_rejected([&] { Shape::sphere(bad); }, "radius");
+    expect_rejected([&] { Shape::capsule(0.1, bad); }, "half_length");
+    expect_rejected([&] { Shape::box(0.1, bad, 0.1); }, "half_extents[1]");
+    expect_rejected([&] { Shape::cylinder(bad, 0.1); }, "radius");
+    expect_rejected([&] { Shape::cone(0.1, bad); }, "half_length");
+    expect_rejected([&] { Shape::ellipsoid(0.1, 0.1, bad); }, "radii[2]");
+  }
+  expect_rejected([] { Shape::sphere(0.1).inflated(-0.01); }, "inflation");
+  expect_rejected([] { Shape::halfspace({0, 0, 0}, 0); }, "normal");
+  expect_rejected([] { Shape::halfspace({0, 0, 1}, std::nan("")); }, "offset");
+  expect_rejected([] { Shape::triangle_shape({0, 0, 0}, {1, 1, 1}, {2, 2, 2}); }, "vertices");
+}
+
+TEST(Shapes, AabbIsTightAndBoundingRadiusContainsTheShape) {
+  testing::Rng rng(21);
+  for (ShapeType t : testing::bounded_shape_types())
+    for (int trial = 0; trial < 50; ++trial) {
+      Shape s = testing::random_shape(rng, t);
+      if (trial % 2) s = s.inflated(0.01);
+      const Eigen::Quaterniond q = testing::random_rotation(rng);
+      const Eigen::Vector3d p = Eigen::Vector3d::Random();
+      const Aabb box = compute_aabb(s, q, p);
+      for (int axis = 0; axis < 3; ++axis) {
+        const Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);
+        EXPECT_NEAR(box.max[axis], p[axis] + testing::extent(s, q.inverse() * e), 1e-12) << to_string(t);
+        EXPECT_NEAR(box.min[axis], p[axis] - testing::extent(s, q.inverse() * -e), 1e-12) << to_string(t);
+        // The shape's extent in any direction is within its bounding radius.
+        const Eigen::Vector3d u = testing::random_unit_vector(rng);
+        EXPECT_LE(testing::extent(s, u), s.bounding_radius() + 1e-12) << to_string(t);
+      }
+    }
+  const Aabb h = compute_aabb(Shape::halfspace({0, 0, 1}, 0), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  EXPECT_TRUE(std::isinf(h.max.x()) && std::isinf(h.min.z()));
+}
+
+TEST(Shapes, HullKeepsVerticesFacesAndAdjacency) {
+  testing::Rng rng(22);
+  const auto pts = testing::random_hull_points(rng, 500, 0.1, 0.3);
+  const Shape s = Shape::convex(pts);
+  const ConvexHull& h = *s.hull;
+  EXPECT_EQ(h.vertices.size(), 500u);  // points on an ellipsoid are all extreme
+  EXPECT_EQ(h.faces.size(), 2 * h.vertices.size() - 4);  // Euler: triangulated sphere
+  EXPECT_EQ(h.neighbor_offsets.size(), h.vertices.size() + 1);
+  EXPECT_EQ(h.neighbors.size(), 3 * h.faces.size());     // each edge seen from both ends
+  for (std::size_t f = 0; f < h.faces.size(); ++f) {
+    const auto& v = h.vertices;
+    const auto& tri = h.faces[f];
+    const Eigen::Vector3d n = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).normalized();
+    EXPECT_GT(n.dot(h.face_normals[f]), 1 - 1e-9);               // counter-clockwise from outside
+    EXPECT_LT((h.centroid - v[tri[0]]).dot(n), 0.0);            // centroid behind every face
+  }
+}
+
+TEST(Shapes, TableStoresEachShapeOnceAndHullsAreShared) {
+  ShapeTable table;
+  const Shape hull = Shape::convex({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}});
+  const auto a = table.add(hull), b = table.add(hull.inflated(0.1));
+  EXPECT_EQ(table.size(), 2u);
+  EXPECT_EQ(table[a].hull.get(), table[b].hull.get());
+}
+
+}  // namespace
+}  // namespace batchcol
