@@ -16,7 +16,7 @@ namespace {
 #ifdef BATCHCOL_HAVE_FCL
 
 constexpr std::size_t kPairsPerType = 10000;
-constexpr FclSolver kSolver = FclSolver::libccd;
+constexpr FclSolver kSolver = FclSolver::indep;
 constexpr double kFclStopTolerance = 1e-12;  // distance_tolerance: libccd stops when an iteration gains less
 constexpr double kFclAgreement = 1e-6;
 
@@ -25,6 +25,19 @@ QueryOptions reference_query() {
   o.level = QueryLevel::penetration;
   o.tolerance = 1e-10;
   return o;
+}
+
+/// FCL 0.7 coneHalfspaceIntersect (primitive_shape_algorithm/halfspace-inl.h) tests `cosa < tolerance` where the
+/// cylinder version tests `std::abs(cosa) < tolerance`: whenever the cone's axis points away from the halfspace
+/// normal it treats the cone as a sphere of the cone's radius around its centre (wrong boolean and depth).
+const char* fcl_cone_halfspace_bug(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
+  const bool cone_a = a.type == ShapeType::cone, cone_b = b.type == ShapeType::cone;
+  if (!((cone_a && b.type == ShapeType::halfspace) || (cone_b && a.type == ShapeType::halfspace))) return nullptr;
+  const Pose& cone_pose = cone_a ? pa : pb;
+  const Pose& plane_pose = cone_a ? pb : pa;
+  const Eigen::Vector3d normal = plane_pose.rotation * (cone_a ? b : a).size;
+  const double cosa = (cone_pose.rotation * Eigen::Vector3d::UnitZ()).dot(normal);
+  return cosa < 1e-6 ? "FCL coneHalfspaceIntersect: cone axis away from the plane normal" : nullptr;
 }
 
 std::string label_for(const char* what) { return std::string("fcl/") + to_string(kSolver) + " " + what; }
@@ -45,6 +58,9 @@ TEST_P(FclCrossCheck, RandomPairsAgree) {
   c.peer_distance = [](const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
     return fcl_distance(a, pa, b, pb, kSolver, kFclStopTolerance);
   };
+  // FCL 0.7's libccd EPA (signed distance of overlapping pairs) aborts on an internal assertion for some pairs
+  // (ComputeVisiblePatch: isOutsidePolytopeFace); the brief compares distances of separated pairs only anyway.
+  c.peer_depths = false;
   const RunSummary s = run_crosscheck(pairs, c);
   print_summary(c.label, s);
   expect_batchcol_certified(s);
@@ -69,6 +85,7 @@ TEST(FclCrossCheckHalfspace, RandomPairsAgree) {
   c.peer_distance = [](const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
     return fcl_collide(a, pa, b, pb, kSolver, true);  // depth of overlapping pairs only
   };
+  c.known_peer_bug = fcl_cone_halfspace_bug;
   const RunSummary s = run_crosscheck(pairs, c);
   print_summary(c.label, s);
   expect_batchcol_certified(s);

@@ -17,7 +17,7 @@ Pose random_pose(testing::Rng& rng) {
 
 double draw_gap(testing::Rng& rng, double width_a, double width_b) {
   if (uniform(rng, 0, 1) < 0.5) return std::exp(uniform(rng, std::log(1e-5), std::log(0.2)));
-  return -uniform(rng, 0.0, 0.6) * std::min(width_a, width_b);
+  return -uniform(rng, 0.0, 0.5) * (width_a + width_b);
 }
 
 }  // namespace

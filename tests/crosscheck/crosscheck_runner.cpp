@@ -132,7 +132,7 @@ void compare_distance(RunSummary& s, const RunConfig& c, const PairState& p) {
   Verdicts& v = p.known_bug ? s.known_bug : separated ? s.distances : s.depths;
   ++v.compared;
   const double diff = std::abs(p.distance - peer.distance);
-  (separated ? s.distance_diff : s.depth_diff).add(diff);
+  if (!p.known_bug) (separated ? s.distance_diff : s.depth_diff).add(diff);
   // Even within the tolerance, a peer direction certifying more than batchcol's distance proves batchcol wrong.
   const bool disproved = peer_lower_bound(p, peer) > p.distance + c.distance_tolerance;
   if (diff > c.distance_tolerance || disproved) settle_distance(s, v, c, p, peer, separated ? "distance" : "depth");
