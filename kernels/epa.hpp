@@ -33,6 +33,12 @@ template <class T> struct EpaFace {
   Vec3<T> n = Vec3<T>::Zero();
   T dist = T(0);
   bool obsolete = false;
+  bool force_visible = false;  // removed with the visible region to avoid a degenerate cone face
+};
+
+/// Edge a->b of the horizon; `face` is the surviving face across it, holding it as b->a at `edge`.
+struct HorizonEdge {
+  int a, b, face, edge;
 };
 
 template <class T> class EpaPolytope {
@@ -44,9 +50,11 @@ template <class T> class EpaPolytope {
   bool add_face(int a, int b, int c) {
     EpaFace<T> f;
     f.v = {a, b, c};
-    const Vec3<T> n = (verts[b].w - verts[a].w).cross(verts[c].w - verts[a].w);
+    const Vec3<T> e1 = verts[b].w - verts[a].w, e2 = verts[c].w - verts[a].w;
+    const Vec3<T> n = e1.cross(e2);
     const T len = n.norm();
-    if (!(len > T(0))) return false;
+    // Nearly collinear corners (sin angle below ~1e3 eps) give a normal dominated by rounding.
+    if (!(len > T(1000) * machine_epsilon<T>() * e1.norm() * e2.norm())) return false;
     f.n = n / len;
     f.dist = f.n.dot(verts[a].w);
     faces.push_back(f);
@@ -59,33 +67,30 @@ template <class T> class EpaPolytope {
     return -1;
   }
 
-  /// Links face fi's edges to the other live faces sharing them (reverse direction).
-  void link(int fi) {
-    for (int e = 0; e < 3; ++e) {
-      const int a = faces[fi].v[e], b = faces[fi].v[(e + 1) % 3];
-      for (int g = 0; g < static_cast<int>(faces.size()); ++g) {
-        if (g == fi || faces[g].obsolete) continue;
-        const int k = edge_index(faces[g], b, a);
-        if (k >= 0) { faces[fi].adj[e] = g; faces[g].adj[k] = fi; break; }
-      }
-    }
+  /// Links edge e of face fi with edge k of face g (they hold the same edge in opposite directions).
+  void link(int fi, int e, int g, int k) {
+    faces[fi].adj[e] = g;
+    faces[g].adj[k] = fi;
   }
 
   /// Depth-first horizon search (van den Bergen's silhouette). We arrive at face gi through the edge a->b of a
   /// removed face (gi holds it as b->a). If gi does not see w, a->b is on the horizon and the new face (a, b, w)
   /// keeps the removed face's winding; otherwise gi is removed too and the search continues over its other edges.
-  void silhouette(int gi, int a, int b, const Vec3<T>& w, std::vector<std::pair<int, int>>& horizon) {
+  /// The horizon comes out as a closed loop in order (each edge starts where the previous one ends).
+  void silhouette(int gi, int a, int b, const Vec3<T>& w, std::vector<HorizonEdge>& horizon,
+                  std::vector<int>& removed) {
     EpaFace<T>& g = faces[gi];
     if (g.obsolete) return;
-    if (g.n.dot(w) - g.dist <= T(0)) {
-      horizon.emplace_back(a, b);
+    if (!g.force_visible && g.n.dot(w) - g.dist <= T(0)) {
+      horizon.push_back({a, b, gi, edge_index(g, b, a)});
       return;
     }
     g.obsolete = true;
+    removed.push_back(gi);
     const int e = edge_index(g, b, a);
     for (int k = 1; k <= 2; ++k) {
       const int ek = (e + k) % 3;
-      silhouette(g.adj[ek], g.v[ek], g.v[(ek + 1) % 3], w, horizon);
+      silhouette(g.adj[ek], g.v[ek], g.v[(ek + 1) % 3], w, horizon, removed);
     }
   }
 };
@@ -143,6 +148,9 @@ bool blow_up(const MinkowskiDifference<T>& D, std::vector<SupportPoint<T>>& v, T
 
 }  // namespace detail
 
+/// Horizon searches per expansion (each retry removes one more face next to a degenerate cone face).
+constexpr int kMaxHorizonRetries = 8;
+
 /// EPA from GJK's final simplex (GjkStatus::overlap). `tolerance` bounds the depth error; `scale` is the size
 /// of the problem, below 1e3 epsilon of which two support points count as the same point.
 template <class T>
@@ -167,14 +175,21 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
     r.status = EpaStatus::degenerate;
     return r;
   }
-  for (int f = 0; f < 4; ++f) P.link(f);
+  // Faces (0,2,1), (0,1,3), (0,3,2), (1,2,3): each pair shares one edge.
+  for (int f = 0; f < 4; ++f)
+    for (int e = 0; e < 3; ++e)
+      for (int g = 0; g < 4; ++g) {
+        const int k = g == f ? -1 : P.edge_index(P.faces[g], P.faces[f].v[(e + 1) % 3], P.faces[f].v[e]);
+        if (k >= 0) P.faces[f].adj[e] = g;
+      }
 
   using Entry = std::pair<T, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
   for (int f = 0; f < 4; ++f) heap.emplace(P.faces[f].dist, f);
   int closest = 0;
   r.status = EpaStatus::max_iterations;
-  std::vector<std::pair<int, int>> horizon;
+  std::vector<detail::HorizonEdge> horizon;
+  std::vector<int> removed, forced;
   for (int it = 0; it < max_iterations; ++it) {
     while (!heap.empty() && P.faces[heap.top().second].obsolete) heap.pop();
     if (heap.empty()) { r.status = EpaStatus::degenerate; break; }
@@ -187,20 +202,43 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
 
     const int wi = static_cast<int>(V.size());
     V.push_back(s);
-    horizon.clear();
-    P.faces[closest].obsolete = true;
-    for (int e = 0; e < 3; ++e)
-      P.silhouette(f.adj[e], f.v[e], f.v[(e + 1) % 3], s.w, horizon);
+    // Find the horizon. If w is collinear with a horizon edge (e.g. two opposite rim points and the centre of a
+    // cylinder cap), the cone face over that edge has no normal: remove the face behind that edge as well and
+    // search again (the vertex between them is then inside the new polytope).
     const int first_new = static_cast<int>(P.faces.size());
-    bool ok = !horizon.empty();
-    for (const auto& [a, b] : horizon) ok = ok && P.add_face(a, b, wi);
-    if (!ok) {  // a cone face without a normal: the polytope can no longer be trusted; keep the last face
+    int m = 0;
+    bool ok = false;
+    for (int attempt = 0; attempt < kMaxHorizonRetries && !ok; ++attempt) {
+      horizon.clear();
+      removed.clear();
+      P.faces[closest].obsolete = true;
+      for (int e = 0; e < 3; ++e) P.silhouette(f.adj[e], f.v[e], f.v[(e + 1) % 3], s.w, horizon, removed);
+      m = static_cast<int>(horizon.size());
+      ok = m >= 3;
+      for (int h = 0; ok && h < m; ++h) ok = horizon[h].b == horizon[(h + 1) % m].a;  // a closed, ordered loop
+      for (int h = 0; ok && h < m; ++h) {
+        if (P.add_face(horizon[h].a, horizon[h].b, wi)) continue;
+        ok = false;
+        P.faces[horizon[h].face].force_visible = true;
+        forced.push_back(horizon[h].face);
+      }
+      if (ok) break;
+      P.faces.resize(first_new);  // undo this attempt
+      for (int g : removed) P.faces[g].obsolete = false;
+    }
+    for (int g : forced) P.faces[g].force_visible = false;  // only for this expansion
+    forced.clear();
+    if (!ok) {  // no usable horizon: stop with the last closest face
       r.status = EpaStatus::degenerate;
       break;
     }
-    for (int g = first_new; g < static_cast<int>(P.faces.size()); ++g) {
-      P.link(g);
-      heap.emplace(P.faces[g].dist, g);
+    // New face h = (a_h, b_h, w): edge 0 borders the surviving face, edge 1 (b_h -> w) the next new face,
+    // edge 2 (w -> a_h) the previous one.
+    for (int h = 0; h < m; ++h) {
+      const int fh = first_new + h;
+      P.link(fh, 0, horizon[h].face, horizon[h].edge);
+      P.link(fh, 1, first_new + (h + 1) % m, 2);
+      heap.emplace(P.faces[fh].dist, fh);
     }
   }
   const detail::EpaFace<T>& f = P.faces[closest];

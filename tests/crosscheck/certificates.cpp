@@ -3,6 +3,7 @@
 #include "support/generators.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace batchcol::crosscheck {
@@ -96,16 +97,54 @@ double signed_outside(const Shape& s, const Pose& p, const Eigen::Vector3d& worl
       return k > 1 ? (x - x / k).norm() : -(1 - k) * z.minCoeff();
     }
     case ShapeType::convex: {
-      double worst = -1e300;
+      // Inside, the depth is the smallest distance to a face plane; outside, the distance to the nearest face.
       const ConvexHull& hull = *s.hull;
+      double excess = -1e300;
       for (std::size_t f = 0; f < hull.faces.size(); ++f)
-        worst = std::max(worst, hull.face_normals[f].dot(x - hull.vertices[hull.faces[f][0]]));
-      return worst;
+        excess = std::max(excess, hull.face_normals[f].dot(x - hull.vertices[hull.faces[f][0]]));
+      if (excess <= 0) return excess;
+      double d = 1e300;
+      for (const auto& f : hull.faces)
+        d = std::min(d, triangle_distance(x, hull.vertices[f[0]], hull.vertices[f[1]], hull.vertices[f[2]]));
+      return d;
     }
     case ShapeType::triangle: return triangle_distance(x, s.triangle[0], s.triangle[1], s.triangle[2]);
     case ShapeType::halfspace: return z.dot(x) - s.offset;
   }
   return 0.0;
+}
+
+namespace {
+
+/// Segment pq crosses the interior of triangle t: the endpoints are strictly on both sides of its plane and the
+/// crossing point strictly inside its edges (relative margins well above rounding).
+bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const std::array<Eigen::Vector3d, 3>& t) {
+  constexpr double kMargin = 1e-9;
+  const Eigen::Vector3d n = (t[1] - t[0]).cross(t[2] - t[0]).normalized();
+  const double dp = n.dot(p - t[0]), dq = n.dot(q - t[0]);
+  const double scale = (q - p).norm();
+  if (!(dp * dq < 0) || std::min(std::abs(dp), std::abs(dq)) <= kMargin * scale) return false;
+  const Eigen::Vector3d x = p + dp / (dp - dq) * (q - p);
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d e = t[(i + 1) % 3] - t[i];
+    if (n.dot(e.cross(x - t[i])) <= kMargin * e.norm() * scale) return false;
+  }
+  return true;
+}
+
+std::array<Eigen::Vector3d, 3> world_triangle(const Shape& s, const Pose& p) {
+  return {p.rotation * s.triangle[0] + p.translation, p.rotation * s.triangle[1] + p.translation,
+          p.rotation * s.triangle[2] + p.translation};
+}
+
+}  // namespace
+
+bool triangles_cross(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
+  if (a.type != ShapeType::triangle || b.type != ShapeType::triangle) return false;
+  const auto ta = world_triangle(a, pa), tb = world_triangle(b, pb);
+  for (int i = 0; i < 3; ++i)
+    if (segment_crosses(ta[i], ta[(i + 1) % 3], tb) || segment_crosses(tb[i], tb[(i + 1) % 3], ta)) return true;
+  return false;
 }
 
 bool proves_overlap(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, const Eigen::Vector3d& x) {

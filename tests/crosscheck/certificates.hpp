@@ -32,13 +32,16 @@ double certified_lower_bound(const Shape& a, const Pose& pa, const Shape& b, con
 double refined_lower_bound(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d n,
                            int evaluations = 600);
 
-/// Signed distance from world point x to the shape's boundary, positive outside. Outside it is exact for every
-/// type except the ellipsoid (distance along the ray from the centre: an upper bound, exact on the surface) and the
-/// polytope (largest face-plane excess: a lower bound, exact in front of a face; both are only used for points
-/// within rounding of the surface). Inside it is a lower bound on the depth (exact for sphere, capsule, box,
+/// Signed distance from world point x to the shape's boundary, positive outside. Outside it is exact, except for
+/// the ellipsoid, where it is the distance along the ray from the centre (an upper bound, exact on the surface);
+/// either way dist(x, shape) <= value. Inside it is a lower bound on the depth (exact for sphere, capsule, box,
 /// cylinder, polytope and halfspace), so a negative value -r certifies that the ball of radius r around x is
 /// inside the shape. Triangles are flat: never negative. Inflation is ignored (the cross-checks use none).
 double signed_outside(const Shape& s, const Pose& p, const Eigen::Vector3d& x);
+
+/// Two triangles whose edges cross each other's interior (by more than rounding): they overlap. Flat shapes have
+/// no interior point, so proves_overlap cannot show it.
+bool triangles_cross(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb);
 
 /// x proves that the shapes overlap: x is within delta of one shape and deeper than delta inside the other, so the
 /// nearest point of the first shape is an interior point of the second.

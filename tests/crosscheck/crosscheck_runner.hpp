@@ -36,14 +36,18 @@ struct Verdicts {
 };
 
 struct RunSummary {
-  std::size_t pairs = 0, separated = 0, overlapping = 0, not_converged = 0, peer_failures = 0;
+  std::size_t pairs = 0, separated = 0, overlapping = 0, peer_failures = 0;
+  std::size_t not_converged_separated = 0;    // GJK ran out of iterations
+  std::size_t not_converged_overlapping = 0;  // usually EPA's vertex budget on deep curved contacts
   ErrorStats identity;        // |witness_b - witness_a - distance * normal| and ||normal| - 1|, all pairs
   ErrorStats containment;     // distance of batchcol's witness points to their shapes (separated pairs)
-  ErrorStats certified_gap;   // batchcol distance - certified lower bound from batchcol's normal (separated)
-  ErrorStats depth_gap;       // the same for overlapping pairs: how far EPA's depth is from certified
+  ErrorStats certified_gap;   // batchcol distance - certified lower bound (converged separated pairs)
+  ErrorStats depth_gap;       // the same for converged overlapping pairs: EPA's depth against its certificate
+  ErrorStats unconverged_gap; // the same for pairs that did not converge
   double min_certified_gap = 0;  // most negative (distance below its certified lower bound: impossible)
-  ErrorStats distance_diff;   // |batchcol - peer| on separated pairs
-  ErrorStats depth_diff;      // |batchcol - peer| on overlapping pairs (information only)
+  ErrorStats distance_diff;   // |batchcol - peer| on separated pairs, proven peer errors excluded
+  ErrorStats depth_diff;      // the same on overlapping pairs (information only)
+  ErrorStats peer_error;      // |batchcol - peer| on the pairs where the certificates prove the peer wrong
   Verdicts booleans, distances, depths;
   Verdicts known_bug;          // all comparisons of pairs matching RunConfig::known_peer_bug
   std::string known_bug_description;

@@ -13,6 +13,8 @@
 #include <fcl/narrowphase/detail/gjk_solver_libccd.h>
 #include <fcl/narrowphase/distance.h>
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -159,7 +161,11 @@ PeerAnswer fcl_distance(const Shape& a, const Pose& pa, const Shape& b, const Po
           return s.shapeTriangleDistance(g, t.other_tf, t.p0, t.p1, t.p2, t.triangle_tf, &d, &p_other, &p_tri);
         });
       });
-      if (!separated) return out;  // the triangle functions compute no penetration depth
+      if (!separated) {  // FCL's triangle functions compute no penetration depth: a boolean answer only
+        out.ok = true;
+        out.collide = true;
+        return out;
+      }
       out.distance = d;
       out.point_a = t.swapped ? p_tri : p_other;
       out.point_b = t.swapped ? p_other : p_tri;

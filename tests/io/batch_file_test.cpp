@@ -43,12 +43,21 @@ std::string with_pairs(const std::string& pairs, const std::string& extra = "") 
 // A batch with the given single shape and no pairs.
 std::string with_shape(const std::string& shape) { return R"({"shapes":[)" + shape + R"(],"pairs":[]})"; }
 
-fs::path make_temp_dir(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / ("batchcol_batch_file_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh directory under the test temp dir, removed with everything in it at the end of the scope.
+struct TempDir {
+  explicit TempDir(const std::string& name)
+      : path(fs::path(testing::TempDir()) / ("batchcol_batch_file_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  fs::path path;
+};
 
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
@@ -182,7 +191,8 @@ TEST(BatchFile, MissingSettingsLeaveOptionsUnchanged) {
 }
 
 TEST(BatchFile, LoadsFileAndResolvesMeshPathsAgainstItsFolder) {
-  const fs::path dir = make_temp_dir("load");
+  const TempDir temp("load");
+  const fs::path& dir = temp.path;
   fs::create_directories(dir / "meshes");
   fs::copy_file(fs::path(kDataDir) / "cube.bin.stl", dir / "meshes" / "cube.stl");
   write_text(dir / "batch.json",
@@ -192,7 +202,6 @@ TEST(BatchFile, LoadsFileAndResolvesMeshPathsAgainstItsFolder) {
   EXPECT_EQ(file.shapes[0].type, ShapeType::convex);
   EXPECT_EQ(file.pairs.size(), 1u);
   EXPECT_EQ(file.query, QueryLevel::distance);
-  fs::remove_all(dir);
 }
 
 // ---- malformed input -------------------------------------------------------------------------------------------
@@ -417,7 +426,8 @@ TEST(BatchFileErrors, MissingMeshFile) {
 }
 
 TEST(BatchFileErrors, MissingBatchFile) {
-  const std::string path = (make_temp_dir("missing") / "nothing.json").string();
+  const TempDir temp("missing");
+  const std::string path = (temp.path / "nothing.json").string();
   try {
     load_batch_file(path);
     FAIL() << "no InputError";
@@ -428,7 +438,8 @@ TEST(BatchFileErrors, MissingBatchFile) {
 }
 
 TEST(BatchFileErrors, DirectoryInsteadOfBatchFile) {
-  const std::string path = make_temp_dir("directory").string();
+  const TempDir temp("directory");
+  const std::string path = temp.path.string();
   try {
     load_batch_file(path);
     FAIL() << "no InputError";
@@ -439,7 +450,8 @@ TEST(BatchFileErrors, DirectoryInsteadOfBatchFile) {
 }
 
 TEST(BatchFileErrors, NonRegularBatchFile) {
-  const fs::path fifo = make_temp_dir("fifo") / "batch.json";
+  const TempDir temp("fifo");
+  const fs::path fifo = temp.path / "batch.json";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   try {
     load_batch_file(fifo.string());  // must not block reading the pipe
@@ -447,12 +459,12 @@ TEST(BatchFileErrors, NonRegularBatchFile) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr(fifo.string() + ": not a regular file"));
   }
-  fs::remove_all(fifo.parent_path());
 }
 
 TEST(BatchFileErrors, UnreadableBatchFile) {
   if (::geteuid() == 0) GTEST_SKIP() << "root reads files regardless of their permissions";
-  const fs::path path = make_temp_dir("unreadable") / "batch.json";
+  const TempDir temp("unreadable");
+  const fs::path path = temp.path / "batch.json";
   write_text(path, with_pairs("[]"));
   fs::permissions(path, fs::perms::none);
   try {
@@ -461,11 +473,11 @@ TEST(BatchFileErrors, UnreadableBatchFile) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr(path.string() + ": cannot open"));
   }
-  fs::remove_all(path.parent_path());
 }
 
 TEST(BatchFileErrors, ErrorInLoadedFileNamesThePath) {
-  const fs::path dir = make_temp_dir("named");
+  const TempDir temp("named");
+  const fs::path& dir = temp.path;
   write_text(dir / "bad.json", R"({"shapes":[],"pairs":[{"a":0,"b":0}]})");
   try {
     load_batch_file((dir / "bad.json").string());
@@ -473,7 +485,6 @@ TEST(BatchFileErrors, ErrorInLoadedFileNamesThePath) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr((dir / "bad.json").string() + ": /pairs/0/a"));
   }
-  fs::remove_all(dir);
 }
 
 // ---- meshes ----------------------------------------------------------------------------------------------------
@@ -488,7 +499,8 @@ TEST(MeshFile, LoadsAsciiAndBinaryStl) {
 }
 
 TEST(MeshFile, RejectsMissingEmptyAndDirectory) {
-  const fs::path dir = make_temp_dir("mesh");
+  const TempDir temp("mesh");
+  const fs::path& dir = temp.path;
   write_text(dir / "empty.stl", "");
   write_text(dir / "nothing.stl", "solid nothing\nendsolid nothing\n");
   for (const std::string name : {"absent.stl", "empty.stl", "nothing.stl", ""}) {
@@ -500,11 +512,11 @@ TEST(MeshFile, RejectsMissingEmptyAndDirectory) {
       EXPECT_THAT(e.what(), HasSubstr(path));
     }
   }
-  fs::remove_all(dir);
 }
 
 TEST(MeshFile, RejectsNonFiniteCoordinates) {
-  const fs::path dir = make_temp_dir("nonfinite");
+  const TempDir temp("nonfinite");
+  const fs::path& dir = temp.path;
   write_text(dir / "inf.stl",
              "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e999 0 0\nvertex 0 1 0\nendloop\n"
              "endfacet\nendsolid t\n");
@@ -515,7 +527,6 @@ TEST(MeshFile, RejectsNonFiniteCoordinates) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr(path));
   }
-  fs::remove_all(dir);
 }
 
 }  // namespace

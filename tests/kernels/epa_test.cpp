@@ -115,3 +115,25 @@ TEST(Epa, TouchingPolytopesHaveZeroDepth) {
 
 }  // namespace
 }  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+TEST(Epa, ExactlyAlignedBoxesRegression) {
+  // Found by the CLI tests: with no rotation at all, EPA met a cone face whose corners are collinear (new point on
+  // the line of a horizon edge) and stopped with a depth of 0.2/sqrt(3). The face behind that edge is now removed too.
+  const Shape cube = Shape::box(0.5, 0.5, 0.5);
+  const std::vector<std::pair<Eigen::Vector3d, double>> cases = {
+      {{0.8, 0, 0}, 0.2}, {{0, 0, 0}, 1.0}, {{0, 0.3, 0}, 0.7}, {{0, 0, -0.95}, 0.05}, {{0.8, 0.1, 0.05}, 0.2}};
+  for (const auto& [t, depth] : cases)
+    for (Solver s : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
+      QueryOptions o = depth_options();
+      o.solver = s;
+      const auto r = testing::run_pair(cube, Pose{}, cube, Pose::from_translation(t), o);
+      EXPECT_EQ(r.status, Status::converged) << t.transpose();
+      EXPECT_NEAR(r.distance, -depth, 1e-12) << t.transpose();
+    }
+}
+
+}  // namespace
+}  // namespace batchcol

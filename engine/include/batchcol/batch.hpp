@@ -56,7 +56,7 @@ struct QueryOptions {
   /// Security margin: a pair collides when its distance is <= margin (boolean queries stop once that is decided).
   double margin = 0.0;
   int max_iterations = 128;       // GJK iterations per pair
-  int epa_max_iterations = 256;   // EPA expansions per pair
+  int epa_max_iterations = 1000;  // EPA expansions per pair (near-concentric curved pairs need hundreds)
   bool closed_forms = true;       // use analytic kernels where they exist (sphere/capsule/box pairs, halfspaces)
   int threads = 0;                // 0 = all cores
 };
