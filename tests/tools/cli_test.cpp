@@ -123,9 +123,9 @@ TEST_F(Cli, ValidBatchWritesCsvHeaderAndOneRowPerPair) {
   }
   // Spheres of radius 0.5 with centres 2 m apart: separated by exactly 1 m along +x.
   EXPECT_THAT(lines[1], StartsWith("0,converged,0,1,0.5,0,0,1.5,0,0,1,0,0,"));
-  // Overlapping pairs get a negative distance (penetration level).
-  EXPECT_THAT(lines[2], MatchesRegex("1,[a-z_]+,1,-[0-9].*"));
-  EXPECT_THAT(lines[3], MatchesRegex("2,[a-z_]+,1,-[0-9].*"));
+  // Unit cubes 0.8 apart overlap by 0.2 along +x; the sphere sinks 0.25 into the halfspace z <= 0.
+  EXPECT_THAT(lines[2], MatchesRegex("1,converged,1,(-0\\.2|-0\\.1999999999999999[0-9]*),.*,1,0,0,[0-9]+"));
+  EXPECT_THAT(lines[3], MatchesRegex("2,converged,1,-0\\.25,.*"));
 }
 
 TEST_F(Cli, FlagsOverrideFileSettings) {
