@@ -24,9 +24,6 @@ namespace {
 using json = nlohmann::json;
 namespace fs = std::filesystem;
 
-// Largest accepted deviation from a unit quaternion / orthonormal rotation; within it the value is renormalized.
-constexpr double kUnitTolerance = 1e-6;
-
 std::string pointer_token(const std::string& key) {
   std::string out;
   for (char c : key) {
@@ -375,29 +372,22 @@ class BatchReader {
     sized_array(v, pointer, 4);
     double q[4];
     for (int i = 0; i < 4; ++i) q[i] = number(v[i], pointer + "/" + std::to_string(i));
-    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-    const double norm = rotation.norm();
-    if (!(std::abs(norm - 1.0) <= kUnitTolerance)) {
-      std::ostringstream msg;
-      msg << "the quaternion [w, x, y, z] must have norm 1 (within 1e-6), its norm is " << norm;
-      fail(pointer, msg.str());
+    try {
+      return checked_unit_quaternion(Eigen::Quaterniond(q[0], q[1], q[2], q[3]));
+    } catch (const InputError& e) {
+      fail(pointer, e.what());
     }
-    return rotation.normalized();
   }
 
   Eigen::Quaterniond rotation_matrix(const json& v, const std::string& pointer) const {
     if (!v.is_array() || v.size() != 3) fail(pointer, "expected 3 rows of 3 numbers, got " + describe(v));
     Eigen::Matrix3d r;
     for (int i = 0; i < 3; ++i) r.row(i) = vec3(v[i], pointer + "/" + std::to_string(i)).transpose();
-    const double orthogonality = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    const double det = r.determinant();
-    if (!(orthogonality <= kUnitTolerance) || !(std::abs(det - 1.0) <= kUnitTolerance)) {
-      std::ostringstream msg;
-      msg << "not a rotation matrix (needs R R^T = I and det R = +1 within 1e-6; max |R R^T - I| = " << orthogonality
-          << ", det = " << det << ")";
-      fail(pointer, msg.str());
+    try {
+      return rotation_from_matrix(r);
+    } catch (const InputError& e) {
+      fail(pointer, e.what());
     }
-    return Eigen::Quaterniond(r).normalized();
   }
 
   Pose read_pose(const json& v, const std::string& p) const {

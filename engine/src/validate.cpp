@@ -32,9 +32,7 @@ void validate_batch_layout(const PairBatch& b) {
 }
 
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
-  if (!q.coeffs().allFinite()) return std::nullopt;
-  const double norm = q.norm();
-  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) return std::nullopt;
+  if (!q.coeffs().allFinite() || !(std::abs(q.norm() - 1.0) <= kUnitTolerance)) return std::nullopt;
   return q.normalized();
 }
 

@@ -7,13 +7,10 @@
 
 namespace batchcol::detail {
 
-/// Quaternions whose norm is within this of 1 are normalised; beyond it they are rejected (a typo, not rounding).
-constexpr double kQuaternionNormTolerance = 1e-6;
-
 /// Throws InputError when the arrays of `batch` have different lengths.
 void validate_batch_layout(const PairBatch& batch);
 
-/// The unit quaternion for `q`, or nothing when q is not finite or not unit within kQuaternionNormTolerance.
+/// The unit quaternion for `q`, or nothing when q is not finite or not unit within kUnitTolerance.
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q);
 
 }  // namespace batchcol::detail

@@ -85,3 +85,20 @@ TEST(Shapes, TableStoresEachShapeOnceAndHullsAreShared) {
 
 }  // namespace
 }  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+TEST(Poses, RotationMatricesAndQuaternionsAreCheckedAtTheBoundary) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Pose p = Pose::from_matrix(R, Eigen::Vector3d(1, 2, 3));
+  EXPECT_LT((p.rotation.toRotationMatrix() - R).norm(), 1e-14);
+  EXPECT_THROW(Pose::from_matrix(2 * R, Eigen::Vector3d::Zero()), InputError);
+  EXPECT_THROW(Pose::from_matrix(-R, Eigen::Vector3d::Zero()), InputError);  // det -1: a reflection
+  EXPECT_NEAR(checked_unit_quaternion(Eigen::Quaterniond(1 + 9e-7, 0, 0, 0)).norm(), 1.0, 1e-15);
+  EXPECT_THROW(checked_unit_quaternion(Eigen::Quaterniond(1.01, 0, 0, 0)), InputError);
+  EXPECT_THROW(checked_unit_quaternion(Eigen::Quaterniond(std::nan(""), 0, 0, 0)), InputError);
+}
+
+}  // namespace
+}  // namespace batchcol

@@ -10,6 +10,16 @@
 
 namespace batchcol {
 
+/// Quaternions and rotation matrices within this of unit norm / orthonormality are normalised; beyond it they are
+/// rejected as input errors (a typo, not rounding).
+constexpr double kUnitTolerance = 1e-6;
+
+/// The normalised quaternion; throws InputError unless | |q| - 1 | <= kUnitTolerance and q is finite.
+Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q);
+/// The unit quaternion of a rotation matrix; throws InputError unless R R^T = I and det R = +1 within
+/// kUnitTolerance.
+Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R);
+
 /// A rigid transform x_world = rotation * x_local + translation.
 struct Pose {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
@@ -17,6 +27,8 @@ struct Pose {
 
   static Pose identity() { return {}; }
   static Pose from_translation(const Eigen::Vector3d& t) { return {t, Eigen::Quaterniond::Identity()}; }
+  /// Accepts a rotation matrix at the boundary (validated by rotation_from_matrix).
+  static Pose from_matrix(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) { return {t, rotation_from_matrix(R)}; }
 };
 
 /// Structure-of-arrays storage of 3-vectors: one contiguous array per component.

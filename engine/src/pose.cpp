@@ -1,0 +1,33 @@
+#include "batchcol/errors.hpp"
+#include "batchcol/pose.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace batchcol {
+
+Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
+  if (!q.coeffs().allFinite()) throw InputError("the quaternion has a non-finite component");
+  const double norm = q.norm();
+  if (!(std::abs(norm - 1.0) <= kUnitTolerance)) {
+    std::ostringstream msg;
+    msg << "the quaternion [w, x, y, z] must have norm 1 (within " << kUnitTolerance << "), its norm is " << norm;
+    throw InputError(msg.str());
+  }
+  return q.normalized();
+}
+
+Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R) {
+  if (!R.allFinite()) throw InputError("the rotation matrix has a non-finite entry");
+  const double orthogonality = (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double det = R.determinant();
+  if (!(orthogonality <= kUnitTolerance) || !(std::abs(det - 1.0) <= kUnitTolerance)) {
+    std::ostringstream msg;
+    msg << "not a rotation matrix (needs R R^T = I and det R = +1 within " << kUnitTolerance
+        << "; max |R R^T - I| = " << orthogonality << ", det = " << det << ")";
+    throw InputError(msg.str());
+  }
+  return Eigen::Quaterniond(R).normalized();
+}
+
+}  // namespace batchcol
