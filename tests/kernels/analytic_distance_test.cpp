@@ -26,16 +26,6 @@ std::vector<Eigen::Matrix3d> axis_rotations() {
   return out;
 }
 
-/// A shape with reflection symmetry in the three coordinate planes of its frame (cones: only about x and y).
-Shape symmetric_shape(Rng& rng, ShapeType type) {
-  if (type != ShapeType::convex) return testing::random_shape(rng, type);
-  std::vector<Eigen::Vector3d> pts;
-  for (const auto& p : testing::random_hull_points(rng, 6, 0.02, 0.2))
-    for (int s = 0; s < 8; ++s)
-      pts.emplace_back(s & 1 ? -p.x() : p.x(), s & 2 ? -p.y() : p.y(), s & 4 ? -p.z() : p.z());
-  return Shape::convex(pts);
-}
-
 /// A rotation of the allowed set that keeps the shape symmetric about the world x axis.
 Eigen::Matrix3d symmetric_rotation(Rng& rng, ShapeType type) {
   static const std::vector<Eigen::Matrix3d> rotations = axis_rotations();
@@ -53,7 +43,7 @@ struct Config {
 };
 
 Config make_config(Rng& rng, ShapeType ta, ShapeType tb, double gap) {
-  Config c{symmetric_shape(rng, ta), symmetric_shape(rng, tb), {}, {}, 0};
+  Config c{testing::symmetric_shape(rng, ta), testing::symmetric_shape(rng, tb), {}, {}, 0};
   if (rng() % 3 == 0) c.a = c.a.inflated(testing::uniform(rng, 0.0, 0.05));
   const Eigen::Matrix3d Ra = symmetric_rotation(rng, ta), Rb = symmetric_rotation(rng, tb);
   const Eigen::Vector3d e = Eigen::Vector3d::UnitX();

@@ -54,6 +54,15 @@ Shape random_shape(Rng& rng, ShapeType type, double lo, double hi) {
   return Shape::sphere(u());
 }
 
+Shape symmetric_shape(Rng& rng, ShapeType type, int seeds) {
+  if (type != ShapeType::convex) return random_shape(rng, type);
+  std::vector<Eigen::Vector3d> pts;
+  for (const auto& p : random_hull_points(rng, seeds, 0.02, 0.2))
+    for (int s = 0; s < 8; ++s)
+      pts.emplace_back(s & 1 ? -p.x() : p.x(), s & 2 ? -p.y() : p.y(), s & 4 ? -p.z() : p.z());
+  return Shape::convex(pts);
+}
+
 double extent(const Shape& s, const Eigen::Vector3d& d) {
   const double n = d.norm();
   const double rho = std::hypot(d.x(), d.y());

@@ -24,6 +24,10 @@ Shape random_shape(Rng& rng, ShapeType type, double min_size = 0.02, double max_
 /// Points of a convex polytope: `n` random points on an ellipsoid with radii in [min_size, max_size].
 std::vector<Eigen::Vector3d> random_hull_points(Rng& rng, int n, double min_size, double max_size);
 
+/// A shape of `type` with reflection symmetry in the three coordinate planes of its frame (cones: in the two
+/// planes containing their axis). Hulls are `seeds` random points mirrored in the three planes.
+Shape symmetric_shape(Rng& rng, ShapeType type, int seeds = 6);
+
 /// Reference signed distance of two shapes by a slow, independent route: for separated pairs, long-double
 /// projected-gradient on the support functions is not independent enough, so the tests use closed forms instead;
 /// this helper returns the extent of a shape along local direction d: max <x, d> over the shape (inflation

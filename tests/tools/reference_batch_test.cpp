@@ -59,21 +59,12 @@ std::string pose_json(const Pose& p) {
          num(q.y()) + "," + num(q.z()) + "]}";
 }
 
-/// Shapes symmetric in their three coordinate planes (cones: about their axis only), as in the analytic test.
-Shape symmetric_shape(Rng& rng, ShapeType t) {
-  if (t != ShapeType::convex) return testing::random_shape(rng, t);
-  std::vector<Eigen::Vector3d> pts;
-  for (const auto& p : testing::random_hull_points(rng, 5, 0.02, 0.2))
-    for (int s = 0; s < 8; ++s) pts.emplace_back(s & 1 ? -p.x() : p.x(), s & 2 ? -p.y() : p.y(), s & 4 ? -p.z() : p.z());
-  return Shape::convex(pts);
-}
-
 /// Separated: extent gap along the line of centres; the cone's axis lies on that line.
 RefPair separated(Rng& rng) {
   const std::vector<ShapeType> types = {ShapeType::sphere, ShapeType::capsule, ShapeType::box, ShapeType::cylinder,
                                         ShapeType::cone, ShapeType::ellipsoid, ShapeType::convex};
   const ShapeType ta = types[rng() % types.size()], tb = types[rng() % types.size()];
-  Shape a = symmetric_shape(rng, ta), b = symmetric_shape(rng, tb);
+  Shape a = testing::symmetric_shape(rng, ta, 5), b = testing::symmetric_shape(rng, tb, 5);
   if (rng() % 4 == 0) b = b.inflated(testing::uniform(rng, 0.001, 0.03));
   const Eigen::Quaterniond along_x(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));  // local z -> world x
   const Eigen::Quaterniond ra = ta == ShapeType::cone || rng() % 2 ? along_x : Eigen::Quaterniond::Identity();
