@@ -1,0 +1,56 @@
+// Support functions against the extent formula h(d) = max <x, d> written from the shape definitions
+// (tests/support/generators.cpp), and hill climbing on large hulls against a linear scan.
+#include "kernels/support.hpp"
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+namespace batchcol::kernels {
+namespace {
+
+TEST(Support, EveryCoreReachesItsExtent) {
+  batchcol::testing::Rng rng(31);
+  for (ShapeType t : batchcol::testing::bounded_shape_types())
+    for (int trial = 0; trial < 200; ++trial) {
+      const Shape s = batchcol::testing::random_shape(rng, t);
+      const ShapeCore<double> core = make_core<double>(s);
+      Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+      if (trial % 10 == 0) d = Eigen::Vector3d::Unit(trial % 3);  // axis directions hit the tie branches
+      SupportHint hint;
+      const Eigen::Vector3d p = support(core, d, hint);
+      // extent() includes the swept radius, the core support does not.
+      EXPECT_NEAR(p.dot(d) + core.radius, batchcol::testing::extent(s, d), 1e-12) << to_string(t);
+    }
+}
+
+TEST(Support, HillClimbingOnLargeHullsEqualsALinearScan) {
+  batchcol::testing::Rng rng(32);
+  for (int n : {40, 250, 940, 3000}) {
+    const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
+    ASSERT_GE(s.hull->vertices.size(), kHillClimbMinVertices);
+    const ShapeCore<double> core = make_core<double>(s);
+    SupportHint hint;  // kept across queries, as inside one GJK run
+    for (int q = 0; q < 2000; ++q) {
+      const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+      double best = -1e300;
+      for (const auto& v : s.hull->vertices) best = std::max(best, v.dot(d));
+      EXPECT_EQ(support(core, d, hint).dot(d), best) << n << " vertices, query " << q;
+    }
+  }
+}
+
+TEST(Support, FloatCoresStayWithinFloatRounding) {
+  batchcol::testing::Rng rng(33);
+  for (ShapeType t : batchcol::testing::bounded_shape_types())
+    for (int trial = 0; trial < 100; ++trial) {
+      const Shape s = batchcol::testing::random_shape(rng, t);
+      const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+      SupportHint h1, h2;
+      const Eigen::Vector3d pd = support(make_core<double>(s), d, h1);
+      const Eigen::Vector3f pf = support(make_core<float>(s), Eigen::Vector3f(d.cast<float>()), h2);
+      EXPECT_NEAR(pf.cast<double>().dot(d), pd.dot(d), 1e-6) << to_string(t);
+    }
+}
+
+}  // namespace
+}  // namespace batchcol::kernels
