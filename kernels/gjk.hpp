@@ -128,7 +128,14 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (params.boolean_only && lb > params.core_margin) { r.status = GjkStatus::separated_proven; break; }
 
     const T tol = std::max(params.tolerance, params.relative_tolerance * xn);
-    if (xn - lower_bound <= tol) { r.status = GjkStatus::converged; break; }
+    if (xn - lower_bound <= tol) {
+      // Certified distance. Stop only when the certificate is along x itself: then the normal -x/|x| is
+      // certified too (its support gap is <= tol). A momentum direction certifies |x| but leaves the direction of
+      // x off by up to sqrt(2 |x| tol) / |x|, so finish with a plain step.
+      if (plain_step) { r.status = GjkStatus::converged; break; }
+      momentum = false;
+      continue;
+    }
     if (!plain_step && xx - x.dot(s.w) <= tol * xn) {
       // The momentum support point would not move x: switch to plain GJK, whose gap certifies convergence.
       momentum = false;
