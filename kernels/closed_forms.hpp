@@ -165,8 +165,9 @@ PairOutput<T> halfspace_halfspace(const ShapeCore<T>& A, const ShapeCore<T>& B, 
   PairOutput<T> out;
   out.status = Status::converged;
   out.normal = na;
-  // Antiparallel within rounding of a rotated unit vector (1e3 eps): the planes are treated as parallel.
-  if (na.dot(nb) <= T(-1) + T(1000) * machine_epsilon<T>()) {
+  // Antiparallel when the sine of the angle between the normals is within rounding of a rotated unit vector
+  // (1e3 eps; comparing 1 + cos instead would square the angle).
+  if (na.dot(nb) < T(0) && na.cross(nb).norm() <= T(1000) * machine_epsilon<T>()) {
     // B = {x : -na.x <= -na.pb}: the gap between the planes is na.pb - offset_a.
     out.distance = na.dot(pb) - A.halfspace_offset - A.radius - B.radius;
     out.witness_b = pb - B.radius * na;

@@ -45,6 +45,9 @@ template <class T> class EpaPolytope {
  public:
   std::vector<SupportPoint<T>> verts;
   std::vector<EpaFace<T>> faces;
+  /// A face sees w only when w is beyond its plane by more than this (a few ulps of the problem size): rounding
+  /// must not make a face behind w visible, which would carve the polytope non-convex.
+  T visibility_margin = T(0);
 
   /// Adds face (a, b, c), counter-clockwise seen from outside; returns false if it has no usable normal.
   bool add_face(int a, int b, int c) {
@@ -81,7 +84,7 @@ template <class T> class EpaPolytope {
                   std::vector<int>& removed) {
     EpaFace<T>& g = faces[gi];
     if (g.obsolete) return;
-    if (!g.force_visible && g.n.dot(w) - g.dist <= T(0)) {
+    if (!g.force_visible && g.n.dot(w) - g.dist <= visibility_margin) {
       horizon.push_back({a, b, gi, edge_index(g, b, a)});
       return;
     }
@@ -159,6 +162,7 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
   detail::EpaPolytope<T> P;
   for (int i = 0; i < start.count; ++i) P.verts.push_back(start.v[i]);
   const T min_len = T(1000) * machine_epsilon<T>() * scale;
+  P.visibility_margin = T(4) * machine_epsilon<T>() * scale;
   Vec3<T> flat_normal;
   if (!detail::blow_up(D, P.verts, min_len, flat_normal)) {
     r.status = EpaStatus::flat;
@@ -193,8 +197,14 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
   for (int it = 0; it < max_iterations; ++it) {
     while (!heap.empty() && P.faces[heap.top().second].obsolete) heap.pop();
     if (heap.empty()) { r.status = EpaStatus::degenerate; break; }
-    closest = heap.top().second;
     r.iterations = it + 1;
+    // On a convex polytope the closest-face distance (a lower bound on the depth) never decreases; if rounding
+    // broke convexity it does: stop and keep the best face found so far.
+    if (it > 0 && P.faces[heap.top().second].dist < P.faces[closest].dist - tolerance) {
+      r.status = EpaStatus::degenerate;
+      break;
+    }
+    closest = heap.top().second;
     const detail::EpaFace<T> f = P.faces[closest];
     const SupportPoint<T> s = D.support(f.n);
     const T upper = f.n.dot(s.w);  // h_D(n) >= depth >= f.dist
@@ -247,7 +257,9 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
   const Vec3<T> p = f.n * f.dist;
   const Vec3<T> lam = detail::face_barycentric(V[f.v[0]].w, V[f.v[1]].w, V[f.v[2]].w, p, f.n);
   r.witness_a = lam[0] * V[f.v[0]].a + lam[1] * V[f.v[1]].a + lam[2] * V[f.v[2]].a;
-  r.witness_b = lam[0] * V[f.v[0]].b + lam[1] * V[f.v[1]].b + lam[2] * V[f.v[2]].b;
+  // witness_a - witness_b is the origin's projection on the face, dist * n; with the depth clamped at 0 (origin
+  // a rounding error outside), move witness_b so that witness_a - witness_b = depth * normal holds exactly.
+  r.witness_b = r.witness_a - r.depth * r.normal;
   return r;
 }
 

@@ -128,11 +128,11 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (params.boolean_only && lb > params.core_margin) { r.status = GjkStatus::separated_proven; break; }
 
     const T tol = std::max(params.tolerance, params.relative_tolerance * xn);
-    if (xn - lower_bound <= tol) {
-      // Certified distance. Stop only when the certificate is along x itself: then the normal -x/|x| is
-      // certified too (its support gap is <= tol). A momentum direction certifies |x| but leaves the direction of
-      // x off by up to sqrt(2 |x| tol) / |x|, so finish with a plain step.
-      if (plain_step) { r.status = GjkStatus::converged; break; }
+    // Stop on the duality gap along x itself, (|x|^2 - <x, s>) / |x| = |x| - lb: it certifies the distance and
+    // the normal -x/|x| (its support gap is <= tol). A bound from an earlier or a momentum direction certifies
+    // |x| only and leaves the direction of x off by up to sqrt(2 |x| tol) / |x|, so it just switches to plain steps.
+    if (plain_step && xn - lb <= tol) { r.status = GjkStatus::converged; break; }
+    if (!plain_step && xn - lower_bound <= tol) {
       momentum = false;
       continue;
     }
@@ -168,6 +168,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     d_prev = d;
     last_s = s.w;
   }
+  // The budget can run out right after x reached the origin.
+  if (r.status == GjkStatus::max_iterations && x.norm() <= params.touch_tolerance) r.status = GjkStatus::overlap;
   r.x = x;
   r.lower_bound = lower_bound;
   if (r.status == GjkStatus::overlap) r.x = Vec3<T>::Zero();

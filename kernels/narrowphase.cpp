@@ -81,7 +81,7 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
   params.boolean_only = opt.level == QueryLevel::boolean;
   params.core_margin = T(opt.margin) + radii;
   params.normalize_momentum = !(A.strictly_convex() && B.strictly_convex());
-  params.touch_tolerance = T(64) * floor;  // ~1e3 ulps of the problem size
+  params.touch_tolerance = floor;  // 16 ulps of the problem size
   const MinkowskiDifference<T> D{&A, &B, X, {}, {}};
   const Vec3<T> warm = warm_direction.cast<T>();
   const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
@@ -118,15 +118,21 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
   // of D (~ scale); (2) a Frank-Wolfe step decreases |x|^2 by ~ gap^2 / |x - s|^2, which rounds to nothing once
   // the distance gap is below ~ sqrt(eps) |x - s|. The distance itself is usually far more accurate than this
   // certificate (the tests measure it against closed forms).
-  const T certifiable =
-      std::max(T(64) * floor * (T(1) + scale / xn), T(4) * std::sqrt(machine_epsilon<T>()) * scale);
+  // Limit (1) is capped at the larger of |x| and limit (2): it must not grow without bound as |x| -> 0.
+  const T sqrt_limit = T(4) * std::sqrt(machine_epsilon<T>()) * scale;
+  const T certifiable = std::max(std::min(T(4) * floor * (T(1) + scale / xn), std::max(xn, sqrt_limit)), sqrt_limit);
   if (g.status == GjkStatus::stalled && xn - g.lower_bound > std::max(params.tolerance, certifiable))
     out.status = Status::degenerate;
   out.distance = xn - radii;
   out.normal = n;
   out.witness_a = g.witness_a() + A.radius * n;
   out.witness_b = g.witness_b() - B.radius * n;
-  finish(out, opt, false, false);
+  // collide: when the gap certified the distance (or the budget ran out), it is decided conservatively, false
+  // only when a separating plane beyond the margin is certified (a loose tolerance must not turn a shallow
+  // overlap into a separation). After an accepted stall the certificate is at the arithmetic's limit and the
+  // distance estimate decides.
+  if (g.status == GjkStatus::stalled) finish(out, opt, false, false);
+  else finish(out, opt, true, !(g.lower_bound > params.core_margin));
   return out;
 }
 

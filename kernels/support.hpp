@@ -41,7 +41,8 @@ template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d
     T best_dot = dot(best);
     for (bool moved = true; moved;) {
       moved = false;
-      for (std::uint32_t k = hull.neighbor_offsets[best]; k < hull.neighbor_offsets[best + 1]; ++k) {
+      const std::uint32_t from = best;  // the loop bounds must not follow `best` while it moves
+      for (std::uint32_t k = hull.neighbor_offsets[from]; k < hull.neighbor_offsets[from + 1]; ++k) {
         const std::uint32_t n = hull.neighbors[k];
         const T dn = dot(n);
         if (dn > best_dot) { best_dot = dn; best = n; moved = true; }

@@ -116,6 +116,7 @@ std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::V
     throw InputError(what + ": the convex hull is degenerate (fewer than 4 vertices)");
   for (const auto& v : hull->vertices) hull->centroid += v;
   hull->centroid /= static_cast<double>(hull->vertices.size());
+  for (const auto& v : hull->vertices) hull->radius = std::max(hull->radius, v.norm());
   build_adjacency(*hull);
   return hull;
 }

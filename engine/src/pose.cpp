@@ -6,10 +6,14 @@
 
 namespace batchcol {
 
+bool is_unit_quaternion(const Eigen::Quaterniond& q) {
+  return q.coeffs().allFinite() && std::abs(q.norm() - 1.0) <= kUnitTolerance;
+}
+
 Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
   if (!q.coeffs().allFinite()) throw InputError("the quaternion has a non-finite component");
   const double norm = q.norm();
-  if (!(std::abs(norm - 1.0) <= kUnitTolerance)) {
+  if (!is_unit_quaternion(q)) {
     std::ostringstream msg;
     msg << "the quaternion [w, x, y, z] must have norm 1 (within " << kUnitTolerance << "), its norm is " << norm;
     throw InputError(msg.str());

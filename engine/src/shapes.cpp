@@ -114,9 +114,7 @@ double Shape::bounding_radius() const {
     case ShapeType::cylinder:
     case ShapeType::cone: core = std::hypot(size.x(), size.y()); break;
     case ShapeType::ellipsoid: core = size.maxCoeff(); break;
-    case ShapeType::convex:
-      for (const auto& v : hull->vertices) core = std::max(core, v.norm());
-      break;
+    case ShapeType::convex: core = hull->radius; break;
     case ShapeType::triangle:
       for (const auto& v : triangle) core = std::max(core, v.norm());
       break;

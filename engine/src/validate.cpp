@@ -32,7 +32,7 @@ void validate_batch_layout(const PairBatch& b) {
 }
 
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
-  if (!q.coeffs().allFinite() || !(std::abs(q.norm() - 1.0) <= kUnitTolerance)) return std::nullopt;
+  if (!is_unit_quaternion(q)) return std::nullopt;
   return q.normalized();
 }
 

@@ -19,8 +19,9 @@ namespace batchcol {
 /// What to compute per pair; each level includes the previous ones and costs more.
 enum class QueryLevel : std::uint8_t {
   boolean,      // collide only; stops as soon as a separating plane (or an overlap) is proven
-  distance,     // + signed distance for separated pairs (overlapping pairs: collide, distance NaN)
-  witness,      // + witness points and normal for separated pairs
+  distance,     // + signed distance for separated pairs; overlapping pairs get it only where it costs no EPA
+                //   (closed forms, inflated shapes whose cores are apart), else NaN
+  witness,      // + witness points and normal wherever the distance is known
   penetration,  // + EPA depth, normal and witness points for overlapping pairs
 };
 
@@ -50,14 +51,18 @@ struct QueryOptions {
   Solver solver = Solver::nesterov;
   Precision precision = Precision::float64;
   /// Absolute bound on the distance error in metres, certified by the Frank-Wolfe duality gap:
-  /// GJK stops when (|x|^2 - <x, s>) / |x| <= max(tolerance, relative_tolerance * |x|).
+  /// GJK stops when (|x|^2 - <x, s>) / |x| <= max(tolerance, relative_tolerance * |x|). The tolerance is raised
+  /// to the precision floor 16 eps (bounding radii + centre distance): ~1e-15 m in double, ~1e-6 m in float for
+  /// 0.5 m problems. EPA stops when its depth bounds are within the same tolerance.
   double tolerance = 1e-8;
   double relative_tolerance = 0.0;
   /// Security margin: a pair collides when its distance is <= margin (boolean queries stop once that is decided).
+  /// collide is conservative: false only when a separating plane beyond the margin is certified.
   double margin = 0.0;
   int max_iterations = 128;       // GJK iterations per pair
   int epa_max_iterations = 1000;  // EPA expansions per pair (near-concentric curved pairs need hundreds)
-  bool closed_forms = true;       // use analytic kernels where they exist (sphere/capsule/box pairs, halfspaces)
+  bool closed_forms = true;       // analytic kernels for sphere/capsule pairs, sphere-box, box-box boolean
+                                  // (halfspace pairs always use their closed form: they have no support function)
   int threads = 0;                // 0 = all cores
 };
 

@@ -14,6 +14,8 @@ namespace batchcol {
 /// rejected as input errors (a typo, not rounding).
 constexpr double kUnitTolerance = 1e-6;
 
+/// True when q is finite and | |q| - 1 | <= kUnitTolerance.
+bool is_unit_quaternion(const Eigen::Quaterniond& q);
 /// The normalised quaternion; throws InputError unless | |q| - 1 | <= kUnitTolerance and q is finite.
 Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q);
 /// The unit quaternion of a rotation matrix; throws InputError unless R R^T = I and det R = +1 within

@@ -33,6 +33,7 @@ struct ConvexHull {
   std::vector<std::uint32_t> neighbor_offsets;      // size vertices+1
   std::vector<std::uint32_t> neighbors;             // vertex indices adjacent through a hull edge
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mean of the hull vertices (inside the hull)
+  double radius = 0.0;  // largest vertex norm: the hull's bounding radius about the local origin
 };
 
 /// Computes the convex hull of `points` with qhull. Throws InputError (naming `what`) when a point is not finite or
