@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #ifdef BATCHCOL_HAVE_BULLET
-#include "crosscheck/bullet_adapter.hpp"
+#include "peers/bullet_adapter.hpp"
 #endif
 
 namespace batchcol::crosscheck {

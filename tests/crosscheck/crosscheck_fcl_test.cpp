@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #ifdef BATCHCOL_HAVE_FCL
-#include "crosscheck/fcl_adapter.hpp"
+#include "peers/fcl_adapter.hpp"
 #endif
 
 namespace batchcol::crosscheck {

@@ -7,13 +7,16 @@
 
 #include "crosscheck/agreement.hpp"
 #include "crosscheck/crosscheck_pairs.hpp"
-#include "crosscheck/peer_answer.hpp"
+#include "peers/peer_answer.hpp"
 
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace batchcol::crosscheck {
+
+// The peer adapters live in tools/peers (shared with `batchcol bench`).
+using namespace ::batchcol::peers;
 
 using PeerQuery = std::function<PeerAnswer(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb)>;
 

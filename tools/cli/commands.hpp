@@ -15,5 +15,6 @@ struct Command {
 
 Command add_demo_command(CLI::App& parent);
 Command add_query_command(CLI::App& parent);
+Command add_bench_command(CLI::App& parent);
 
 }  // namespace batchcol::cli

@@ -1,4 +1,4 @@
-#include "crosscheck/bullet_adapter.hpp"
+#include "peers/bullet_adapter.hpp"
 
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
 #include <BulletCollision/CollisionShapes/btCapsuleShape.h>
@@ -11,8 +11,9 @@
 
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
-namespace batchcol::crosscheck {
+namespace batchcol::peers {
 namespace {
 
 btVector3 to_bt(const Eigen::Vector3d& v) { return {btScalar(v.x()), btScalar(v.y()), btScalar(v.z())}; }
@@ -53,26 +54,11 @@ std::unique_ptr<btConvexShape> make_shape(const Shape& s) {
   return shape;
 }
 
-}  // namespace
-
-bool bullet_supports(ShapeType type) { return type != ShapeType::ellipsoid && type != ShapeType::halfspace; }
-
-bool bullet_double_precision() { return sizeof(btScalar) == sizeof(double); }
-
-double bullet_extent(const Shape& s, const Eigen::Vector3d& d) {
-  const auto shape = make_shape(s);
-  const btVector3 dir = to_bt(d);
-  return double(shape->localGetSupportingVertexWithoutMargin(dir).dot(dir)) +
-         double(shape->getMargin()) * d.norm();
-}
-
-PeerAnswer bullet_signed_distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
+PeerAnswer signed_distance(const btConvexShape* sa, const Pose& pa, const btConvexShape* sb, const Pose& pb) {
   PeerAnswer out;
-  if (!bullet_supports(a.type) || !bullet_supports(b.type)) return out;
-  const auto sa = make_shape(a), sb = make_shape(b);
   btGjkEpaSolver2::sResults r;
   const btVector3 guess = to_bt(pa.translation - pb.translation);
-  if (!btGjkEpaSolver2::SignedDistance(sa.get(), to_bt(pa), sb.get(), to_bt(pb), guess, r)) return out;
+  if (!btGjkEpaSolver2::SignedDistance(sa, to_bt(pa), sb, to_bt(pb), guess, r)) return out;
   // Core result: witnesses[1] - witnesses[0] = core_distance * n (n from a to b) in both outcomes.
   const double core = double(r.distance);  // > 0 from Distance, -depth from Penetration
   Eigen::Vector3d wa = from_bt(r.witnesses[0]), wb = from_bt(r.witnesses[1]);
@@ -88,4 +74,41 @@ PeerAnswer bullet_signed_distance(const Shape& a, const Pose& pa, const Shape& b
   return out;
 }
 
-}  // namespace batchcol::crosscheck
+}  // namespace
+
+bool bullet_supports(ShapeType type) { return type != ShapeType::ellipsoid && type != ShapeType::halfspace; }
+
+bool bullet_double_precision() { return sizeof(btScalar) == sizeof(double); }
+
+double bullet_extent(const Shape& s, const Eigen::Vector3d& d) {
+  const auto shape = make_shape(s);
+  const btVector3 dir = to_bt(d);
+  return double(shape->localGetSupportingVertexWithoutMargin(dir).dot(dir)) +
+         double(shape->getMargin()) * d.norm();
+}
+
+PeerAnswer bullet_signed_distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
+  if (!bullet_supports(a.type) || !bullet_supports(b.type)) return {};
+  const auto sa = make_shape(a), sb = make_shape(b);
+  return signed_distance(sa.get(), pa, sb.get(), pb);
+}
+
+struct BulletShapeCache::Impl {
+  std::vector<std::unique_ptr<btConvexShape>> shapes;  // null for unsupported types
+};
+
+BulletShapeCache::BulletShapeCache(const ShapeTable& shapes) : impl_(std::make_unique<Impl>()) {
+  for (const Shape& s : shapes.shapes()) {
+    impl_->shapes.push_back(bullet_supports(s.type) && s.inflation == 0.0 ? make_shape(s) : nullptr);
+  }
+}
+
+BulletShapeCache::~BulletShapeCache() = default;
+
+PeerAnswer BulletShapeCache::signed_distance(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb) const {
+  const btConvexShape *sa = impl_->shapes.at(a).get(), *sb = impl_->shapes.at(b).get();
+  if (!sa || !sb) return {};
+  return peers::signed_distance(sa, pa, sb, pb);
+}
+
+}  // namespace batchcol::peers

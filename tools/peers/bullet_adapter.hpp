@@ -11,9 +11,12 @@
 #pragma once
 
 #include "batchcol/batchcol.hpp"
-#include "crosscheck/peer_answer.hpp"
+#include "peers/peer_answer.hpp"
 
-namespace batchcol::crosscheck {
+#include <cstdint>
+#include <memory>
+
+namespace batchcol::peers {
 
 /// Shape types with a Bullet convex counterpart (no ellipsoid; halfspaces are concave btStaticPlaneShapes).
 bool bullet_supports(ShapeType type);
@@ -27,4 +30,21 @@ double bullet_extent(const Shape& s, const Eigen::Vector3d& d);
 /// true when the library was built with BT_USE_DOUBLE_PRECISION.
 bool bullet_double_precision();
 
-}  // namespace batchcol::crosscheck
+/// Bullet shapes built once per shape of a table (unsupported types stay empty and answer ok = false), so that
+/// timing loops measure btGjkEpaSolver2 and not shape construction. Same answers as bullet_signed_distance; the
+/// query is const and may run concurrently.
+class BulletShapeCache {
+ public:
+  explicit BulletShapeCache(const ShapeTable& shapes);
+  ~BulletShapeCache();
+  BulletShapeCache(const BulletShapeCache&) = delete;
+  BulletShapeCache& operator=(const BulletShapeCache&) = delete;
+
+  PeerAnswer signed_distance(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace batchcol::peers

@@ -1,4 +1,4 @@
-#include "crosscheck/fcl_adapter.hpp"
+#include "peers/fcl_adapter.hpp"
 
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -19,7 +19,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace batchcol::crosscheck {
+namespace batchcol::peers {
 namespace {
 
 fcl::Transform3d to_fcl(const Pose& p) {
@@ -185,4 +185,56 @@ PeerAnswer fcl_distance(const Shape& a, const Pose& pa, const Shape& b, const Po
   return out;
 }
 
-}  // namespace batchcol::crosscheck
+struct FclShapeCache::Impl {
+  std::vector<Shape> shapes;
+  std::vector<std::shared_ptr<fcl::CollisionGeometryd>> geometries;  // null for triangles and halfspaces
+};
+
+FclShapeCache::FclShapeCache(const ShapeTable& shapes) : impl_(std::make_unique<Impl>()) {
+  impl_->shapes = shapes.shapes();
+  for (const Shape& s : impl_->shapes) {
+    const bool simple = s.type != ShapeType::triangle && s.type != ShapeType::halfspace;
+    impl_->geometries.push_back(simple ? make_geometry(s) : nullptr);
+  }
+}
+
+FclShapeCache::~FclShapeCache() = default;
+
+PeerAnswer FclShapeCache::collide(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb,
+                                  FclSolver solver) const {
+  const auto &ga = impl_->geometries.at(a), &gb = impl_->geometries.at(b);
+  if (!ga || !gb) return fcl_collide(impl_->shapes[a], pa, impl_->shapes[b], pb, solver, false);
+  PeerAnswer out;
+  try {
+    fcl::CollisionRequestd request(1, false);
+    request.gjk_solver_type = to_fcl(solver);
+    fcl::CollisionResultd result;
+    fcl::collide(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
+    out.collide = result.isCollision();
+    out.ok = true;
+  } catch (const std::exception&) {
+    out.ok = false;
+  }
+  return out;
+}
+
+PeerAnswer FclShapeCache::distance(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb,
+                                   FclSolver solver, double tolerance) const {
+  const auto &ga = impl_->geometries.at(a), &gb = impl_->geometries.at(b);
+  if (!ga || !gb) return fcl_distance(impl_->shapes[a], pa, impl_->shapes[b], pb, solver, tolerance);
+  PeerAnswer out;
+  try {
+    fcl::DistanceRequestd request(true, true, 0.0, 0.0, tolerance, to_fcl(solver));
+    fcl::DistanceResultd result;
+    out.distance = fcl::distance(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
+    out.point_a = result.nearest_points[0];
+    out.point_b = result.nearest_points[1];
+    out.collide = out.distance <= 0;
+    out.ok = true;
+  } catch (const std::exception&) {
+    out.ok = false;
+  }
+  return out;
+}
+
+}  // namespace batchcol::peers

@@ -8,9 +8,12 @@
 #pragma once
 
 #include "batchcol/batchcol.hpp"
-#include "crosscheck/peer_answer.hpp"
+#include "peers/peer_answer.hpp"
 
-namespace batchcol::crosscheck {
+#include <cstdint>
+#include <memory>
+
+namespace batchcol::peers {
 
 enum class FclSolver { libccd, indep };
 const char* to_string(FclSolver solver);
@@ -25,4 +28,23 @@ PeerAnswer fcl_collide(const Shape& a, const Pose& pa, const Shape& b, const Pos
 PeerAnswer fcl_distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, FclSolver solver,
                         double tolerance);
 
-}  // namespace batchcol::crosscheck
+/// FCL geometries built once per shape of a table, so that timing loops measure the queries and not the geometry
+/// construction of fcl_collide / fcl_distance (which build both geometries on every call). Same answers as those
+/// functions; the queries are const and may run concurrently (FCL only reads the geometries).
+class FclShapeCache {
+ public:
+  explicit FclShapeCache(const ShapeTable& shapes);
+  ~FclShapeCache();
+  FclShapeCache(const FclShapeCache&) = delete;
+  FclShapeCache& operator=(const FclShapeCache&) = delete;
+
+  PeerAnswer collide(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb, FclSolver solver) const;
+  PeerAnswer distance(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb, FclSolver solver,
+                      double tolerance) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace batchcol::peers

@@ -6,7 +6,7 @@
 
 #include <limits>
 
-namespace batchcol::crosscheck {
+namespace batchcol::peers {
 
 struct PeerAnswer {
   bool ok = false;       // the peer handled the pair (false: unsupported pair, failure or exception)
@@ -16,4 +16,4 @@ struct PeerAnswer {
   Eigen::Vector3d point_b = point_a;
 };
 
-}  // namespace batchcol::crosscheck
+}  // namespace batchcol::peers

@@ -1,0 +1,141 @@
+// Runs `batchcol bench` (the built binary): JSON output and its fields, the close regime's reference distances
+// (re-checked through the public API on the pairs the bench saves), and the exit codes of refused flags.
+#include "batchcol/batchcol.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class BenchCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+#ifndef BATCHCOL_CLI_PATH
+    GTEST_SKIP() << "the batchcol CLI is not built (BATCHCOL_BUILD_TOOLS=OFF)";
+#endif
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(::testing::TempDir()) / ("batchcol_bench_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    if (!dir_.empty()) fs::remove_all(dir_, ec);
+  }
+
+  RunResult run(const std::string& args) const {
+#ifdef BATCHCOL_CLI_PATH
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command =
+        "'" + std::string(BATCHCOL_CLI_PATH) + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = read_text(out);
+    result.err = read_text(err);
+    return result;
+#else
+    (void)args;
+    return {};
+#endif
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(BenchCli, JsonHasTheDocumentedFields) {
+  const RunResult r = run("bench --case sphere-sphere --regime close --pairs 2000 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);  // throws (fails the test) on invalid JSON
+  ASSERT_TRUE(j.is_object()) << r.out;
+  for (const char* key : {"case", "regime", "query", "precision", "solver", "threads", "pairs", "kernel",
+                          "pairs_per_second", "ns_per_pair", "error_median", "error_max", "peers"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["case"], "sphere-sphere");
+  EXPECT_EQ(j["regime"], "close");
+  EXPECT_EQ(j["kernel"], "scalar");
+  EXPECT_EQ(j["pairs"], 2000);
+  EXPECT_GT(j["pairs_per_second"].get<double>(), 0.0);
+  EXPECT_GT(j["ns_per_pair"].get<double>(), 0.0);
+  EXPECT_LE(j["error_max"].get<double>(), 1e-6);
+  ASSERT_TRUE(j["peers"].is_array());
+  for (const auto& peer : j["peers"]) {
+    for (const char* key : {"name", "ns_per_pair", "error_max", "ratio"}) EXPECT_TRUE(peer.contains(key)) << key;
+  }
+}
+
+TEST_F(BenchCli, TextOutputNamesTheScalarKernel) {
+  const RunResult r = run("bench --case box-cone --regime overlap --query penetration --pairs 200 --no-peers");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("kernel: scalar reference"), std::string::npos) << r.out;
+}
+
+// The close regime puts every pair at a reference distance in [1e-4, 1e-2] m; checked here independently of the
+// bench's own numbers, on the batch file it saves, with closed forms on (the bench's reference has them off).
+TEST_F(BenchCli, ClosePairsHaveReferenceDistancesInRange) {
+  for (const std::string c : {"sphere-sphere", "box-convex8", "cylinder-ellipsoid"}) {
+    const fs::path saved = dir_ / (c + ".json");
+    const RunResult r = run("bench --case " + c + " --regime close --pairs 300 --no-peers --json --save-pairs '" +
+                            saved.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const batchcol::BatchFile batch = batchcol::load_batch_file(saved.string());
+    ASSERT_EQ(batch.pairs.size(), 300u);
+    batchcol::QueryOptions o;
+    o.level = batchcol::QueryLevel::penetration;
+    o.solver = batchcol::Solver::gjk;
+    o.tolerance = 1e-12;
+    o.max_iterations = 1000;
+    batchcol::PairResults res;
+    batchcol::collide(batch.shapes, batch.pairs, o, res);
+    for (std::size_t i = 0; i < res.size(); ++i) {
+      EXPECT_GE(res.distance[i], 1e-4 * (1 - 1e-6)) << c << " pair " << i;
+      EXPECT_LE(res.distance[i], 1e-2 * (1 + 1e-6)) << c << " pair " << i;
+    }
+  }
+}
+
+TEST_F(BenchCli, SimdIsasAreRefused) {
+  for (const char* isa : {"avx2", "avx512"}) {
+    const RunResult r = run(std::string("bench --case sphere-sphere --pairs 10 --isa ") + isa);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err.rfind("batchcol: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("not implemented yet (issue 3)"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+TEST_F(BenchCli, BadFlagsExitWith2) {
+  for (const char* args : {"bench --case sphere-torus", "bench --case sphere", "bench --regime near",
+                           "bench --pairs 0", "bench --query everything"}) {
+    const RunResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(r.err.rfind("batchcol: error: ", 0), 0u) << args << ": " << r.err;
+  }
+}
+
+}  // namespace

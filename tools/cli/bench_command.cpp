@@ -1,0 +1,237 @@
+// `batchcol bench`: times collide() on generated pairs of one shape-type pair per case, in one distance regime,
+// reports throughput and the error against the double-precision reference, and times FCL and Bullet (when found at
+// configure time) on the same pairs and thread count. Only the scalar reference kernels exist so far: --isa avx2 /
+// avx512 are refused (issue 3).
+#include "cli/atomic_output.hpp"
+#include "cli/bench_pairs.hpp"
+#include "cli/bench_peers.hpp"
+#include "cli/commands.hpp"
+
+#include <batchcol/batch.hpp>
+#include <batchcol/io.hpp>
+
+#include <nlohmann/json.hpp>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace batchcol::cli {
+namespace {
+
+struct BenchSettings {
+  std::string cases = "all", regime = "close", query = "witness", precision = "double", solver = "nesterov";
+  std::string isa = "scalar", save_pairs;
+  int threads = 0, runs = 5;
+  std::size_t pairs = 100000;
+  std::uint64_t seed = 20240603;
+  bool json = false, no_peers = false;
+};
+
+struct CaseResult {
+  BenchCase bench_case;
+  double ns_per_pair = 0, pairs_per_second = 0;
+  double error_median = 0, error_max = 0;
+  std::size_t error_pairs = 0, disagreements = 0;
+  double reference_min = 0, reference_max = 0;
+  std::string note;
+  PeerReport peers;
+};
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void save_pairs(const BenchPairs& p, const std::string& path) {
+  using nlohmann::json;
+  json shapes = json::array(), pairs = json::array();
+  const auto vec = [](const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); };
+  for (const Shape& s : p.shapes.shapes()) {
+    json j = {{"type", to_string(s.type)}};
+    switch (s.type) {
+      case ShapeType::sphere: j["radius"] = s.size.x(); break;
+      case ShapeType::capsule:
+      case ShapeType::cylinder:
+      case ShapeType::cone: j["radius"] = s.size.x(); j["half_length"] = s.size.y(); break;
+      case ShapeType::box: j["half_extents"] = vec(s.size); break;
+      case ShapeType::ellipsoid: j["radii"] = vec(s.size); break;
+      default: {
+        json v = json::array();
+        for (const auto& x : s.hull->vertices) v.push_back(vec(x));
+        j["vertices"] = v;
+      }
+    }
+    shapes.push_back(j);
+  }
+  for (std::size_t i = 0; i < p.pairs.size(); ++i) {
+    const auto pose = [&](const Pose& q) {
+      return json{{"translation", vec(q.translation)},
+                  {"quaternion", json::array({q.rotation.w(), q.rotation.x(), q.rotation.y(), q.rotation.z()})}};
+    };
+    pairs.push_back({{"a", p.pairs.shape_a[i]}, {"pose_a", pose(p.pairs.pose_a(i))}, {"b", p.pairs.shape_b[i]},
+                     {"pose_b", pose(p.pairs.pose_b(i))}});
+  }
+  write_file_atomically(path, [&](std::ostream& out) { out << json{{"shapes", shapes}, {"pairs", pairs}}.dump(1) << '\n'; });
+}
+
+CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const BenchSettings& s,
+                    const QueryOptions& options, Regime regime, int threads) {
+  CaseResult out;
+  out.bench_case = bench_case;
+  const BenchPairs p = make_bench_pairs(bench_case, regime, s.pairs, s.seed + 7919 * case_index, threads);
+  if (!s.save_pairs.empty()) save_pairs(p, s.save_pairs);
+  out.reference_min = *std::min_element(p.reference.begin(), p.reference.end());
+  out.reference_max = *std::max_element(p.reference.begin(), p.reference.end());
+
+  PairResults results;
+  collide(p.shapes, p.pairs, options, results);  // warm-up: page faults, TBB thread start
+  std::vector<double> seconds;
+  for (int run = 0; run < s.runs; ++run) {
+    const auto start = std::chrono::steady_clock::now();
+    collide(p.shapes, p.pairs, options, results);
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  const double median = median_of(seconds);
+  const double n = double(p.pairs.size());
+  out.ns_per_pair = median * 1e9 / n;
+  out.pairs_per_second = median > 0 ? n / median : 0.0;
+
+  std::vector<double> errors;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    out.disagreements += (results.collide[i] != 0) != (p.reference[i] <= options.margin) ? 1 : 0;
+    if (options.level != QueryLevel::boolean && std::isfinite(results.distance[i])) {
+      errors.push_back(std::abs(results.distance[i] - p.reference[i]));
+    }
+  }
+  out.error_pairs = errors.size();
+  out.error_median = median_of(errors);
+  out.error_max = errors.empty() ? 0.0 : *std::max_element(errors.begin(), errors.end());
+  if (options.level == QueryLevel::boolean) {
+    out.note = "boolean query computes no distance: error fields are 0, see collide_disagreements";
+  } else if (errors.empty()) {
+    out.note = "no pair has a distance at this query level (overlapping pairs need --query penetration): "
+               "error fields are 0";
+  }
+  if (!s.no_peers) out.peers = time_peers(bench_case, p, options.level, threads, s.runs);
+  return out;
+}
+
+nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryOptions& o, Regime regime, int threads) {
+  nlohmann::json peers = nlohmann::json::array();
+  for (const PeerTiming& t : r.peers.timings) {
+    peers.push_back({{"name", t.name}, {"query", t.query}, {"ns_per_pair", t.ns_per_pair},
+                     {"error_max", t.error_max}, {"ratio", r.ns_per_pair > 0 ? t.ns_per_pair / r.ns_per_pair : 0.0},
+                     {"pairs_answered", t.handled}, {"collide_disagreements", t.disagreements}});
+  }
+  nlohmann::json j = {{"case", r.bench_case.name()}, {"regime", to_string(regime)}, {"query", to_string(o.level)},
+                      {"precision", s.precision}, {"solver", to_string(o.solver)}, {"threads", threads},
+                      {"pairs", s.pairs}, {"kernel", "scalar"}, {"pairs_per_second", r.pairs_per_second},
+                      {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
+                      {"error_pairs", r.error_pairs}, {"collide_disagreements", r.disagreements},
+                      {"reference_min", r.reference_min}, {"reference_max", r.reference_max},
+                      {"timed_runs", s.runs}, {"peers", peers}, {"peers_missing", r.peers.notes}};
+  if (!r.note.empty()) j["note"] = r.note;
+  return j;
+}
+
+void print_table(const std::vector<CaseResult>& results, const BenchSettings& s, const QueryOptions& o, Regime regime,
+                 int threads) {
+  std::printf("kernel: scalar reference (SIMD kernels not implemented yet, issue 3)\n");
+  std::printf("regime %s, query %s, precision %s, solver %s, threads %d, pairs %zu, median of %d runs after 1 warm-up\n",
+              to_string(regime), to_string(o.level), s.precision.c_str(), to_string(o.solver), threads, s.pairs, s.runs);
+  std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
+  const bool boolean = o.level == QueryLevel::boolean;
+  std::printf("%-22s %10s %11s %10s %10s", "case", "ns/pair", "pairs/s", boolean ? "disagree" : "err_med",
+              boolean ? "" : "err_max");
+  std::printf("   %-s\n", "peers: name ns/pair ratio err_max|disagree");
+  for (const CaseResult& r : results) {
+    std::printf("%-22s %10.1f %11.4g ", r.bench_case.name().c_str(), r.ns_per_pair, r.pairs_per_second);
+    if (boolean) std::printf("%10zu %10s", r.disagreements, "");
+    else std::printf("%10.2e %10.2e", r.error_median, r.error_max);
+    for (const PeerTiming& t : r.peers.timings) {
+      std::printf("   %s %.1f %.2fx ", t.name.c_str(), t.ns_per_pair, r.ns_per_pair > 0 ? t.ns_per_pair / r.ns_per_pair : 0.0);
+      if (boolean) std::printf("%zu", t.disagreements);
+      else std::printf("%.2e", t.error_max);
+    }
+    std::printf("\n");
+  }
+  std::vector<std::string> notes;
+  for (const CaseResult& r : results) {
+    if (!r.note.empty()) notes.push_back(r.note);
+    notes.insert(notes.end(), r.peers.notes.begin(), r.peers.notes.end());
+  }
+  std::sort(notes.begin(), notes.end());
+  notes.erase(std::unique(notes.begin(), notes.end()), notes.end());
+  for (const std::string& n : notes) std::printf("note: %s\n", n.c_str());
+}
+
+int run_bench(const BenchSettings& s) {
+  if (s.isa == "avx2" || s.isa == "avx512") {
+    throw InputError("--isa " + s.isa + ": not implemented yet (issue 3); only --isa scalar is available");
+  }
+  if (s.isa != "scalar") throw InputError("--isa " + s.isa + ": unknown instruction set (valid: scalar, avx2, avx512)");
+  const std::vector<BenchCase> cases = parse_bench_cases(s.cases);
+  const Regime regime = parse_regime(s.regime);
+  if (!s.save_pairs.empty() && cases.size() != 1) throw InputError("--save-pairs needs a single --case");
+  QueryOptions options;
+  options.level = parse_query_level(s.query);
+  options.precision = parse_precision(s.precision);
+  options.solver = parse_solver(s.solver);
+  options.threads = s.threads;
+  validate(options);
+  const int threads = s.threads > 0 ? s.threads : tbb::info::default_concurrency();
+
+  std::vector<CaseResult> results;
+  for (std::size_t i = 0; i < cases.size(); ++i) results.push_back(run_case(cases[i], i, s, options, regime, threads));
+
+  if (s.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const CaseResult& r : results) out.push_back(to_json(r, s, options, regime, threads));
+    std::cout << (s.cases == "all" ? out : out[0]).dump(2) << '\n';
+  } else {
+    print_table(results, s, options, regime, threads);
+  }
+  std::cout.flush();
+  if (!std::cout) throw InputError("writing to standard output failed");
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench_command(CLI::App& parent) {
+  auto s = std::make_shared<BenchSettings>();
+  CLI::App* app = parent.add_subcommand(
+      "bench", "Time collide() per shape-type pair and distance regime against the double reference and FCL/Bullet");
+  app->add_option("--case", s->cases, "TYPE-TYPE (sphere, capsule, box, cylinder, cone, ellipsoid, convex8, "
+                                      "convex250, convex940) or all")
+      ->capture_default_str();
+  app->add_option("--regime", s->regime, "distant (0.1-1 m), close (1e-4-1e-2 m) or overlap (depth 1e-4-1e-2 m)")
+      ->capture_default_str();
+  app->add_option("--query", s->query, "boolean, distance, witness or penetration")->capture_default_str();
+  app->add_option("--precision", s->precision, "double or float")->capture_default_str();
+  app->add_option("--solver", s->solver, "gjk, nesterov or polyak")->capture_default_str();
+  app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
+      ->capture_default_str();
+  app->add_option("--pairs", s->pairs, "Pairs per case")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))
+      ->capture_default_str();
+  app->add_option("--runs", s->runs, "Timed runs (the median is reported)")->check(CLI::Range(5, 1000))->capture_default_str();
+  app->add_option("--isa", s->isa, "scalar (avx2, avx512: not implemented yet, issue 3)")->capture_default_str();
+  app->add_option("--seed", s->seed, "Seed of the pair generator")->capture_default_str();
+  app->add_option("--save-pairs", s->save_pairs, "Write the generated pairs as a batch file (single --case)");
+  app->add_flag("--no-peers", s->no_peers, "Do not time FCL and Bullet");
+  app->add_flag("--json", s->json, "Print JSON (one object, an array for --case all)");
+  return {app, [s] { return run_bench(*s); }};
+}
+
+}  // namespace batchcol::cli

@@ -1,0 +1,99 @@
+#include "cli/bench_peers.hpp"
+
+#ifdef BATCHCOL_HAVE_FCL
+#include <peers/fcl_adapter.hpp>
+#endif
+#ifdef BATCHCOL_HAVE_BULLET
+#include <peers/bullet_adapter.hpp>
+#endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+namespace batchcol::cli {
+namespace {
+
+using PeerQuery = std::function<peers::PeerAnswer(std::size_t pair)>;
+
+PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p, int threads, int timed_runs,
+                     const PeerQuery& query) {
+  const std::size_t n = p.pairs.size();
+  std::vector<peers::PeerAnswer> answers(n);
+  tbb::task_arena arena(threads);
+  const auto run = [&] {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) answers[i] = query(i);
+      });
+    });
+  };
+  run();  // warm-up
+  std::vector<double> seconds;
+  for (int k = 0; k < timed_runs; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    run();
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::sort(seconds.begin(), seconds.end());
+
+  PeerTiming t;
+  t.name = name;
+  t.query = boolean ? "collide" : "distance";
+  t.ns_per_pair = seconds[seconds.size() / 2] * 1e9 / double(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const peers::PeerAnswer& a = answers[i];
+    if (!a.ok) continue;
+    ++t.handled;
+    if (boolean) {
+      t.disagreements += a.collide != (p.reference[i] <= 0.0) ? 1 : 0;
+    } else if (std::isfinite(a.distance)) {
+      t.error_max = std::max(t.error_max, std::abs(a.distance - p.reference[i]));
+    }
+  }
+  return t;
+}
+
+}  // namespace
+
+PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLevel level, int threads,
+                      int timed_runs) {
+  PeerReport report;
+  const bool boolean = level == QueryLevel::boolean;
+  const PairBatch& b = p.pairs;
+#ifdef BATCHCOL_HAVE_FCL
+  {
+    const peers::FclShapeCache fcl(p.shapes);
+    constexpr double kFclTolerance = 1e-8;  // batchcol's default tolerance (QueryOptions::tolerance)
+    report.timings.push_back(time_peer("FCL", boolean, p, threads, timed_runs, [&](std::size_t i) {
+      return boolean ? fcl.collide(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), peers::FclSolver::libccd)
+                     : fcl.distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), peers::FclSolver::libccd,
+                                    kFclTolerance);
+    }));
+  }
+#else
+  report.notes.push_back("FCL not installed (apt-get install libfcl-dev)");
+#endif
+#ifdef BATCHCOL_HAVE_BULLET
+  if (!peers::bullet_supports(bench_case.a.type) || !peers::bullet_supports(bench_case.b.type)) {
+    report.notes.push_back("Bullet: no " + bench_case.name() + " pair (Bullet has no ellipsoid shape)");
+  } else {
+    const peers::BulletShapeCache bullet(p.shapes);
+    report.timings.push_back(time_peer("Bullet", boolean, p, threads, timed_runs, [&](std::size_t i) {
+      return bullet.signed_distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i));
+    }));
+    if (boolean) report.timings.back().query = "signed distance (no boolean GJK in btGjkEpaSolver2)";
+  }
+#else
+  (void)bench_case;
+  report.notes.push_back("Bullet not installed (apt-get install libbullet-dev)");
+#endif
+  return report;
+}
+
+}  // namespace batchcol::cli

@@ -1,0 +1,33 @@
+// Peer timings of `batchcol bench`: FCL and Bullet (when found at configure time) on the same pairs, with
+// tbb::parallel_for in a task_arena of the same thread count, one warm-up and the median of the timed runs.
+#pragma once
+
+#include "cli/bench_pairs.hpp"
+
+#include <batchcol/batch.hpp>
+
+#include <string>
+#include <vector>
+
+namespace batchcol::cli {
+
+struct PeerTiming {
+  std::string name;              // "FCL" or "Bullet"
+  std::string query;             // what the peer ran: "collide" or "distance"
+  double ns_per_pair = 0;        // median run time / pairs
+  std::size_t handled = 0;       // pairs the peer answered (ok)
+  double error_max = 0;          // max |signed distance - reference| over handled pairs (distance queries)
+  std::size_t disagreements = 0; // boolean queries: collide != (reference <= 0)
+};
+
+struct PeerReport {
+  std::vector<PeerTiming> timings;
+  std::vector<std::string> notes;  // missing or unsupported peers
+};
+
+/// Boolean queries run the peers' collide, every other level their (signed) distance. Geometries are built once
+/// before timing (peers::FclShapeCache, peers::BulletShapeCache).
+PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& pairs, QueryLevel level, int threads,
+                      int timed_runs);
+
+}  // namespace batchcol::cli

@@ -1,0 +1,17 @@
+#include "peers/peers.hpp"
+
+namespace batchcol::peers {
+
+#ifdef BATCHCOL_HAVE_FCL
+bool have_fcl() { return true; }
+#else
+bool have_fcl() { return false; }
+#endif
+
+#ifdef BATCHCOL_HAVE_BULLET
+bool have_bullet() { return true; }
+#else
+bool have_bullet() { return false; }
+#endif
+
+}  // namespace batchcol::peers
