@@ -3,6 +3,8 @@
 #include "batchcol/batchcol.hpp"
 
 #include <gtest/gtest.h>
+
+#include "tools/cli_runner.hpp"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -19,53 +21,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
+using batchcol::testing::read_text;
+using batchcol::testing::RunResult;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-class BenchCli : public ::testing::Test {
- protected:
-  void SetUp() override {
-#ifndef BATCHCOL_CLI_PATH
-    GTEST_SKIP() << "the batchcol CLI is not built (BATCHCOL_BUILD_TOOLS=OFF)";
-#endif
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(::testing::TempDir()) / ("batchcol_bench_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    if (!dir_.empty()) fs::remove_all(dir_, ec);
-  }
-
-  RunResult run(const std::string& args) const {
-#ifdef BATCHCOL_CLI_PATH
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command =
-        "'" + std::string(BATCHCOL_CLI_PATH) + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    result.out = read_text(out);
-    result.err = read_text(err);
-    return result;
-#else
-    (void)args;
-    return {};
-#endif
-  }
-
-  fs::path dir_;
-};
+class BenchCli : public batchcol::testing::CliTest {};
 
 TEST_F(BenchCli, JsonHasTheDocumentedFields) {
   const RunResult r = run("bench --case sphere-sphere --regime close --pairs 2000 --json");

@@ -1,4 +1,5 @@
 #include "cli/bench_pairs.hpp"
+#include "cli/portable_random.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,30 +10,7 @@
 namespace batchcol::cli {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// std::uniform_real_distribution differs between standard libraries; raw mt19937_64 bits keep the pairs identical
-// everywhere.
-class Random {
- public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  std::size_t index(std::size_t n) { return std::min(n - 1, static_cast<std::size_t>(uniform() * double(n))); }
-  Eigen::Vector3d unit_vector() {
-    const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * kPi), s = std::sqrt(1.0 - z * z);
-    return {s * std::cos(phi), s * std::sin(phi), z};
-  }
-  // Uniformly distributed rotation (Shoemake 1992).
-  Eigen::Quaterniond rotation() {
-    const double u1 = uniform(), a = 2.0 * kPi * uniform(), b = 2.0 * kPi * uniform();
-    const double s = std::sqrt(1.0 - u1), t = std::sqrt(u1);
-    return Eigen::Quaterniond(t * std::cos(b), s * std::sin(a), s * std::cos(a), t * std::sin(b)).normalized();
-  }
-
- private:
-  std::mt19937_64 engine_;
-};
+using Random = PortableRandom;
 
 const std::vector<BenchShapeKind>& primitive_kinds() {
   static const std::vector<BenchShapeKind> kinds = {
