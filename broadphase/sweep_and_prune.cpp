@@ -4,14 +4,16 @@
 // whose min lies in [min, max] on that axis and test the two other axes; "multi box pruning" for splitting the world
 // into regions swept separately; P. Terdiman, "Radix sort revisited" (2000) for sorting float keys as integers.
 //
-// Pipeline (each stage is split into a fixed number of chunks, never into "one per thread", so every stage computes
-// the same thing for any thread count):
-//   1. keys: (sortable min on the sweep axis << 32 | object id), radix-sorted (rebuild) or the previous frame's order
-//      re-keyed and insertion-sorted (update); equal keys are ordered by id in both cases, so both orders are equal;
-//   2. bucketing: a stable counting sort of that order into the grid cells each box spans (see sap_grid.hpp), which
-//      leaves every cell's entries sorted by min on the sweep axis;
-//   3. sweep: box pruning inside each cell, groups of cells in parallel, each group appending to its own buffer;
-//      a pair is kept only in the cell holding the lower corner of its overlap on the grid axes (so exactly once);
+// Pipeline (each stage is split into a fixed number of chunks or cell groups, never into "one per thread", so every
+// stage computes the same thing for any thread count):
+//   1. grid: chosen by rebuild() (see sap_grid.hpp), kept by update() unless the object count changed or the scene
+//      drifted (entries or fullest cell grew past kDrift* of the rebuild's);
+//   2. bucketing, in INPUT order: a counting pass and a scatter pass read the box arrays linearly and write one
+//      32-byte record per cell a box spans (no random reads of the inputs); inside a cell, records are in id order;
+//   3. per cell, in parallel over fixed groups of cells: sort the records by (min on the sweep axis, id) (insertion
+//      sort for small cells, an LSD radix sort on the float key for larger ones; the cell fits in cache), then box
+//      pruning; a pair is kept only in the cell holding the lower corner of its overlap on the grid axes (so
+//      exactly once); each group appends to its own buffer;
 //   4. emit: the group buffers concatenated and radix-sorted as (a << 32 | b): unique keys, one sorted answer.
 #include "broadphase/sweep_and_prune.hpp"
 
@@ -21,6 +23,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <utility>
 
 namespace batchcol::broadphase {
@@ -30,23 +34,16 @@ namespace {
 // most kMaxBucketChunks (the counters are chunks x cells words).
 constexpr std::size_t kBucketChunkMin = 16384;
 constexpr std::size_t kMaxBucketChunks = 16;
-// Groups of cells swept as parallel tasks, balanced by entry count; enough for load balance on a few cores.
+// Groups of cells sorted and swept as parallel tasks, balanced by entry count; enough for load balance on a few cores.
 constexpr std::size_t kSweepGroups = 64;
-// Incremental re-sort: chunks insertion-sorted in parallel, then their boundaries merged sequentially.
-constexpr std::size_t kSortChunk = 32768;
-// Beyond a few moves per object, insertion sort costs more than the 4 radix passes (each reads and scatters every
-// word): give up and radix-sort. "Moves" are inversions repaired, counted exactly. Objects moving by a tenth of their
-// size in a dense scene already cross several neighbours' keys, hence a budget above 1.
-constexpr std::size_t kMovesPerObject = 4;
-// Objects visited in sorted order are scattered in memory: prefetch this many iterations ahead to overlap the misses.
-constexpr std::size_t kPrefetchDistance = 16;
+// Cells up to this size are insertion-sorted; larger ones radix-sorted.
+constexpr std::size_t kInsertionSortMax = 48;
+// update() chooses a new grid when the entries exceed kDriftEntries x (or the fullest cell kDriftMaxCell x) those of
+// the call that chose the current grid, plus some slack for small scenes.
+constexpr double kDriftEntries = 1.25;
+constexpr double kDriftMaxCell = 2.0;
 // Big boxes straddling many cells: when the copies exceed this many per object, coarsen the grid (x 1/2 per axis).
 constexpr std::size_t kMaxCopiesPerObject = 4;
-
-std::uint64_t pack_range(int cu0, int cu1, int cv0, int cv1) {
-  return static_cast<std::uint64_t>(cu0) | static_cast<std::uint64_t>(cu1) << 16 |
-         static_cast<std::uint64_t>(cv0) << 32 | static_cast<std::uint64_t>(cv1) << 48;
-}
 
 struct Chunks {
   std::size_t count, size;
@@ -75,9 +72,8 @@ void SweepAndPrune::update(const AabbSoa& boxes, const FilterSoa& filter, std::v
 void SweepAndPrune::clear() { *this = SweepAndPrune(); }
 
 std::size_t SweepAndPrune::memory_bytes() const {
-  std::size_t bytes = order_.capacity() * 4 + words_.capacity() * 8 + scratch_.capacity() * 8 +
-                      counts_.capacity() * 4 + cell_start_.capacity() * 4 + id_.capacity() * 4;
-  for (const auto* v : {&x0_, &x1_, &u0_, &u1_, &v0_, &v1_}) bytes += v->capacity() * 4;
+  std::size_t bytes = words_.capacity() * 8 + scratch_.capacity() * 8 + counts_.capacity() * 4 +
+                      cell_start_.capacity() * 4 + entries_.capacity() * sizeof(Entry);
   for (const auto& g : group_pairs_) bytes += g.capacity() * 8;
   return bytes;
 }
@@ -87,20 +83,21 @@ void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vect
   validate_aabbs(boxes);
   const std::size_t n = boxes.size();
   validate_filter(filter, n);
-  incremental = incremental && have_order_ && order_.size() == n;
-  if (!incremental) grid_ = choose_grid(boxes);
+  incremental = incremental && have_order_ && object_count_ == n;
   stats_ = SapStats{};
-  words_.resize(n);
-  scratch_.resize(n);
-  order_.resize(n);
-  const float* key = boxes.min(grid_.axis);
-  stats_.incremental = incremental && sort_incremental(key);
-  if (!stats_.incremental) sort_full(key);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k < r.end(); ++k) order_[k] = static_cast<std::uint32_t>(words_[k]);
-  });
-  have_order_ = true;
+  if (!incremental) grid_ = choose_grid(boxes);
   std::size_t entries = count_entries(boxes);
+  const auto grew = [](std::size_t now, std::size_t then, double factor, double slack) {
+    return static_cast<double>(now) > factor * static_cast<double>(then) + slack;
+  };
+  if (incremental && (grew(entries, rebuild_entries_, kDriftEntries, 1024) ||
+                      grew(stats_.max_cell, rebuild_max_cell_, kDriftMaxCell, 64))) {
+    incremental = false;
+    grid_ = choose_grid(boxes);
+    entries = count_entries(boxes);
+  }
+  object_count_ = n;
+  have_order_ = true;
   while (entries > kMaxCopiesPerObject * n + 1024 && grid_.cell_count() > 1) {
     grid_ = coarser(grid_);
     entries = count_entries(boxes);
@@ -109,78 +106,16 @@ void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vect
   stats_.cells_u = grid_.cells_u;
   stats_.cells_v = grid_.cells_v;
   stats_.entries = entries;
+  stats_.incremental = incremental;
+  if (!incremental) rebuild_entries_ = entries, rebuild_max_cell_ = stats_.max_cell;
   bucket(boxes);
-  sweep(filter);
+  sort_and_sweep(filter);
   emit(pairs);
   stats_.pairs = pairs.size();
 }
 
-void SweepAndPrune::sort_full(const float* key) {
-  const std::size_t n = order_.size();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i < r.end(); ++i)
-      words_[i] = static_cast<std::uint64_t>(sortable_key(key[i])) << 32 | i;
-  });
-  radix_sort(words_.data(), scratch_.data(), n, digit_shifts(32, 64));
-}
-
-bool SweepAndPrune::sort_incremental(const float* key) {
-  const std::size_t n = order_.size();
-  const std::size_t chunks = (n + kSortChunk - 1) / kSortChunk;
-  std::vector<std::size_t> moves(chunks, 0);
-  std::vector<char> ok(chunks, 1);
-  std::uint64_t* w = words_.data();
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    const std::size_t s = c * kSortChunk, e = std::min(n, s + kSortChunk);
-    const std::size_t budget = (e - s) * kMovesPerObject;
-    for (std::size_t k = s; k < e; ++k) {
-      const std::uint32_t id = order_[k];
-      w[k] = static_cast<std::uint64_t>(sortable_key(key[id])) << 32 | id;
-    }
-    std::size_t m = 0;
-    for (std::size_t j = s + 1; j < e; ++j) {
-      const std::uint64_t x = w[j];
-      if (x >= w[j - 1]) continue;
-      std::size_t i = j;
-      do {
-        w[i] = w[i - 1];
-        --i;
-      } while (i > s && w[i - 1] > x);
-      w[i] = x;
-      m += j - i;
-      if (m > budget) { ok[c] = 0; return; }
-    }
-    moves[c] = m;
-  });
-  std::size_t total = 0;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    if (!ok[c]) return false;
-    total += moves[c];
-  }
-  // Merge the chunk boundaries: with [0, s) sorted and chunk c sorted, insert chunk c's elements backwards until one
-  // is already >= its predecessor; the rest of the chunk is then >= everything before it.
-  const std::size_t budget = n * kMovesPerObject;
-  for (std::size_t c = 1; c < chunks; ++c) {
-    const std::size_t s = c * kSortChunk, e = std::min(n, s + kSortChunk);
-    for (std::size_t j = s; j < e; ++j) {
-      const std::uint64_t x = w[j];
-      if (x >= w[j - 1]) break;
-      std::size_t i = j;
-      do {
-        w[i] = w[i - 1];
-        --i;
-      } while (i > 0 && w[i - 1] > x);
-      w[i] = x;
-      total += j - i;
-      if (total > budget) return false;
-    }
-  }
-  stats_.sort_moves = total;
-  return true;
-}
-
 std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
-  const std::size_t n = order_.size(), cells = grid_.cell_count();
+  const std::size_t n = boxes.size(), cells = grid_.cell_count();
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
   counts_.assign(ch.count * cells, 0);
   std::vector<std::size_t> chunk_entries(ch.count, 0);
@@ -190,15 +125,8 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
     std::uint32_t* count = counts_.data() + c * cells;
     std::size_t total = 0;
     const std::size_t end = ch.end(c, n);
-    for (std::size_t k = ch.begin(c, n); k < end; ++k) {
-      if (k + kPrefetchDistance < end) {
-        const std::uint32_t ahead = order_[k + kPrefetchDistance];
-        __builtin_prefetch(lu + ahead), __builtin_prefetch(hu + ahead);
-        __builtin_prefetch(lv + ahead), __builtin_prefetch(hv + ahead);
-      }
-      const std::uint32_t id = order_[k];
-      const int cu0 = g.cell_u(lu[id]), cu1 = g.cell_u(hu[id]), cv0 = g.cell_v(lv[id]), cv1 = g.cell_v(hv[id]);
-      scratch_[k] = pack_range(cu0, cu1, cv0, cv1);
+    for (std::size_t i = ch.begin(c, n); i < end; ++i) {
+      const int cu0 = g.cell_u(lu[i]), cu1 = g.cell_u(hu[i]), cv0 = g.cell_v(lv[i]), cv1 = g.cell_v(hv[i]);
       for (int cv = cv0; cv <= cv1; ++cv)
         for (int cu = cu0; cu <= cu1; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
       total += static_cast<std::size_t>(cu1 - cu0 + 1) * static_cast<std::size_t>(cv1 - cv0 + 1);
@@ -207,14 +135,21 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
   });
   std::size_t entries = 0;
   for (std::size_t e : chunk_entries) entries += e;
+  std::size_t max_cell = 0;
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    std::size_t total = 0;
+    for (std::size_t c = 0; c < ch.count; ++c) total += counts_[c * cells + cell];
+    max_cell = std::max(max_cell, total);
+  }
+  stats_.max_cell = max_cell;
   return entries;
 }
 
 void SweepAndPrune::bucket(const AabbSoa& boxes) {
-  const std::size_t n = order_.size(), cells = grid_.cell_count();
+  const std::size_t n = boxes.size(), cells = grid_.cell_count();
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
-  // Exclusive scan in (cell, chunk) order: chunk c's entries of a cell follow those of chunks < c, which keeps each
-  // cell sorted by key (a stable counting sort).
+  // Exclusive scan in (cell, chunk) order: chunk c's entries of a cell follow those of chunks < c, so every cell
+  // holds its records in increasing id order.
   cell_start_.resize(cells + 1);
   std::uint32_t running = 0;
   for (std::size_t cell = 0; cell < cells; ++cell) {
@@ -226,35 +161,24 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
     }
   }
   cell_start_[cells] = running;
-  const std::size_t entries = running;
-  for (auto* v : {&x0_, &x1_, &u0_, &u1_, &v0_, &v1_}) v->resize(entries);
-  id_.resize(entries);
+  entries_.resize(running);
+  Entry* out = entries_.data();
   const float *lx = boxes.min(grid_.axis), *hx = boxes.max(grid_.axis);
   const float *lu = boxes.min(grid_.u), *hu = boxes.max(grid_.u), *lv = boxes.min(grid_.v), *hv = boxes.max(grid_.v);
-  const int cells_u = grid_.cells_u;
+  const SapGrid g = grid_;
   tbb::parallel_for(std::size_t{0}, ch.count, [&](std::size_t c) {
     std::uint32_t* offset = counts_.data() + c * cells;
     const std::size_t end = ch.end(c, n);
-    for (std::size_t k = ch.begin(c, n); k < end; ++k) {
-      if (k + kPrefetchDistance < end) {
-        const std::uint32_t ahead = order_[k + kPrefetchDistance];
-        __builtin_prefetch(lx + ahead), __builtin_prefetch(hx + ahead), __builtin_prefetch(lu + ahead);
-        __builtin_prefetch(hu + ahead), __builtin_prefetch(lv + ahead), __builtin_prefetch(hv + ahead);
-      }
-      const std::uint32_t id = order_[k];
-      const std::uint64_t r = scratch_[k];
-      const int cu0 = r & 0xffff, cu1 = (r >> 16) & 0xffff, cv0 = (r >> 32) & 0xffff, cv1 = (r >> 48) & 0xffff;
-      const float a = lx[id], b = hx[id], d = lu[id], e = hu[id], f = lv[id], h = hv[id];
+    for (std::size_t i = ch.begin(c, n); i < end; ++i) {
+      const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i), sortable_key(lx[i])};
+      const int cu0 = g.cell_u(e.u0), cu1 = g.cell_u(e.u1), cv0 = g.cell_v(e.v0), cv1 = g.cell_v(e.v1);
       for (int cv = cv0; cv <= cv1; ++cv)
-        for (int cu = cu0; cu <= cu1; ++cu) {
-          const std::uint32_t p = offset[static_cast<std::size_t>(cv) * cells_u + cu]++;
-          x0_[p] = a, x1_[p] = b, u0_[p] = d, u1_[p] = e, v0_[p] = f, v1_[p] = h, id_[p] = id;
-        }
+        for (int cu = cu0; cu <= cu1; ++cu) out[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
     }
   });
 }
 
-void SweepAndPrune::sweep(const FilterSoa& filter) {
+void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
   const std::size_t cells = grid_.cell_count();
   const std::size_t groups = std::min(kSweepGroups, cells);
   group_pairs_.resize(groups);
@@ -270,24 +194,65 @@ void SweepAndPrune::sweep(const FilterSoa& filter) {
   }
   first_cell[0] = 0;
   const SapGrid grid = grid_;
-  const float *x0 = x0_.data(), *x1 = x1_.data(), *u0 = u0_.data(), *u1 = u1_.data(), *v0 = v0_.data(),
-              *v1 = v1_.data();
-  const std::uint32_t* id = id_.data();
+  Entry* all = entries_.data();
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::vector<std::uint64_t>& out = group_pairs_[g];
     out.clear();
+    std::vector<std::uint64_t> w, tmp;
+    std::vector<Entry> buf;
     for (std::size_t cell = first_cell[g]; cell < first_cell[g + 1]; ++cell) {
+      const std::size_t s = cell_start_[cell], k = cell_start_[cell + 1] - s;
+      Entry* e = all + s;
+      // Sort by (key, id). The records arrive in id order, so a stable sort by key alone is enough.
+      if (k <= kInsertionSortMax) {
+        for (std::size_t j = 1; j < k; ++j) {
+          if (e[j].key >= e[j - 1].key) continue;
+          const Entry x = e[j];
+          std::size_t i = j;
+          do {
+            e[i] = e[i - 1];
+            --i;
+          } while (i > 0 && e[i - 1].key > x.key);
+          e[i] = x;
+        }
+      } else {
+        w.resize(k), tmp.resize(k), buf.resize(k);
+        std::array<std::array<std::uint32_t, 256>, 4> hist{};
+        for (std::size_t i = 0; i < k; ++i) {
+          const std::uint32_t key = e[i].key;
+          w[i] = static_cast<std::uint64_t>(key) << 32 | i;
+          ++hist[0][key & 0xff], ++hist[1][(key >> 8) & 0xff], ++hist[2][(key >> 16) & 0xff], ++hist[3][key >> 24];
+        }
+        std::uint64_t* src = w.data();
+        std::uint64_t* dst = tmp.data();
+        for (int d = 0; d < 4; ++d) {
+          std::uint32_t running = 0;
+          bool trivial = false;
+          for (int b = 0; b < 256; ++b) {
+            const std::uint32_t count = hist[d][b];
+            if (count == k) { trivial = true; break; }
+            hist[d][b] = running;
+            running += count;
+          }
+          if (trivial) continue;
+          const int shift = 32 + 8 * d;
+          for (std::size_t i = 0; i < k; ++i) dst[hist[d][(src[i] >> shift) & 0xff]++] = src[i];
+          std::swap(src, dst);
+        }
+        for (std::size_t i = 0; i < k; ++i) buf[i] = e[static_cast<std::uint32_t>(src[i])];
+        std::memcpy(static_cast<void*>(e), buf.data(), k * sizeof(Entry));
+      }
       const int cu = static_cast<int>(cell % grid.cells_u), cv = static_cast<int>(cell / grid.cells_u);
-      const std::size_t s = cell_start_[cell], e = cell_start_[cell + 1];
-      for (std::size_t i = s; i < e; ++i) {
-        const float hx = x1[i], lu = u0[i], hu = u1[i], lv = v0[i], hv = v1[i];
-        // Entries are sorted by x0, so x0[i] <= x0[j] <= x1[j]: the x overlap reduces to x0[j] <= x1[i].
-        for (std::size_t j = i + 1; j < e && x0[j] <= hx; ++j) {
-          if (!((u0[j] <= hu) & (lu <= u1[j]) & (v0[j] <= hv) & (lv <= v1[j]))) continue;
+      for (std::size_t i = 0; i < k; ++i) {
+        const float hx = e[i].x1, lu = e[i].u0, hu = e[i].u1, lv = e[i].v0, hv = e[i].v1;
+        // Records are sorted by x0, so x0[i] <= x0[j] <= x1[j]: the x overlap reduces to x0[j] <= x1[i].
+        for (std::size_t j = i + 1; j < k && e[j].x0 <= hx; ++j) {
+          const Entry& f = e[j];
+          if (!((f.u0 <= hu) & (lu <= f.u1) & (f.v0 <= hv) & (lv <= f.v1))) continue;
           // Report the pair only in the cell of the lower corner of the overlap (in both boxes' cell ranges since
           // cell_of is monotone), so pairs straddling several shared cells appear once.
-          if (grid.cell_u(std::max(lu, u0[j])) != cu || grid.cell_v(std::max(lv, v0[j])) != cv) continue;
-          std::uint32_t a = id[i], b = id[j];
+          if (grid.cell_u(std::max(lu, f.u0)) != cu || grid.cell_v(std::max(lv, f.v0)) != cv) continue;
+          std::uint32_t a = e[i].id, b = f.id;
           if (a > b) std::swap(a, b);
           if (pair_passes(filter, a, b)) out.push_back(static_cast<std::uint64_t>(a) << 32 | b);
         }
@@ -301,13 +266,13 @@ void SweepAndPrune::emit(std::vector<CandidatePair>& pairs) {
   std::vector<std::size_t> start(groups + 1, 0);
   for (std::size_t g = 0; g < groups; ++g) start[g + 1] = start[g] + group_pairs_[g].size();
   const std::size_t total = start[groups];
-  if (words_.size() < total) words_.resize(total);  // words_ and scratch_ are free again after bucketing
+  if (words_.size() < total) words_.resize(total);
   if (scratch_.size() < total) scratch_.resize(total);
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::copy(group_pairs_[g].begin(), group_pairs_[g].end(), words_.begin() + static_cast<std::ptrdiff_t>(start[g]));
   });
   // Object ids are < n: only the low bit_width(n - 1) bits of a and of b can differ.
-  const int w = bit_width(order_.empty() ? 0 : order_.size() - 1);
+  const int w = bit_width(object_count_ == 0 ? 0 : object_count_ - 1);
   std::vector<int> shifts = digit_shifts(0, w);
   for (int s : digit_shifts(32, 32 + w)) shifts.push_back(s);
   radix_sort(words_.data(), scratch_.data(), total, shifts);

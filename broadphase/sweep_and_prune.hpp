@@ -5,9 +5,10 @@
 // [lo2, hi2] overlap iff lo1 <= hi2 and lo2 <= hi1.
 //
 // Usage: keep one SweepAndPrune per scene; call rebuild() for a fresh scene, update() every frame after. update()
-// re-sorts the previous frame's order (nearly sorted when objects move a little) and keeps the sweep axis and the
-// grid of the last rebuild; it falls back to a full rebuild when the object count changed or the order is far from
-// sorted. Both give the same pairs.
+// keeps the sweep axis and the grid of the last rebuild (skipping their choice); it chooses them afresh, like
+// rebuild(), when the object count changed or the scene drifted away from the grid (many more cell copies, or a
+// much fuller largest cell, than at the last rebuild). Both give the same pairs; every call re-buckets and re-sorts
+// each cell (the per-cell sort runs in cache, so re-sorting a previous order would save little).
 #pragma once
 
 #include "broadphase/aabb_soa.hpp"
@@ -24,14 +25,14 @@ struct SapStats {
   int axis = -1;                  // sweep axis of the last rebuild
   int cells_u = 0, cells_v = 0;   // grid over the two other axes
   std::size_t entries = 0;        // object copies in grid cells (>= objects: boxes straddling cells)
-  std::size_t sort_moves = 0;     // insertion-sort moves of the last update()
-  bool incremental = false;       // the last call re-sorted the previous order (false: full radix sort)
+  std::size_t max_cell = 0;       // entries in the fullest cell
+  bool incremental = false;       // the last call kept the previous grid (false: axis and grid chosen afresh)
   std::size_t pairs = 0;
 };
 
 class SweepAndPrune {
  public:
-  /// Full rebuild: chooses the sweep axis and grid, radix-sorts the keys, sweeps. Throws InputError (naming the
+  /// Full rebuild: chooses the sweep axis and grid, buckets, sorts and sweeps each cell. Throws InputError (naming the
   /// lowest bad object index) for non-finite boxes, min > max, or a filter of the wrong size.
   void rebuild(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs);
   /// Incremental update after the objects moved (same objects, same count); same pairs as rebuild().
@@ -44,25 +45,29 @@ class SweepAndPrune {
   void clear();
 
  private:
+  // One object copy in one grid cell: x = sweep axis, u, v = grid axes; key = sortable_key(x0). 32 bytes, so a
+  // candidate tested by the sweep costs one cache line at most.
+  struct alignas(32) Entry {
+    float x0, x1, u0, u1, v0, v1;
+    std::uint32_t id, key;
+  };
+
   void run(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs, bool incremental);
-  void sort_full(const float* keys);
-  bool sort_incremental(const float* keys);
+  std::size_t count_entries(const AabbSoa& boxes);  // sets stats_.max_cell
   void bucket(const AabbSoa& boxes);
-  std::size_t count_entries(const AabbSoa& boxes);
-  void sweep(const FilterSoa& filter);
+  void sort_and_sweep(const FilterSoa& filter);
   void emit(std::vector<CandidatePair>& pairs);
 
   SapGrid grid_;
-  bool have_order_ = false;
+  bool have_order_ = false;               // a grid from an earlier call exists
+  std::size_t object_count_ = 0;          // objects of the last call
+  std::size_t rebuild_entries_ = 0, rebuild_max_cell_ = 0;  // stats when the grid was chosen: drift reference
   SapStats stats_;
-  std::vector<std::uint32_t> order_;      // object ids sorted by min on the sweep axis (kept for update())
-  std::vector<std::uint64_t> words_;      // (key << 32 | id) while sorting; then the pairs (a << 32 | b)
-  std::vector<std::uint64_t> scratch_;    // radix scratch; then each sorted object's cell range (4 x 16 bits)
+  std::vector<std::uint64_t> words_;      // the pairs (a << 32 | b) while sorting them
+  std::vector<std::uint64_t> scratch_;    // radix scratch for the pairs
   std::vector<std::uint32_t> counts_;     // per bucketing chunk and cell: entry count, then write offset
   std::vector<std::uint32_t> cell_start_; // entries of cell c are [cell_start_[c], cell_start_[c + 1])
-  // Entries (object copies per cell), sorted by cell then by min on the sweep axis: x = sweep axis, u, v = grid.
-  std::vector<float> x0_, x1_, u0_, u1_, v0_, v1_;
-  std::vector<std::uint32_t> id_;
+  std::vector<Entry> entries_;            // by cell, then sorted by (x0, id) inside each cell
   std::vector<std::vector<std::uint64_t>> group_pairs_;  // per fixed group of cells: its pairs, written lock-free
 };
 
