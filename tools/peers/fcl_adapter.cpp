@@ -113,6 +113,27 @@ bool has_triangle(const Shape& a, const Shape& b) {
   return a.type == ShapeType::triangle || b.type == ShapeType::triangle;
 }
 
+// fcl::collide on two built geometries; the depth of the first contact when asked and colliding.
+bool geometry_collide(const fcl::CollisionGeometryd& ga, const Pose& pa, const fcl::CollisionGeometryd& gb,
+                      const Pose& pb, FclSolver solver, bool want_depth, double& depth) {
+  fcl::CollisionRequestd request(1, want_depth);
+  request.gjk_solver_type = to_fcl(solver);
+  fcl::CollisionResultd result;
+  fcl::collide(&ga, to_fcl(pa), &gb, to_fcl(pb), request, result);
+  if (result.isCollision() && want_depth) depth = result.getContact(0).penetration_depth;
+  return result.isCollision();
+}
+
+// fcl::distance on two built geometries: fills the distance and the nearest points.
+void geometry_distance(const fcl::CollisionGeometryd& ga, const Pose& pa, const fcl::CollisionGeometryd& gb,
+                       const Pose& pb, FclSolver solver, double tolerance, PeerAnswer& out) {
+  fcl::DistanceRequestd request(true, true, 0.0, 0.0, tolerance, to_fcl(solver));
+  fcl::DistanceResultd result;
+  out.distance = fcl::distance(&ga, to_fcl(pa), &gb, to_fcl(pb), request, result);
+  out.point_a = result.nearest_points[0];
+  out.point_b = result.nearest_points[1];
+}
+
 }  // namespace
 
 const char* to_string(FclSolver solver) { return solver == FclSolver::libccd ? "libccd" : "indep"; }
@@ -131,13 +152,7 @@ PeerAnswer fcl_collide(const Shape& a, const Pose& pa, const Shape& b, const Pos
         });
       });
     } else {
-      fcl::CollisionRequestd request(1, want_depth);
-      request.gjk_solver_type = to_fcl(solver);
-      fcl::CollisionResultd result;
-      const auto ga = make_geometry(a), gb = make_geometry(b);
-      fcl::collide(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
-      out.collide = result.isCollision();
-      if (out.collide && want_depth) depth = result.getContact(0).penetration_depth;
+      out.collide = geometry_collide(*make_geometry(a), pa, *make_geometry(b), pb, solver, want_depth, depth);
     }
     if (out.collide && want_depth) out.distance = -depth;
     out.ok = true;
@@ -170,12 +185,7 @@ PeerAnswer fcl_distance(const Shape& a, const Pose& pa, const Shape& b, const Po
       out.point_a = t.swapped ? p_tri : p_other;
       out.point_b = t.swapped ? p_other : p_tri;
     } else {
-      fcl::DistanceRequestd request(true, true, 0.0, 0.0, tolerance, to_fcl(solver));
-      fcl::DistanceResultd result;
-      const auto ga = make_geometry(a), gb = make_geometry(b);
-      out.distance = fcl::distance(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
-      out.point_a = result.nearest_points[0];
-      out.point_b = result.nearest_points[1];
+      geometry_distance(*make_geometry(a), pa, *make_geometry(b), pb, solver, tolerance, out);
     }
     out.collide = out.distance <= 0;
     out.ok = true;
@@ -206,11 +216,8 @@ PeerAnswer FclShapeCache::collide(std::uint32_t a, const Pose& pa, std::uint32_t
   if (!ga || !gb) return fcl_collide(impl_->shapes[a], pa, impl_->shapes[b], pb, solver, false);
   PeerAnswer out;
   try {
-    fcl::CollisionRequestd request(1, false);
-    request.gjk_solver_type = to_fcl(solver);
-    fcl::CollisionResultd result;
-    fcl::collide(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
-    out.collide = result.isCollision();
+    double unused_depth = 0;
+    out.collide = geometry_collide(*ga, pa, *gb, pb, solver, false, unused_depth);
     out.ok = true;
   } catch (const std::exception&) {
     out.ok = false;
@@ -224,11 +231,7 @@ PeerAnswer FclShapeCache::distance(std::uint32_t a, const Pose& pa, std::uint32_
   if (!ga || !gb) return fcl_distance(impl_->shapes[a], pa, impl_->shapes[b], pb, solver, tolerance);
   PeerAnswer out;
   try {
-    fcl::DistanceRequestd request(true, true, 0.0, 0.0, tolerance, to_fcl(solver));
-    fcl::DistanceResultd result;
-    out.distance = fcl::distance(ga.get(), to_fcl(pa), gb.get(), to_fcl(pb), request, result);
-    out.point_a = result.nearest_points[0];
-    out.point_b = result.nearest_points[1];
+    geometry_distance(*ga, pa, *gb, pb, solver, tolerance, out);
     out.collide = out.distance <= 0;
     out.ok = true;
   } catch (const std::exception&) {
