@@ -51,41 +51,54 @@ template <class T> void finish(PairOutput<T>& o, const QueryOptions& opt, bool k
 }  // namespace
 
 template <class T>
-PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                         const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
-  const ShapeCore<T> A = make_core<T>(a), B = make_core<T>(b);
-  Transform<T> X;
-  X.R = b_in_a.R.cast<T>();
-  X.t = b_in_a.t.cast<T>();
-  PairOutput<T> out;
+PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                        const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
+  PairSetup<T> s;
+  s.A = make_core<T>(a);
+  s.B = make_core<T>(b);
+  const ShapeCore<T>& A = s.A;
+  const ShapeCore<T>& B = s.B;
+  s.X.R = b_in_a.R.cast<T>();
+  s.X.t = b_in_a.t.cast<T>();
   // The separating-axis test is exact for boolean queries on plain boxes with a zero margin.
   if (opt.closed_forms && a.type == ShapeType::box && b.type == ShapeType::box && opt.level == QueryLevel::boolean &&
       opt.margin == 0.0 && A.radius == T(0) && B.radius == T(0)) {
-    finish(out, opt, true, boxes_intersect(A.size, B.size, X));
-    return out;
+    finish(s.out, opt, true, boxes_intersect(A.size, B.size, s.X));
+    s.done = true;
+    return s;
   }
-  if (closed_form(A, B, X, opt, out)) {
-    finish(out, opt, false, false);
-    return out;
+  if (closed_form(A, B, s.X, opt, s.out)) {
+    finish(s.out, opt, false, false);
+    s.done = true;
+    return s;
   }
 
   // GJK on the cores; the swept radii are added afterwards.
-  const T radii = A.radius + B.radius;
-  const T scale = T(a.bounding_radius() + b.bounding_radius() + b_in_a.t.norm());
-  const T floor = tolerance_floor(scale);
-  GjkParams<T> params;
+  s.radii = A.radius + B.radius;
+  s.scale = T(a.bounding_radius() + b.bounding_radius() + b_in_a.t.norm());
+  s.floor = tolerance_floor(s.scale);
+  GjkParams<T>& params = s.params;
   params.solver = opt.solver;
-  params.tolerance = std::max(T(opt.tolerance), floor);
+  params.tolerance = std::max(T(opt.tolerance), s.floor);
   params.relative_tolerance = T(opt.relative_tolerance);
   params.max_iterations = opt.max_iterations;
   params.boolean_only = opt.level == QueryLevel::boolean;
-  params.core_margin = T(opt.margin) + radii;
+  params.core_margin = T(opt.margin) + s.radii;
   params.normalize_momentum = !(A.strictly_convex() && B.strictly_convex());
-  params.touch_tolerance = floor;  // 16 ulps of the problem size
-  const MinkowskiDifference<T> D{&A, &B, X, {}, {}};
+  params.touch_tolerance = s.floor;  // 16 ulps of the problem size
   const Vec3<T> warm = warm_direction.cast<T>();
   const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
-  const GjkResult<T> g = gjk(D, use_warm ? warm : D.center(), params);
+  s.initial_direction = use_warm ? warm : s.difference().center();
+  return s;
+}
+
+template <class T>
+PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const QueryOptions& opt) {
+  const ShapeCore<T>& A = s.A;
+  const ShapeCore<T>& B = s.B;
+  const GjkParams<T>& params = s.params;
+  const T radii = s.radii, scale = s.scale, floor = s.floor;
+  PairOutput<T> out;
   out.iterations = g.iterations;
   out.direction = g.direction;
 
@@ -94,7 +107,7 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
     case GjkStatus::collision_proven: finish(out, opt, true, true); return out;
     case GjkStatus::overlap: {
       if (opt.level < QueryLevel::penetration) { finish(out, opt, true, true); return out; }
-      const EpaResult<T> e = epa(D, g.simplex, params.tolerance, scale, opt.epa_max_iterations);
+      const EpaResult<T> e = epa(s.difference(), g.simplex, params.tolerance, scale, opt.epa_max_iterations);
       out.iterations += e.iterations;
       out.status = e.status == EpaStatus::converged || e.status == EpaStatus::flat ? Status::converged
                    : e.status == EpaStatus::max_iterations                          ? Status::max_iterations
@@ -136,9 +149,25 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
   return out;
 }
 
+template <class T>
+PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                         const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
+  const PairSetup<T> s = setup_pair<T>(a, b, b_in_a, warm_direction, opt);
+  if (s.done) return s.out;
+  return complete_pair(s, gjk(s.difference(), s.initial_direction, s.params), opt);
+}
+
 template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const RelativePose&,
                                                const Eigen::Vector3d&, const QueryOptions&);
 template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
                                              const Eigen::Vector3d&, const QueryOptions&);
+template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const RelativePose&,
+                                              const Eigen::Vector3d&, const QueryOptions&);
+template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,
+                                            const Eigen::Vector3d&, const QueryOptions&);
+template PairOutput<double> complete_pair<double>(const PairSetup<double>&, const GjkResult<double>&,
+                                                  const QueryOptions&);
+template PairOutput<float> complete_pair<float>(const PairSetup<float>&, const GjkResult<float>&,
+                                                const QueryOptions&);
 
 }  // namespace batchcol::kernels

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "batchcol/batch.hpp"
+#include "kernels/gjk.hpp"
 #include "kernels/pair_output.hpp"
 
 namespace batchcol::kernels {
@@ -18,6 +19,29 @@ template <class T>
 PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                          const Eigen::Vector3d& warm_direction, const QueryOptions& options);
 
+/// Everything GJK needs for one pair, prepared once: the cores, B's pose in A's frame in precision T, the
+/// parameters and the first direction. `done` means a closed form already answered (`out`). The scalar path and
+/// the wide (SIMD) kernels share this setup and complete_pair(), so they differ only in how GJK itself runs.
+template <class T> struct PairSetup {
+  ShapeCore<T> A, B;
+  Transform<T> X;
+  GjkParams<T> params;
+  T radii = T(0), scale = T(0), floor = T(0);
+  Vec3<T> initial_direction = Vec3<T>::UnitX();
+  bool done = false;
+  PairOutput<T> out;
+
+  MinkowskiDifference<T> difference() const { return MinkowskiDifference<T>{&A, &B, X, {}, {}}; }
+};
+
+template <class T>
+PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                        const Eigen::Vector3d& warm_direction, const QueryOptions& options);
+/// From GJK's result to the pair's answer: EPA when the cores overlap and depth was asked, the swept radii, the
+/// stall acceptance and the conservative `collide`.
+template <class T>
+PairOutput<T> complete_pair(const PairSetup<T>& setup, const GjkResult<T>& gjk, const QueryOptions& options);
+
 /// The smallest distance tolerance precision T can certify for a problem of size `scale` (metres): the requested
 /// tolerance is raised to this floor, since support values and |x| are only known to a few ulps of the scale.
 template <class T> T tolerance_floor(T scale) { return T(16) * machine_epsilon<T>() * scale; }
@@ -26,5 +50,13 @@ extern template PairOutput<double> solve_pair<double>(const Shape&, const Shape&
                                                       const Eigen::Vector3d&, const QueryOptions&);
 extern template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
                                                     const Eigen::Vector3d&, const QueryOptions&);
+extern template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const RelativePose&,
+                                                     const Eigen::Vector3d&, const QueryOptions&);
+extern template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,
+                                                   const Eigen::Vector3d&, const QueryOptions&);
+extern template PairOutput<double> complete_pair<double>(const PairSetup<double>&, const GjkResult<double>&,
+                                                         const QueryOptions&);
+extern template PairOutput<float> complete_pair<float>(const PairSetup<float>&, const GjkResult<float>&,
+                                                       const QueryOptions&);
 
 }  // namespace batchcol::kernels
