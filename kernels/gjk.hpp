@@ -74,17 +74,17 @@ constexpr int kMaxStaleMomentumSteps = 4;
 /// the triangle's normal is off by ~eps |w|^2 / |n| instead. Return whichever is better conditioned, scaled to
 /// |x| (both are the same direction in exact arithmetic).
 template <class T> Vec3<T> face_direction(const Simplex<T>& S, const Vec3<T>& x) {
-  const Vec3<T> n = (S.v[1].w - S.v[0].w).cross(S.v[2].w - S.v[0].w);
-  const T w = std::max({S.v[0].w.norm(), S.v[1].w.norm(), S.v[2].w.norm()});
-  const T xn = x.norm(), nn = n.norm();
+  const Vec3<T> n = cross3<T>(S.v[1].w - S.v[0].w, S.v[2].w - S.v[0].w);
+  const T w = std::max({norm3(S.v[0].w), norm3(S.v[1].w), norm3(S.v[2].w)});
+  const T xn = norm3(x), nn = norm3(n);
   if (!(nn > xn * w)) return x;
-  return (n.dot(x) < T(0) ? -n : n) * (xn / nn);
+  return (dot3(n, x) < T(0) ? -n : n) * (xn / nn);
 }
 
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
-  if (!(initial_direction.squaredNorm() > T(0))) initial_direction = Vec3<T>::UnitX();
+  if (!(norm2(initial_direction) > T(0))) initial_direction = Vec3<T>::UnitX();
   Simplex<T>& S = r.simplex;
   S.v[0] = D.support(-initial_direction);
   S.lambda[0] = T(1);
@@ -98,7 +98,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
-    const T xx = x.squaredNorm();
+    const T xx = norm2(x);
     const T xn = std::sqrt(xx);
     if (xn <= params.touch_tolerance) { r.status = GjkStatus::overlap; break; }
     if (params.boolean_only && xn <= params.core_margin) { r.status = GjkStatus::collision_proven; break; }
@@ -107,20 +107,20 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (momentum && params.solver == Solver::nesterov) {
       const T delta = T(k + 1) / T(k + 3);
       const Vec3<T> y = delta * x + (T(1) - delta) * last_s;
-      const T yn = y.norm(), dn = d_prev.norm();
+      const T yn = norm3(y), dn = norm3(d_prev);
       if (params.normalize_momentum && yn > T(0) && dn > T(0)) d = delta * d_prev / dn + (T(1) - delta) * y / yn;
       else if (!params.normalize_momentum) d = delta * d_prev + (T(1) - delta) * y;
     } else if (momentum) {  // Polyak heavy ball: running average of the gradients with weight 1/(k+2)
       const T beta = T(1) / T(k + 2);
       d = (T(1) - beta) * x + beta * d_prev;
     }
-    const T dn = d.norm();
+    const T dn = norm3(d);
     if (!(dn > T(0))) d = x;  // momentum cancelled out: use the gradient
     const bool plain_step = (d == x);
     if (plain_step && S.count == 3) d = face_direction(S, x);
 
     const SupportPoint<T> s = D.support(-d);
-    const T lb = s.w.dot(d) / d.norm();  // every y in D has <y, d/|d|> >= lb
+    const T lb = dot3(s.w, d) / norm3(d);  // every y in D has <y, d/|d|> >= lb
     // Progress = closing at least a tenth of the certified gap |x| - lower_bound.
     stale = lb > lower_bound + T(0.1) * (xn - lower_bound) ? 0 : stale + 1;
     lower_bound = std::max(lower_bound, lb);
@@ -136,7 +136,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       momentum = false;
       continue;
     }
-    if (!plain_step && xx - x.dot(s.w) <= tol * xn) {
+    if (!plain_step && xx - dot3(x, s.w) <= tol * xn) {
       // The momentum support point would not move x: switch to plain GJK, whose gap certifies convergence.
       momentum = false;
       continue;
@@ -149,7 +149,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     Simplex<T> next;
     next.count = proj.count;
     for (int i = 0; i < proj.count; ++i) { next.v[i] = S.v[proj.index[i]]; next.lambda[i] = proj.lambda[i]; }
-    const T next_xx = proj.x.squaredNorm();
+    const T next_xx = norm2(proj.x);
     if (proj.contains_origin) { S = next; x = proj.x; r.status = GjkStatus::overlap; break; }
     if (!(next_xx < xx)) {
       // No decrease although conv(W + s) contains x: we are at the resolution of the arithmetic.
@@ -169,7 +169,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     last_s = s.w;
   }
   // The budget can run out right after x reached the origin.
-  if (r.status == GjkStatus::max_iterations && x.norm() <= params.touch_tolerance) r.status = GjkStatus::overlap;
+  if (r.status == GjkStatus::max_iterations && norm3(x) <= params.touch_tolerance) r.status = GjkStatus::overlap;
   r.x = x;
   r.lower_bound = lower_bound;
   if (r.status == GjkStatus::overlap) r.x = Vec3<T>::Zero();

@@ -15,12 +15,35 @@ template <class T> using Mat3 = Eigen::Matrix<T, 3, 3>;
 template <class T> constexpr T machine_epsilon() { return std::numeric_limits<T>::epsilon(); }
 template <class T> T quiet_nan() { return std::numeric_limits<T>::quiet_NaN(); }
 
+// Reductions with one fixed association, (a0 b0 + a1 b1) + a2 b2. Eigen's own dot products and 3x3 products
+// associate differently for float and double and change with the instruction set it vectorizes for (measured:
+// double R * v matched neither order under -mavx2), so the GJK path uses these: the SIMD kernels repeat the same
+// operations in the same order and agree with this reference bit for bit.
+template <class T> T dot3(const Vec3<T>& a, const Vec3<T>& b) { return (a.x() * b.x() + a.y() * b.y()) + a.z() * b.z(); }
+template <class T> T norm2(const Vec3<T>& a) { return dot3(a, a); }
+template <class T> T norm3(const Vec3<T>& a) { return std::sqrt(norm2(a)); }
+template <class T> Vec3<T> cross3(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.y() * b.z() - a.z() * b.y(), a.z() * b.x() - a.x() * b.z(), a.x() * b.y() - a.y() * b.x());
+}
+/// R v, row by row with dot3's association.
+template <class T> Vec3<T> mul(const Mat3<T>& R, const Vec3<T>& v) {
+  return Vec3<T>((R(0, 0) * v.x() + R(0, 1) * v.y()) + R(0, 2) * v.z(),
+                 (R(1, 0) * v.x() + R(1, 1) * v.y()) + R(1, 2) * v.z(),
+                 (R(2, 0) * v.x() + R(2, 1) * v.y()) + R(2, 2) * v.z());
+}
+/// R^T v, column by column with dot3's association.
+template <class T> Vec3<T> mul_transposed(const Mat3<T>& R, const Vec3<T>& v) {
+  return Vec3<T>((R(0, 0) * v.x() + R(1, 0) * v.y()) + R(2, 0) * v.z(),
+                 (R(0, 1) * v.x() + R(1, 1) * v.y()) + R(2, 1) * v.z(),
+                 (R(0, 2) * v.x() + R(1, 2) * v.y()) + R(2, 2) * v.z());
+}
+
 /// A rigid transform x_parent = R x_local + t, in precision T.
 template <class T> struct Transform {
   Mat3<T> R = Mat3<T>::Identity();
   Vec3<T> t = Vec3<T>::Zero();
 
-  Vec3<T> apply(const Vec3<T>& p) const { return R * p + t; }
+  Vec3<T> apply(const Vec3<T>& p) const { return mul(R, p) + t; }
 };
 
 /// Any unit vector orthogonal to `v` (v need not be normalised, must be non-zero).

@@ -22,7 +22,7 @@ template <class T> struct MinkowskiDifference {
   SupportPoint<T> support(const Vec3<T>& d) const {
     SupportPoint<T> p;
     p.a = kernels::support(*A, d, hint_a);
-    const Vec3<T> d_in_b = b_in_a.R.transpose() * (-d);
+    const Vec3<T> d_in_b = mul_transposed<T>(b_in_a.R, -d);
     p.b = b_in_a.apply(kernels::support(*B, d_in_b, hint_b));
     p.w = p.a - p.b;
     return p;

@@ -34,9 +34,9 @@ template <class T> SimplexProjection<T> vertex(const Vec3<T>* p, int i) {
 
 template <class T> SimplexProjection<T> segment(const Vec3<T>* p, int i, int j) {
   const Vec3<T> t = p[j] - p[i];
-  const T tt = t.squaredNorm();
+  const T tt = norm2(t);
   if (tt == T(0)) return vertex(p, i);  // duplicate points
-  const T u = -p[i].dot(t) / tt;        // parameter of the origin's projection on the line
+  const T u = -dot3(p[i], t) / tt;        // parameter of the origin's projection on the line
   if (u <= T(0)) return vertex(p, i);
   if (u >= T(1)) return vertex(p, j);
   SimplexProjection<T> r;
@@ -48,19 +48,19 @@ template <class T> SimplexProjection<T> segment(const Vec3<T>* p, int i, int j) 
 }
 
 template <class T> const SimplexProjection<T>& closer(const SimplexProjection<T>& a, const SimplexProjection<T>& b) {
-  return b.x.squaredNorm() < a.x.squaredNorm() ? b : a;
+  return norm2(b.x) < norm2(a.x) ? b : a;
 }
 
 template <class T> bool opposite_sign(T a, T b) { return (a > T(0) && b < T(0)) || (a < T(0) && b > T(0)); }
 
 template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j, int k) {
-  const Vec3<T> n = (p[j] - p[i]).cross(p[k] - p[i]);
-  const T nn = n.squaredNorm();
+  const Vec3<T> n = cross3<T>(p[j] - p[i], p[k] - p[i]);
+  const T nn = norm2(n);
   const auto edges = [&] { return closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k)); };
   if (nn == T(0)) return edges();  // collinear: the closest point lies on one of the edges
   // Origin projected on the triangle's plane, then 2D signed areas on the coordinate plane where the triangle's
   // projection is largest (drop the axis of the largest |n| component: best conditioned).
-  const Vec3<T> p0 = n * (p[i].dot(n) / nn);
+  const Vec3<T> p0 = n * (dot3(p[i], n) / nn);
   int drop = 0;
   if (std::abs(n.y()) > std::abs(n[drop])) drop = 1;
   if (std::abs(n.z()) > std::abs(n[drop])) drop = 2;
@@ -94,7 +94,7 @@ template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j,
   return have ? best : edges();
 }
 
-template <class T> T det3(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) { return a.dot(b.cross(c)); }
+template <class T> T det3(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) { return dot3(a, cross3(b, c)); }
 
 template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   // V[m] = signed volume of the tetrahedron with vertex m replaced by the origin; their sum is the full volume.

@@ -26,7 +26,7 @@ template <class T> Vec3<T> sign_or_plus(const Vec3<T>& d) {
 
 template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d, SupportHint& hint) {
   const auto& v = hull.vertices;
-  const auto dot = [&](std::uint32_t i) { return v[i].template cast<T>().dot(d); };
+  const auto dot = [&](std::uint32_t i) { return dot3<T>(v[i].template cast<T>(), d); };
   std::uint32_t best = 0;
   if (v.size() < kHillClimbMinVertices) {
     T best_dot = dot(0);
@@ -80,13 +80,13 @@ template <class T> Vec3<T> support(const ShapeCore<T>& s, const Vec3<T>& d, Supp
     case ShapeType::ellipsoid: {
       // argmax <x,d> on {x : |x ./ r| <= 1} is r.^2 .* d / |r .* d|.
       const Vec3<T> rd = s.size.cwiseProduct(d);
-      const T n = rd.norm();
+      const T n = norm3(rd);
       if (n == T(0)) return Vec3<T>::Zero();  // d == 0: every point maximises <x, 0>
       return s.size.cwiseProduct(rd) / n;
     }
     case ShapeType::convex: return hull_support(*s.hull, d, hint);
     case ShapeType::triangle: {
-      const T d0 = s.triangle[0].dot(d), d1 = s.triangle[1].dot(d), d2 = s.triangle[2].dot(d);
+      const T d0 = dot3(s.triangle[0], d), d1 = dot3(s.triangle[1], d), d2 = dot3(s.triangle[2], d);
       if (d0 >= d1 && d0 >= d2) return s.triangle[0];
       return d1 >= d2 ? s.triangle[1] : s.triangle[2];
     }
