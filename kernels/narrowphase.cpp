@@ -171,3 +171,14 @@ template PairOutput<float> complete_pair<float>(const PairSetup<float>&, const G
                                                 const QueryOptions&);
 
 }  // namespace batchcol::kernels
+
+namespace batchcol {
+
+const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
+  kernels::RelativePose apart;
+  apart.t = Eigen::Vector3d(1e3, 0, 0);  // the kernel depends on the types and options only, not on the pose
+  const auto setup = kernels::setup_pair<double>(a, b, apart, Eigen::Vector3d::Zero(), options);
+  return setup.done ? "closed form" : "gjk";
+}
+
+}  // namespace batchcol

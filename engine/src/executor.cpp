@@ -1,8 +1,9 @@
 // The batch executor: validate, group pairs by shape-pair type, run tiles of pairs on TBB, write results in input
-// order. Each pair is computed by the same sequential code whatever thread runs it, so results are bitwise
-// identical for any thread count.
+// order. Inside a tile, pairs of one type go through the SIMD GJK together (one pair per lane); every lane repeats
+// the scalar reference's operations, so results are bitwise identical for any thread count and instruction set.
 #include "batchcol/batch.hpp"
 #include "kernels/narrowphase.hpp"
+#include "kernels/simd/wide_gjk.hpp"
 #include "validate.hpp"
 
 #include <tbb/blocked_range.h>
@@ -36,33 +37,101 @@ void group_by_type(const ShapeTable& shapes, const PairBatch& batch, std::size_t
   for (std::size_t i = begin; i < end; ++i) order[start[key(i)]++] = static_cast<std::uint32_t>(i - begin);
 }
 
+/// World frame of shape A for one pair: outputs are computed in A's frame and mapped back with it.
+struct PairFrame {
+  Eigen::Matrix3d Ra;
+  Eigen::Vector3d ta;
+};
+
+/// Pairs of one shape-pair type handed to the SIMD kernels at once: enough to keep every lane busy through the
+/// refills, few enough that their setups (~0.5 KB each) stay in L1/L2.
+constexpr std::size_t kChunkPairs = 64;
+
+/// Per-task scratch, reused across the task's tiles.
+template <class T> struct ChunkScratch {
+  std::vector<kernels::PairSetup<T>> setups;
+  std::vector<kernels::GjkResult<T>> gjk;
+  std::vector<PairFrame> frames;
+  std::vector<std::uint32_t> pairs;
+  std::vector<std::uint32_t> order;
+};
+
 template <class T>
-void run_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
-              PairResults& out) {
+void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size_t i, PairResults& out) {
+  out.status[i] = r.status;
+  out.collide[i] = r.collide ? 1 : 0;
+  out.distance[i] = static_cast<double>(r.distance);
+  out.witness_a.set(i, f.Ra * r.witness_a.template cast<double>() + f.ta);
+  out.witness_b.set(i, f.Ra * r.witness_b.template cast<double>() + f.ta);
+  out.normal.set(i, f.Ra * r.normal.template cast<double>());
+  out.direction.set(i, f.Ra * r.direction.template cast<double>());
+  out.iterations[i] = r.iterations;
+}
+
+/// Validates pair i, computes B's pose in A's frame (double) and the setup. Returns false for an invalid pair
+/// (status invalid_input written; everything else stays NaN / 0 from PairResults::resize).
+template <class T>
+bool prepare_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
+                  PairFrame& frame, kernels::PairSetup<T>& setup, PairResults& out) {
   const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
   const auto qa = detail::unit_quaternion(batch.rotation_a[i]);
   const auto qb = detail::unit_quaternion(batch.rotation_b[i]);
   const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
   if (ia >= shapes.size() || ib >= shapes.size() || !qa || !qb || !ta.allFinite() || !tb.allFinite()) {
-    out.status[i] = Status::invalid_input;  // everything else stays NaN / 0 from PairResults::resize
-    return;
+    out.status[i] = Status::invalid_input;
+    return false;
   }
-  const Eigen::Matrix3d Ra = qa->toRotationMatrix(), Rb = qb->toRotationMatrix();
+  frame.Ra = qa->toRotationMatrix();
+  frame.ta = ta;
+  const Eigen::Matrix3d Rb = qb->toRotationMatrix();
   kernels::RelativePose b_in_a;
-  b_in_a.R = Ra.transpose() * Rb;
-  b_in_a.t = Ra.transpose() * (tb - ta);
+  b_in_a.R = frame.Ra.transpose() * Rb;
+  b_in_a.t = frame.Ra.transpose() * (tb - ta);
   Eigen::Vector3d warm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  if (!batch.warm_start.empty()) warm = Ra.transpose() * batch.warm_start[i];
+  if (!batch.warm_start.empty()) warm = frame.Ra.transpose() * batch.warm_start[i];
+  setup = kernels::setup_pair<T>(shapes[ia], shapes[ib], b_in_a, warm, options);
+  return true;
+}
 
-  const kernels::PairOutput<T> r = kernels::solve_pair<T>(shapes[ia], shapes[ib], b_in_a, warm, options);
-  out.status[i] = r.status;
-  out.collide[i] = r.collide ? 1 : 0;
-  out.distance[i] = static_cast<double>(r.distance);
-  out.witness_a.set(i, Ra * r.witness_a.template cast<double>() + ta);
-  out.witness_b.set(i, Ra * r.witness_b.template cast<double>() + ta);
-  out.normal.set(i, Ra * r.normal.template cast<double>());
-  out.direction.set(i, Ra * r.direction.template cast<double>());
-  out.iterations[i] = r.iterations;
+/// Pairs [begin, end) of the tile, grouped by type (`order` holds offsets from begin): closed forms answer at
+/// setup, the rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
+template <class T>
+void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
+              std::size_t begin, ChunkScratch<T>& s, PairResults& out) {
+  s.setups.resize(kChunkPairs);
+  s.gjk.resize(kChunkPairs);
+  s.frames.resize(kChunkPairs);
+  s.pairs.resize(kChunkPairs);
+  std::size_t pending = 0;
+  ShapeType pending_a = ShapeType::sphere, pending_b = ShapeType::sphere;
+  const auto flush = [&] {
+    kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver);
+    for (std::size_t j = 0; j < pending; ++j)
+      write_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j], s.pairs[j], out);
+    pending = 0;
+  };
+  for (const std::uint32_t k : s.order) {
+    const std::size_t i = begin + k;
+    PairFrame frame;
+    kernels::PairSetup<T>& setup = s.setups[pending];
+    if (!prepare_pair(shapes, batch, options, i, frame, setup, out)) continue;
+    if (setup.done) {
+      write_output(setup.out, frame, i, out);
+      continue;
+    }
+    // A chunk holds one shape-pair type (the kernels branch on the type once per chunk, not per lane).
+    if (pending > 0 && (setup.A.type != pending_a || setup.B.type != pending_b)) {
+      const kernels::PairSetup<T> keep = setup;
+      flush();
+      s.setups[0] = keep;
+    }
+    pending_a = s.setups[pending].A.type;
+    pending_b = s.setups[pending].B.type;
+    s.frames[pending] = frame;
+    s.pairs[pending] = static_cast<std::uint32_t>(i);
+    if (++pending == kChunkPairs) flush();
+  }
+  if (pending > 0) flush();
 }
 
 }  // namespace
@@ -73,14 +142,18 @@ void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOption
   results.resize(batch.size());
   const std::size_t n = batch.size();
   const std::size_t tiles = (n + kTilePairs - 1) / kTilePairs;
+  const InstructionSet isa = resolve_instruction_set(options.isa);
   const auto run_tiles = [&](const tbb::blocked_range<std::size_t>& range) {
-    std::vector<std::uint32_t> order;
+    ChunkScratch<double> scratch_double;
+    ChunkScratch<float> scratch_float;
     for (std::size_t t = range.begin(); t != range.end(); ++t) {
       const std::size_t begin = t * kTilePairs, end = std::min(n, begin + kTilePairs);
-      group_by_type(shapes, batch, begin, end, order);
-      for (const std::uint32_t k : order) {
-        if (options.precision == Precision::float32) run_pair<float>(shapes, batch, options, begin + k, results);
-        else run_pair<double>(shapes, batch, options, begin + k, results);
+      if (options.precision == Precision::float32) {
+        group_by_type(shapes, batch, begin, end, scratch_float.order);
+        run_tile(shapes, batch, options, isa, begin, scratch_float, results);
+      } else {
+        group_by_type(shapes, batch, begin, end, scratch_double.order);
+        run_tile(shapes, batch, options, isa, begin, scratch_double, results);
       }
     }
   };

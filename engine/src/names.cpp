@@ -32,6 +32,7 @@ constexpr const char* kQueryLevelNames[] = {"boolean", "distance", "witness", "p
 constexpr const char* kSolverNames[] = {"gjk", "nesterov", "polyak"};
 constexpr const char* kPrecisionNames[] = {"double", "float"};
 constexpr const char* kStatusNames[] = {"converged", "max_iterations", "degenerate", "invalid_input"};
+constexpr const char* kInstructionSetNames[] = {"automatic", "scalar", "avx2", "avx512"};
 
 static_assert(sizeof(kShapeTypeNames) / sizeof(kShapeTypeNames[0]) == kShapeTypeCount);
 
@@ -42,6 +43,7 @@ const char* to_string(QueryLevel level) { return name_of(level, kQueryLevelNames
 const char* to_string(Solver solver) { return name_of(solver, kSolverNames); }
 const char* to_string(Precision precision) { return name_of(precision, kPrecisionNames); }
 const char* to_string(Status status) { return name_of(status, kStatusNames); }
+const char* to_string(InstructionSet isa) { return name_of(isa, kInstructionSetNames); }
 
 QueryLevel parse_query_level(const std::string& name) {
   return parse_enum<QueryLevel>(name, kQueryLevelNames, "query level");
@@ -49,6 +51,9 @@ QueryLevel parse_query_level(const std::string& name) {
 Solver parse_solver(const std::string& name) { return parse_enum<Solver>(name, kSolverNames, "solver"); }
 Precision parse_precision(const std::string& name) {
   return parse_enum<Precision>(name, kPrecisionNames, "precision");
+}
+InstructionSet parse_instruction_set(const std::string& name) {
+  return parse_enum<InstructionSet>(name, kInstructionSetNames, "instruction set");
 }
 
 }  // namespace batchcol

@@ -26,6 +26,15 @@ using batchcol::testing::RunResult;
 
 class BenchCli : public batchcol::testing::CliTest {};
 
+bool cpu_runs(const char* isa) {
+  try {
+    batchcol::resolve_instruction_set(batchcol::parse_instruction_set(isa));
+    return true;
+  } catch (const batchcol::InputError&) {
+    return false;
+  }
+}
+
 TEST_F(BenchCli, JsonHasTheDocumentedFields) {
   const RunResult r = run("bench --case sphere-sphere --regime close --pairs 2000 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -37,7 +46,8 @@ TEST_F(BenchCli, JsonHasTheDocumentedFields) {
   }
   EXPECT_EQ(j["case"], "sphere-sphere");
   EXPECT_EQ(j["regime"], "close");
-  EXPECT_EQ(j["kernel"], "scalar");
+  EXPECT_EQ(j["kernel"], "closed form");  // sphere-sphere is analytic
+  EXPECT_EQ(j["isa"], batchcol::to_string(batchcol::resolve_instruction_set()));
   EXPECT_EQ(j["pairs"], 2000);
   EXPECT_GT(j["pairs_per_second"].get<double>(), 0.0);
   EXPECT_GT(j["ns_per_pair"].get<double>(), 0.0);
@@ -48,10 +58,11 @@ TEST_F(BenchCli, JsonHasTheDocumentedFields) {
   }
 }
 
-TEST_F(BenchCli, TextOutputNamesTheScalarKernel) {
-  const RunResult r = run("bench --case box-cone --regime overlap --query penetration --pairs 200 --no-peers");
+TEST_F(BenchCli, TextOutputNamesTheKernelAndInstructionSet) {
+  const RunResult r = run("bench --case box-cone --regime overlap --query penetration --pairs 200 --no-peers --isa scalar");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("kernel: scalar reference"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("instruction set: scalar"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("box-cone               gjk"), std::string::npos) << r.out;
 }
 
 // The close regime puts every pair at a reference distance in [1e-4, 1e-2] m; checked here independently of the
@@ -78,19 +89,30 @@ TEST_F(BenchCli, ClosePairsHaveReferenceDistancesInRange) {
   }
 }
 
-TEST_F(BenchCli, SimdIsasAreRefused) {
-  for (const char* isa : {"avx2", "avx512"}) {
-    const RunResult r = run(std::string("bench --case sphere-sphere --pairs 10 --isa ") + isa);
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_EQ(r.err.rfind("batchcol: error: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find("not implemented yet (issue 3)"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+// Every set this CPU runs gives the same errors (the kernels are bitwise equal); a set it lacks exits 2.
+TEST_F(BenchCli, EveryInstructionSetThisCpuRunsAgreesAndOthersExitWith2) {
+  std::string first_error;
+  for (const char* isa : {"scalar", "avx2", "avx512"}) {
+    const RunResult r = run(std::string("bench --case ellipsoid-convex8 --pairs 300 --no-peers --json --isa ") + isa);
+    if (!cpu_runs(isa)) {
+      EXPECT_EQ(r.exit_code, 2) << isa;
+      EXPECT_NE(r.err.find("not supported by this CPU"), std::string::npos) << r.err;
+      EXPECT_TRUE(r.out.empty()) << r.out;
+      continue;
+    }
+    ASSERT_EQ(r.exit_code, 0) << isa << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["isa"], isa);
+    EXPECT_EQ(j["kernel"], "gjk");
+    const std::string errors = j["error_median"].dump() + " " + j["error_max"].dump();
+    if (first_error.empty()) first_error = errors;
+    EXPECT_EQ(errors, first_error) << isa;
   }
 }
 
 TEST_F(BenchCli, BadFlagsExitWith2) {
   for (const char* args : {"bench --case sphere-torus", "bench --case sphere", "bench --regime near",
-                           "bench --pairs 0", "bench --query everything"}) {
+                           "bench --pairs 0", "bench --query everything", "bench --isa sse9"}) {
     const RunResult r = run(args);
     EXPECT_EQ(r.exit_code, 2) << args;
     EXPECT_EQ(r.err.rfind("batchcol: error: ", 0), 0u) << args << ": " << r.err;

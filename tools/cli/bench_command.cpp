@@ -1,7 +1,7 @@
 // `batchcol bench`: times collide() on generated pairs of one shape-type pair per case, in one distance regime,
 // reports throughput and the error against the double-precision reference, and times FCL and Bullet (when found at
-// configure time) on the same pairs and thread count. Only the scalar reference kernels exist so far: --isa avx2 /
-// avx512 are refused (issue 3).
+// configure time) on the same pairs and thread count. --isa picks the instruction set of the SIMD kernels (auto: the
+// best this CPU runs); pair types with a closed form run their scalar analytic kernel whatever the set.
 #include "cli/atomic_output.hpp"
 #include "cli/bench_pairs.hpp"
 #include "cli/bench_peers.hpp"
@@ -28,7 +28,7 @@ namespace {
 
 struct BenchSettings {
   std::string cases = "all", regime = "close", query = "witness", precision = "double", solver = "nesterov";
-  std::string isa = "scalar", save_pairs;
+  std::string isa = "auto", save_pairs;
   int threads = 0, runs = 5;
   std::size_t pairs = 100000;
   std::uint64_t seed = 20240603;
@@ -41,7 +41,7 @@ struct CaseResult {
   double error_median = 0, error_max = 0;
   std::size_t error_pairs = 0, disagreements = 0;
   double reference_min = 0, reference_max = 0;
-  std::string note;
+  std::string note, kernel;
   PeerReport peers;
 };
 
@@ -92,6 +92,7 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
   out.reference_min = *std::min_element(p.reference.begin(), p.reference.end());
   out.reference_max = *std::max_element(p.reference.begin(), p.reference.end());
 
+  out.kernel = kernel_for(p.shapes[p.pairs.shape_a[0]], p.shapes[p.pairs.shape_b[0]], options);
   PairResults results;
   collide(p.shapes, p.pairs, options, results);  // warm-up: page faults, TBB thread start
   std::vector<double> seconds;
@@ -134,7 +135,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
   }
   nlohmann::json j = {{"case", r.bench_case.name()}, {"regime", to_string(regime)}, {"query", to_string(o.level)},
                       {"precision", s.precision}, {"solver", to_string(o.solver)}, {"threads", threads},
-                      {"pairs", s.pairs}, {"kernel", "scalar"}, {"pairs_per_second", r.pairs_per_second},
+                      {"pairs", s.pairs}, {"isa", to_string(o.isa)}, {"kernel", r.kernel}, {"pairs_per_second", r.pairs_per_second},
                       {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
                       {"error_pairs", r.error_pairs}, {"collide_disagreements", r.disagreements},
                       {"reference_min", r.reference_min}, {"reference_max", r.reference_max},
@@ -145,16 +146,17 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
 
 void print_table(const std::vector<CaseResult>& results, const BenchSettings& s, const QueryOptions& o, Regime regime,
                  int threads) {
-  std::printf("kernel: scalar reference (SIMD kernels not implemented yet, issue 3)\n");
+  std::printf("instruction set: %s (closed-form pair types run scalar analytic kernels)\n", to_string(o.isa));
   std::printf("regime %s, query %s, precision %s, solver %s, threads %d, pairs %zu, median of %d runs after 1 warm-up\n",
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(o.solver), threads, s.pairs, s.runs);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
-  std::printf("%-22s %10s %11s %10s %10s", "case", "ns/pair", "pairs/s", boolean ? "disagree" : "err_med",
+  std::printf("%-22s %-11s %10s %11s %10s %10s", "case", "kernel", "ns/pair", "pairs/s", boolean ? "disagree" : "err_med",
               boolean ? "" : "err_max");
   std::printf("   %-s\n", "peers: name ns/pair ratio err_max|disagree");
   for (const CaseResult& r : results) {
-    std::printf("%-22s %10.1f %11.4g ", r.bench_case.name().c_str(), r.ns_per_pair, r.pairs_per_second);
+    std::printf("%-22s %-11s %10.1f %11.4g ", r.bench_case.name().c_str(), r.kernel.c_str(), r.ns_per_pair,
+                r.pairs_per_second);
     if (boolean) std::printf("%10zu %10s", r.disagreements, "");
     else std::printf("%10.2e %10.2e", r.error_median, r.error_max);
     for (const PeerTiming& t : r.peers.timings) {
@@ -175,10 +177,6 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
 }
 
 int run_bench(const BenchSettings& s) {
-  if (s.isa == "avx2" || s.isa == "avx512") {
-    throw InputError("--isa " + s.isa + ": not implemented yet (issue 3); only --isa scalar is available");
-  }
-  if (s.isa != "scalar") throw InputError("--isa " + s.isa + ": unknown instruction set (valid: scalar, avx2, avx512)");
   const std::vector<BenchCase> cases = parse_bench_cases(s.cases);
   const Regime regime = parse_regime(s.regime);
   if (!s.save_pairs.empty() && cases.size() != 1) throw InputError("--save-pairs needs a single --case");
@@ -187,6 +185,12 @@ int run_bench(const BenchSettings& s) {
   options.precision = parse_precision(s.precision);
   options.solver = parse_solver(s.solver);
   options.threads = s.threads;
+  if (s.isa != "auto") {
+    if (s.isa != "scalar" && s.isa != "avx2" && s.isa != "avx512")
+      throw InputError("--isa " + s.isa + ": unknown instruction set (valid: auto, scalar, avx2, avx512)");
+    options.isa = parse_instruction_set(s.isa);
+  }
+  options.isa = resolve_instruction_set(options.isa);  // InputError when this CPU cannot run it
   validate(options);
   const int threads = s.threads > 0 ? s.threads : tbb::info::default_concurrency();
 
@@ -226,7 +230,7 @@ Command add_bench_command(CLI::App& parent) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))
       ->capture_default_str();
   app->add_option("--runs", s->runs, "Timed runs (the median is reported)")->check(CLI::Range(5, 1000))->capture_default_str();
-  app->add_option("--isa", s->isa, "scalar (avx2, avx512: not implemented yet, issue 3)")->capture_default_str();
+  app->add_option("--isa", s->isa, "auto, scalar, avx2 or avx512 (auto: the best this CPU runs)")->capture_default_str();
   app->add_option("--seed", s->seed, "Seed of the pair generator")->capture_default_str();
   app->add_option("--save-pairs", s->save_pairs, "Write the generated pairs as a batch file (single --case)");
   app->add_flag("--no-peers", s->no_peers, "Do not time FCL and Bullet");

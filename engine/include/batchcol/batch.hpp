@@ -46,6 +46,14 @@ const char* to_string(Solver solver);
 const char* to_string(Precision precision);
 const char* to_string(Status status);
 
+/// Instruction set of the narrow-phase kernels (one pair per SIMD lane). `automatic` = the best this CPU runs,
+/// lowered to the environment variable BATCHCOL_ISA (scalar | avx2 | avx512) when that is set. All sets give
+/// bitwise the same results (the wide kernels repeat the scalar reference's operations in the same order).
+enum class InstructionSet : std::uint8_t { automatic, scalar, avx2, avx512 };
+const char* to_string(InstructionSet isa);
+/// What `requested` runs as on this machine (never `automatic`); throws InputError for a set the CPU lacks.
+InstructionSet resolve_instruction_set(InstructionSet requested = InstructionSet::automatic);
+
 struct QueryOptions {
   QueryLevel level = QueryLevel::witness;
   Solver solver = Solver::nesterov;
@@ -64,7 +72,11 @@ struct QueryOptions {
   bool closed_forms = true;       // analytic kernels for sphere/capsule pairs, sphere-box, box-box boolean
                                   // (halfspace pairs always use their closed form: they have no support function)
   int threads = 0;                // 0 = all cores
+  InstructionSet isa = InstructionSet::automatic;
 };
+/// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic, scalar) or "gjk" (the
+/// SIMD GJK, one pair per lane; EPA runs scalar on the overlapping pairs that asked for depth).
+const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options);
 
 /// A batch of pairs in structure-of-arrays layout. `warm_start`, when not empty, holds one support direction per
 /// pair (world frame, e.g. the `direction` output of the previous frame) used to start GJK.

@@ -37,6 +37,7 @@ std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path);
 QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
 Solver parse_solver(const std::string& name);
 Precision parse_precision(const std::string& name);
+InstructionSet parse_instruction_set(const std::string& name);
 
 /// Result rows: pair,status,collide,distance,pa_x,pa_y,pa_z,pb_x,pb_y,pb_z,n_x,n_y,n_z,iterations.
 /// Values the query level did not compute are empty (CSV) or null (JSON). Numbers use 17 significant digits.

@@ -1,0 +1,89 @@
+// Run-time choice of the instruction set: the CPU's best (cpuid through __builtin_cpu_supports), lowered by the
+// environment variable BATCHCOL_ISA, or an explicit request checked against the CPU.
+#include "kernels/simd/wide_gjk.hpp"
+
+#include <cstdlib>
+#include <string>
+
+namespace batchcol::kernels::simd {
+
+// One entry point per instruction set and precision, defined in isa_*.cpp.
+#define BATCHCOL_DECLARE_ISA(ns)                                                                             \
+  namespace ns {                                                                                             \
+  void gjk_lanes_double(const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver);                \
+  void gjk_lanes_float(const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver);                   \
+  }
+BATCHCOL_DECLARE_ISA(scalar)
+BATCHCOL_DECLARE_ISA(avx2)
+BATCHCOL_DECLARE_ISA(avx512)
+#undef BATCHCOL_DECLARE_ISA
+
+bool cpu_has(InstructionSet isa) {
+  switch (isa) {
+    case InstructionSet::avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+             __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
+             __builtin_cpu_supports("fma");
+    case InstructionSet::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    default: return true;
+  }
+}
+
+InstructionSet detected_instruction_set() {
+  if (cpu_has(InstructionSet::avx512)) return InstructionSet::avx512;
+  if (cpu_has(InstructionSet::avx2)) return InstructionSet::avx2;
+  return InstructionSet::scalar;
+}
+
+int lane_count(InstructionSet isa, Precision precision) {
+  const int bytes = isa == InstructionSet::avx512 ? 64 : isa == InstructionSet::avx2 ? 32 : 0;
+  if (bytes == 0) return 1;
+  return precision == Precision::float32 ? bytes / 4 : bytes / 8;
+}
+
+template <>
+void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size_t n, GjkResult<double>* out,
+                       Solver solver) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::gjk_lanes_double(s, n, out, solver);
+    case InstructionSet::avx2: return avx2::gjk_lanes_double(s, n, out, solver);
+    default: return scalar::gjk_lanes_double(s, n, out, solver);
+  }
+}
+
+template <>
+void gjk_lanes<float>(InstructionSet isa, const PairSetup<float>* s, std::size_t n, GjkResult<float>* out,
+                      Solver solver) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver);
+    case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver);
+    default: return scalar::gjk_lanes_float(s, n, out, solver);
+  }
+}
+
+}  // namespace batchcol::kernels::simd
+
+namespace batchcol {
+
+InstructionSet resolve_instruction_set(InstructionSet requested) {
+  using kernels::simd::cpu_has;
+  if (requested == InstructionSet::automatic) {
+    InstructionSet best = kernels::simd::detected_instruction_set();
+    if (const char* env = std::getenv("BATCHCOL_ISA"); env != nullptr && *env != '\0') {
+      InstructionSet cap = InstructionSet::automatic;
+      for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512})
+        if (std::string(env) == to_string(isa)) cap = isa;
+      if (cap == InstructionSet::automatic)
+        throw InputError("environment variable BATCHCOL_ISA='" + std::string(env) +
+                         "' names no instruction set (valid: scalar, avx2, avx512)");
+      if (static_cast<int>(cap) < static_cast<int>(best)) best = cap;
+    }
+    return best;
+  }
+  if (!cpu_has(requested))
+    throw InputError(std::string("instruction set ") + to_string(requested) + " is not supported by this CPU (best: " +
+                     to_string(kernels::simd::detected_instruction_set()) + ")");
+  return requested;
+}
+
+}  // namespace batchcol

@@ -1,0 +1,84 @@
+// The wide-type layer: W lanes of float or double as GCC/Clang vector extensions (one register on AVX2 / AVX-512,
+// W = 1 for the scalar build), with the masks, select, min/max, sqrt, fused multiply-add and gathers the kernels
+// need. Kernels are written once against these types and compiled once per instruction set (see isa_*.cpp).
+//
+// No include guard on purpose: each instruction-set translation unit includes this file once, inside its own
+// namespace and `#pragma GCC target` region, with BATCHCOL_SIMD_BYTES set to its register width (0 = scalar).
+// Intrinsics stay in kernels/simd; public headers never see them.
+#if !defined(BATCHCOL_SIMD_NS) || !defined(BATCHCOL_SIMD_BYTES)
+#error "include kernels/simd/wide.hpp only from an instruction-set translation unit (isa_*.cpp)"
+#endif
+
+template <class T> struct Wide {
+  static constexpr int W = BATCHCOL_SIMD_BYTES == 0 ? 1 : BATCHCOL_SIMD_BYTES / int(sizeof(T));
+  /// Lane integers have the width of T, so comparisons of reals are masks of this type.
+  using Int = std::conditional_t<sizeof(T) == 8, std::int64_t, std::int32_t>;
+  typedef T real __attribute__((vector_size(sizeof(T) * W)));
+  typedef Int mask __attribute__((vector_size(sizeof(T) * W)));  // lanes are 0 (false) or -1 (true)
+};
+
+template <class T> using wreal = typename Wide<T>::real;
+template <class T> using wmask = typename Wide<T>::mask;
+
+/// Lane-wise a ? b : c (a is a mask of 0 / -1 lanes).
+template <class V, class M> inline V select(M a, V b, V c) { return a ? b : c; }
+template <class V> inline V wmin(V a, V b) { return a < b ? a : b; }
+template <class V> inline V wmax(V a, V b) { return a < b ? b : a; }  // std::max(a, b) lane by lane
+
+template <class T> inline wreal<T> wsqrt(wreal<T> a) {
+  constexpr int bytes = int(sizeof(wreal<T>));
+  if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 8) return _mm256_sqrt_pd(a);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 4) return _mm256_sqrt_ps(a);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 8) return _mm512_sqrt_pd(a);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 4) return _mm512_sqrt_ps(a);
+  else {
+    wreal<T> r = a;
+    for (int l = 0; l < Wide<T>::W; ++l) r[l] = std::sqrt(a[l]);
+    return r;
+  }
+}
+
+/// a * b + c with one rounding. The GJK path does not use it: the scalar reference is compiled without
+/// contraction and the wide kernels must repeat its roundings exactly.
+template <class T> inline wreal<T> fmadd(wreal<T> a, wreal<T> b, wreal<T> c) {
+  constexpr int bytes = int(sizeof(wreal<T>));
+  if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 8) return _mm256_fmadd_pd(a, b, c);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 4) return _mm256_fmadd_ps(a, b, c);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 8) return _mm512_fmadd_pd(a, b, c);
+  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 4) return _mm512_fmadd_ps(a, b, c);
+  else {
+    wreal<T> r = a;
+    for (int l = 0; l < Wide<T>::W; ++l) r[l] = std::fma(a[l], b[l], c[l]);
+    return r;
+  }
+}
+
+/// Bit l set when lane l of m is true.
+template <class M> inline std::uint32_t lane_bits(M m) {
+  constexpr int W = int(sizeof(M) / sizeof(m[0]));
+  if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(M) == 32 && W == 4) {
+    return std::uint32_t(_mm256_movemask_pd(_mm256_castsi256_pd(__m256i(m))));
+  } else if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(M) == 32 && W == 8) {
+    return std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))));
+  } else if constexpr (BATCHCOL_SIMD_BYTES == 64 && sizeof(M) == 64 && W == 8) {
+    return std::uint32_t(_mm512_cmplt_epi64_mask(__m512i(m), _mm512_setzero_si512()));
+  } else if constexpr (BATCHCOL_SIMD_BYTES == 64 && sizeof(M) == 64 && W == 16) {
+    return std::uint32_t(_mm512_cmplt_epi32_mask(__m512i(m), _mm512_setzero_si512()));
+  } else {
+    std::uint32_t bits = 0;
+    for (int l = 0; l < W; ++l) bits |= (m[l] != 0 ? 1u : 0u) << l;
+    return bits;
+  }
+}
+template <class M> inline bool any(M m) { return lane_bits(m) != 0; }
+
+/// Lane-wise integer -> real.
+template <class T> inline wreal<T> to_real(wmask<T> i) { return __builtin_convertvector(i, wreal<T>); }
+
+/// r[l] = base[index[l] * stride + offset], converted to T: per-lane loads the compiler may turn into a gather.
+template <class T, class S> inline wreal<T> gather(const S* const* base, const std::uint32_t* index, int stride,
+                                                   int offset) {
+  wreal<T> r{};
+  for (int l = 0; l < Wide<T>::W; ++l) r[l] = T(base[l][std::size_t(index[l]) * stride + offset]);
+  return r;
+}

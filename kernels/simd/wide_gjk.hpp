@@ -1,0 +1,30 @@
+// Entry points of the SIMD narrow phase: GJK for many pairs of one shape-pair type, one pair per lane, compiled
+// once per instruction set (isa_scalar.cpp, isa_avx2.cpp, isa_avx512.cpp) and chosen at run time from the CPU.
+#pragma once
+
+#include "batchcol/batch.hpp"
+#include "kernels/narrowphase.hpp"
+
+#include <cstddef>
+
+namespace batchcol::kernels::simd {
+
+/// (batchcol::resolve_instruction_set() in batch.hpp turns a request into one of these.)
+/// The best instruction set of this CPU among those batchcol is compiled for (scalar, avx2, avx512).
+InstructionSet detected_instruction_set();
+/// True when this CPU can run `isa`.
+bool cpu_has(InstructionSet isa);
+/// Lanes per register for precision T in instruction set `isa` (1 for scalar).
+int lane_count(InstructionSet isa, Precision precision);
+
+/// Runs GJK on setups[0 .. n) with results in out[0 .. n): every setup must need GJK (done == false) and all must
+/// have the same shape types. Each result is bitwise the scalar gjk()'s on the same setup.
+template <class T>
+void gjk_lanes(InstructionSet isa, const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver);
+
+template <>
+void gjk_lanes<double>(InstructionSet, const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver);
+template <>
+void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver);
+
+}  // namespace batchcol::kernels::simd

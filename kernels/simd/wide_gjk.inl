@@ -1,0 +1,474 @@
+// GJK / Nesterov / Polyak across SIMD lanes: one pair per lane, W pairs at once, lanes refilled with the next pair
+// as soon as theirs finishes (iteration counts differ from pair to pair).
+//   Gilbert, Johnson, Keerthi 1988 (GJK); Montanari, Petrinic, Barbieri 2017 (signed-volume projection);
+//   Montaut et al., RSS 2022 (Nesterov-accelerated GJK). The algorithm is kernels/gjk.hpp, line for line: every
+//   branch of the reference becomes a lane mask, and every arithmetic operation is repeated in the same order, so
+//   each lane's result is bitwise the reference's (tested lane by lane in tests/kernels/wide_gjk_test.cpp).
+//
+// No include guard: included once per instruction set by isa_*.cpp after wide.hpp, inside the ISA namespace.
+
+template <class T> struct WideGjk {
+  using real = wreal<T>;
+  using mask = wmask<T>;
+  using Int = typename Wide<T>::Int;
+  static constexpr int W = Wide<T>::W;
+
+  struct V3 {
+    real x, y, z;
+  };
+  static V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  static V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  static V3 neg(const V3& a) { return {-a.x, -a.y, -a.z}; }
+  static V3 scale(real s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+  static V3 divide(const V3& a, real s) { return {a.x / s, a.y / s, a.z / s}; }
+  static real dot(const V3& a, const V3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+  static real norm2(const V3& a) { return dot(a, a); }
+  static real norm(const V3& a) { return wsqrt<T>(norm2(a)); }
+  static V3 cross(const V3& a, const V3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  }
+  static V3 pick(mask m, const V3& a, const V3& b) { return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)}; }
+  static mask equal(const V3& a, const V3& b) { return (a.x == b.x) & (a.y == b.y) & (a.z == b.z); }
+  static real splat(T v) { return real{} + v; }
+  static mask splat_mask(Int v) { return mask{} + v; }
+  static mask truth(bool b) { return splat_mask(b ? Int(-1) : Int(0)); }
+  static mask opposite_sign(real a, real b) {
+    const real zero = splat(T(0));
+    return ((a > zero) & (b < zero)) | ((a < zero) & (b > zero));
+  }
+
+  // ---- Support functions of the cores, W lanes of one shape type (kernels/support.hpp) ----
+  struct Side {
+    ShapeType type = ShapeType::sphere;
+    real s0{}, s1{}, s2{};                 // ShapeCore::size
+    real tri[9]{};                         // triangle vertices
+    const ConvexHull* hull[W] = {};
+    SupportHint hint[W] = {};
+  };
+
+  static V3 support(Side& s, const V3& d, std::uint32_t live) {
+    const real zero = splat(T(0));
+    switch (s.type) {
+      case ShapeType::sphere: return {zero, zero, zero};
+      case ShapeType::capsule: return {zero, zero, select(d.z < zero, -s.s1, s.s1)};
+      case ShapeType::box: return {select(d.x < zero, -s.s0, s.s0), select(d.y < zero, -s.s1, s.s1), select(d.z < zero, -s.s2, s.s2)};
+      case ShapeType::cylinder: {
+        const real rho = wsqrt<T>(d.x * d.x + d.y * d.y);
+        const real z = select(d.z < zero, -s.s1, s.s1);
+        const real k = s.s0 / rho;
+        const mask axis = rho == zero;
+        return {select(axis, zero, d.x * k), select(axis, zero, d.y * k), z};
+      }
+      case ShapeType::cone: {
+        const real rho = wsqrt<T>(d.x * d.x + d.y * d.y);
+        const real h = s.s1;
+        const mask apex = h * d.z >= (-h) * d.z + s.s0 * rho;
+        const real k = s.s0 / rho;
+        const mask axis = rho == zero;
+        const V3 rim = {select(axis, zero, d.x * k), select(axis, zero, d.y * k), -h};
+        return pick(apex, V3{zero, zero, h}, rim);
+      }
+      case ShapeType::ellipsoid: {
+        const V3 rd = {s.s0 * d.x, s.s1 * d.y, s.s2 * d.z};
+        const real n = norm(rd);
+        const mask flat = n == zero;
+        return pick(flat, V3{zero, zero, zero}, V3{(s.s0 * rd.x) / n, (s.s1 * rd.y) / n, (s.s2 * rd.z) / n});
+      }
+      case ShapeType::triangle: {
+        const V3 t0{s.tri[0], s.tri[1], s.tri[2]}, t1{s.tri[3], s.tri[4], s.tri[5]}, t2{s.tri[6], s.tri[7], s.tri[8]};
+        const real d0 = dot(t0, d), d1 = dot(t1, d), d2 = dot(t2, d);
+        return pick((d0 >= d1) & (d0 >= d2), t0, pick(d1 >= d2, t1, t2));
+      }
+      case ShapeType::convex: {
+        // Per lane: small hulls scan, large ones climb the adjacency (kernels/support.hpp, same tie rules).
+        V3 r{zero, zero, zero};
+        for (int l = 0; l < W; ++l) {
+          if (!(live >> l & 1u)) continue;
+          const Vec3<T> p = hull_support(*s.hull[l], Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
+          r.x[l] = p.x();
+          r.y[l] = p.y();
+          r.z[l] = p.z();
+        }
+        return r;
+      }
+      case ShapeType::halfspace: break;
+    }
+    return {zero, zero, zero};
+  }
+
+  // ---- Projection of the origin on a simplex (kernels/simplex_projection.hpp) ----
+  struct Proj {
+    V3 x;
+    mask count;
+    mask index[4];
+    real lambda[4];
+    mask contains;
+  };
+  static Proj pick(mask m, const Proj& a, const Proj& b) {
+    Proj r;
+    r.x = pick(m, a.x, b.x);
+    r.count = select(m, a.count, b.count);
+    for (int i = 0; i < 4; ++i) {
+      r.index[i] = select(m, a.index[i], b.index[i]);
+      r.lambda[i] = select(m, a.lambda[i], b.lambda[i]);
+    }
+    r.contains = select(m, a.contains, b.contains);
+    return r;
+  }
+  static Proj empty() {
+    Proj r;
+    r.x = {splat(T(0)), splat(T(0)), splat(T(0))};
+    r.count = splat_mask(0);
+    for (int i = 0; i < 4; ++i) { r.index[i] = splat_mask(0); r.lambda[i] = splat(T(0)); }
+    r.contains = splat_mask(0);
+    return r;
+  }
+  static Proj vertex(const V3* p, int i) {
+    Proj r = empty();
+    r.x = p[i];
+    r.count = splat_mask(1);
+    r.index[0] = splat_mask(i);
+    r.lambda[0] = splat(T(1));
+    return r;
+  }
+  static Proj segment(const V3* p, int i, int j) {
+    const V3 t = sub(p[j], p[i]);
+    const real tt = norm2(t);
+    const real u = (-dot(p[i], t)) / tt;
+    Proj r = empty();
+    r.count = splat_mask(2);
+    r.index[0] = splat_mask(i);
+    r.index[1] = splat_mask(j);
+    r.lambda[0] = T(1) - u;
+    r.lambda[1] = u;
+    r.x = add(scale(r.lambda[0], p[i]), scale(r.lambda[1], p[j]));
+    const real zero = splat(T(0)), one = splat(T(1));
+    return pick((tt == zero) | (u <= zero), vertex(p, i), pick(u >= one, vertex(p, j), r));
+  }
+  static Proj closer(const Proj& a, const Proj& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
+
+  static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
+    // which 0: the first kept axis (drop + 1) % 3; which 1: the second (drop + 2) % 3.
+    if (which == 0) return select(drop0, p.y, select(drop1, p.z, p.x));
+    return select(drop0, p.z, select(drop1, p.x, p.y));
+  }
+
+  static Proj triangle(const V3* p, int i, int j, int k) {
+    const real zero = splat(T(0));
+    const V3 n = cross(sub(p[j], p[i]), sub(p[k], p[i]));
+    const real nn = norm2(n);
+    const Proj sij = segment(p, i, j), sik = segment(p, i, k), sjk = segment(p, j, k), ski = segment(p, k, i);
+    const Proj edges = closer(closer(sij, sik), sjk);
+    const V3 p0 = scale(dot(p[i], n) / nn, n);
+    const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
+    const mask d1 = ay > ax;
+    const mask d2 = az > select(d1, ay, ax);
+    const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
+    const auto area = [&](const V3& a, const V3& b, const V3& c) {
+      const real au = coordinate(a, drop0, drop1, 0), av = coordinate(a, drop0, drop1, 1);
+      const real bu = coordinate(b, drop0, drop1, 0), bv = coordinate(b, drop0, drop1, 1);
+      const real cu = coordinate(c, drop0, drop1, 0), cv = coordinate(c, drop0, drop1, 1);
+      return (bu - au) * (cv - av) - (bv - av) * (cu - au);
+    };
+    const real C[3] = {area(p0, p[j], p[k]), area(p[i], p0, p[k]), area(p[i], p[j], p0)};
+    const real total = area(p[i], p[j], p[k]);
+    const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
+    const real sum = (C[0] + C[1]) + C[2];
+    Proj face = empty();
+    face.count = splat_mask(3);
+    face.index[0] = splat_mask(i);
+    face.index[1] = splat_mask(j);
+    face.index[2] = splat_mask(k);
+    for (int m = 0; m < 3; ++m) face.lambda[m] = C[m] / sum;
+    face.x = add(add(scale(face.lambda[0], p[i]), scale(face.lambda[1], p[j])), scale(face.lambda[2], p[k]));
+    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order.
+    const Proj* opposite[3] = {&sjk, &ski, &sij};
+    Proj best = empty();
+    mask have = splat_mask(0);
+    for (int m = 0; m < 3; ++m) {
+      const mask candidate = ~inside & opposite_sign(C[m], total);
+      best = pick(candidate & have, closer(best, *opposite[m]), pick(candidate, *opposite[m], best));
+      have |= candidate;
+    }
+    const mask degenerate = (nn == zero) | (total == zero);
+    return pick(degenerate, edges, pick(inside & (sum != zero), face, pick(have, best, edges)));
+  }
+
+  static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
+
+  static Proj tetrahedron(const V3* p) {
+    const real zero = splat(T(0));
+    const real V[4] = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]), -det3(p[0], p[1], p[2])};
+    const real total = ((V[0] + V[1]) + V[2]) + V[3];
+    mask inside = total != zero;
+    for (int m = 0; m < 4; ++m) inside &= ~opposite_sign(V[m], total);
+    Proj in = empty();
+    in.count = splat_mask(4);
+    in.contains = splat_mask(-1);
+    for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
+    if (!any(~inside)) return in;
+    static constexpr int face[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    Proj best = empty();
+    mask have = splat_mask(0);
+    for (int m = 0; m < 4; ++m) {
+      const mask candidate = ~inside & ((total == zero) | opposite_sign(V[m], total));
+      if (!any(candidate)) continue;
+      const Proj f = triangle(p, face[m][0], face[m][1], face[m][2]);
+      best = pick(candidate & have, closer(best, f), pick(candidate, f, best));
+      have |= candidate;
+    }
+    return pick(inside, in, best);
+  }
+
+  // ---- The lanes ----
+  struct Lanes {
+    Side A, B;
+    real R[9]{}, t[3]{};
+    V3 w[4], a[4], b[4];
+    real lambda[4]{};
+    mask count{}, k{}, stale{}, max_iterations{};
+    V3 x, d_prev, last_s, direction;
+    real lower{};
+    mask momentum{}, normalize{}, boolean_only{};
+    real tolerance{}, relative{}, touch{}, core_margin{};
+    std::int64_t pair[W];  // pair index of each lane, -1 when empty
+  };
+
+  static void load_side(Side& s, const ShapeCore<T>& c, int l) {
+    s.type = c.type;
+    s.s0[l] = c.size.x();
+    s.s1[l] = c.size.y();
+    s.s2[l] = c.size.z();
+    for (int v = 0; v < 3; ++v)
+      for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = c.triangle[v][i];
+    s.hull[l] = c.hull;
+    s.hint[l] = SupportHint{};
+  }
+
+  template <class V> static void set_lane(V3& v, int l, const V& p) {
+    v.x[l] = p.x();
+    v.y[l] = p.y();
+    v.z[l] = p.z();
+  }
+  static Vec3<T> get_lane(const V3& v, int l) { return Vec3<T>(v.x[l], v.y[l], v.z[l]); }
+
+  /// Starts pair `p` in lane l: the reference's initialisation, with the first support point computed by the
+  /// scalar Minkowski support itself.
+  static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
+    L.pair[l] = p;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) L.R[3 * i + j][l] = s.X.R(i, j);
+    for (int i = 0; i < 3; ++i) L.t[i][l] = s.X.t[i];
+    load_side(L.A, s.A, l);
+    load_side(L.B, s.B, l);
+    Vec3<T> init = s.initial_direction;
+    if (!(kernels::norm2(init) > T(0))) init = Vec3<T>::UnitX();
+    MinkowskiDifference<T> D{&s.A, &s.B, s.X, {}, {}};
+    const SupportPoint<T> first = D.support(-init);
+    L.A.hint[l] = D.hint_a;
+    L.B.hint[l] = D.hint_b;
+    set_lane(L.w[0], l, first.w);
+    set_lane(L.a[0], l, first.a);
+    set_lane(L.b[0], l, first.b);
+    L.lambda[0][l] = T(1);
+    L.count[l] = 1;
+    set_lane(L.x, l, first.w);
+    set_lane(L.d_prev, l, init);
+    set_lane(L.last_s, l, first.w);
+    set_lane(L.direction, l, Vec3<T>::Zero());
+    L.lower[l] = -std::numeric_limits<T>::infinity();
+    L.k[l] = 0;
+    L.stale[l] = 0;
+    L.max_iterations[l] = s.params.max_iterations;
+    L.momentum[l] = solver != Solver::gjk ? -1 : 0;
+    L.normalize[l] = s.params.normalize_momentum ? -1 : 0;
+    L.boolean_only[l] = s.params.boolean_only ? -1 : 0;
+    L.tolerance[l] = s.params.tolerance;
+    L.relative[l] = s.params.relative_tolerance;
+    L.touch[l] = s.params.touch_tolerance;
+    L.core_margin[l] = s.params.core_margin;
+  }
+
+  /// Writes lane l's result as the reference's GjkResult.
+  static void finish(const Lanes& L, int l, GjkStatus status, GjkResult<T>& r) {
+    r.status = status;
+    r.iterations = int(L.k[l]);
+    r.simplex.count = int(L.count[l]);
+    for (int m = 0; m < 4; ++m) {
+      r.simplex.v[m].w = get_lane(L.w[m], l);
+      r.simplex.v[m].a = get_lane(L.a[m], l);
+      r.simplex.v[m].b = get_lane(L.b[m], l);
+      r.simplex.lambda[m] = L.lambda[m][l];
+    }
+    r.x = status == GjkStatus::overlap ? Vec3<T>::Zero() : get_lane(L.x, l);
+    r.direction = get_lane(L.direction, l);
+    r.lower_bound = L.lower[l];
+  }
+
+  /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp).
+  static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
+    a = support(L.A, dir, live);
+    const V3 m = neg(dir);
+    const real* R = L.R;
+    const V3 d_in_b = {(R[0] * m.x + R[3] * m.y) + R[6] * m.z, (R[1] * m.x + R[4] * m.y) + R[7] * m.z,
+                       (R[2] * m.x + R[5] * m.y) + R[8] * m.z};
+    const V3 sb = support(L.B, d_in_b, live);
+    b = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + L.t[0], ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + L.t[1],
+         ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + L.t[2]};
+    w = sub(a, b);
+  }
+
+  static V3 face_direction(const Lanes& L, const V3& x) {
+    const V3 n = cross(sub(L.w[1], L.w[0]), sub(L.w[2], L.w[0]));
+    const real w = wmax(wmax(norm(L.w[0]), norm(L.w[1])), norm(L.w[2]));
+    const real xn = norm(x), nn = norm(n);
+    const mask keep = ~(nn > xn * w);
+    const V3 signed_n = pick(dot(n, x) < splat(T(0)), neg(n), n);
+    return pick(keep, x, scale(xn / nn, signed_n));
+  }
+
+  /// Runs GJK on setups[0 .. n): every pair must have the same (A type, B type) and need GJK (setup.done false).
+  static void run(const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver) {
+    if (n == 0) return;
+    Lanes L;
+    L.A.type = setups[0].A.type;
+    L.B.type = setups[0].B.type;
+    std::size_t next = 0;
+    for (int l = 0; l < W; ++l) {
+      if (next < n) refill(L, l, setups[next], std::int64_t(next), solver), ++next;
+      else L.pair[l] = -1;
+    }
+    const real zero = splat(T(0)), one = splat(T(1));
+    // Finishes lane l with `status` and refills it (or empties it). Returns the lane bit if it became empty.
+    const auto close = [&](int l, GjkStatus status) {
+      finish(L, l, status, out[L.pair[l]]);
+      if (next < n) refill(L, l, setups[next], std::int64_t(next), solver), ++next;
+      else L.pair[l] = -1;
+    };
+    const auto active_bits = [&] {
+      std::uint32_t bits = 0;
+      for (int l = 0; l < W; ++l) bits |= (L.pair[l] >= 0 ? 1u : 0u) << l;
+      return bits;
+    };
+
+    for (std::uint32_t active = active_bits(); active != 0; active = active_bits()) {
+      // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
+      const mask at_budget = L.k >= L.max_iterations;
+      if (const std::uint32_t bits = lane_bits(at_budget) & active) {
+        const mask touching = norm(L.x) <= L.touch;
+        for (int l = 0; l < W; ++l)
+          if (bits >> l & 1u) close(l, touching[l] ? GjkStatus::overlap : GjkStatus::max_iterations);
+        continue;  // refilled lanes start with k = 0
+      }
+      mask live = splat_mask(0);
+      for (int l = 0; l < W; ++l) live[l] = (active >> l & 1u) ? -1 : 0;
+      L.k = select(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
+
+      const V3 x = L.x;
+      const real xx = norm2(x);
+      const real xn = wsqrt<T>(xx);
+      const mask ends_overlap = live & (xn <= L.touch);
+      const mask ends_collision = live & ~ends_overlap & L.boolean_only & (xn <= L.core_margin);
+      live &= ~ends_overlap & ~ends_collision;
+
+      V3 d = x;
+      const real kk = to_real<T>(L.k);  // k + 1 of the reference (k already incremented)
+      if (solver == Solver::nesterov) {
+        const real delta = kk / (kk + T(2));  // T(k + 1) / T(k + 3)
+        const V3 y = add(scale(delta, x), scale(one - delta, L.last_s));
+        const real yn = norm(y), dn = norm(L.d_prev);
+        const mask normalized = L.momentum & L.normalize & (yn > zero) & (dn > zero);
+        const mask unnormalized = L.momentum & ~L.normalize;
+        const V3 dn_dir = add(divide(scale(delta, L.d_prev), dn), divide(scale(one - delta, y), yn));
+        const V3 du_dir = add(scale(delta, L.d_prev), scale(one - delta, y));
+        d = pick(normalized, dn_dir, pick(unnormalized, du_dir, d));
+      } else if (solver == Solver::polyak) {
+        const real beta = one / (kk + T(1));  // T(1) / T(k + 2)
+        d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
+      }
+      d = pick(norm(d) > zero, d, x);
+      const mask plain = equal(d, x);
+      const mask face = live & plain & (L.count == splat_mask(3));
+      if (any(face)) d = pick(face, face_direction(L, x), d);
+
+      const std::uint32_t live_bits = lane_bits(live);
+      V3 sw, sa, sb;
+      minkowski(L, neg(d), live_bits, sw, sa, sb);
+      const real lb = dot(sw, d) / norm(d);
+      const mask progress = lb > L.lower + T(0.1) * (xn - L.lower);
+      L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
+      L.lower = select(live, wmax(L.lower, lb), L.lower);
+      L.direction = pick(live, d, L.direction);
+      const mask ends_separated = live & L.boolean_only & (lb > L.core_margin);
+      live &= ~ends_separated;
+
+      const real tol = wmax(L.tolerance, L.relative * xn);
+      const mask ends_converged = live & plain & (xn - lb <= tol);
+      live &= ~ends_converged;
+      const mask gap_closed = live & ~plain & (xn - L.lower <= tol);
+      const mask no_move = live & ~plain & ~gap_closed & (xx - dot(x, sw) <= tol * xn);
+      L.momentum &= ~(gap_closed | no_move);
+      live &= ~(gap_closed | no_move);
+
+      mask ends_contains = splat_mask(0), ends_stall = splat_mask(0), ends_stall_overlap = splat_mask(0);
+      if (any(live)) {
+        // Add s at slot `count`, project the origin on the simplex, keep the support set.
+        V3 pw[4], pa[4], pb[4];
+        for (int m = 0; m < 4; ++m) {
+          const mask here = live & (L.count == splat_mask(m));
+          pw[m] = pick(here, sw, L.w[m]);
+          pa[m] = pick(here, sa, L.a[m]);
+          pb[m] = pick(here, sb, L.b[m]);
+        }
+        const mask n_after = L.count + 1;
+        const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
+        Proj proj = empty();
+        if (any(live & two)) proj = pick(two, segment(pw, 0, 1), proj);
+        if (any(live & three)) proj = pick(three, triangle(pw, 0, 1, 2), proj);
+        if (any(live & (n_after == splat_mask(4)))) proj = pick(n_after == splat_mask(4), tetrahedron(pw), proj);
+        const real next_xx = norm2(proj.x);
+
+        ends_contains = live & proj.contains;
+        const mask no_decrease = live & ~ends_contains & ~(next_xx < xx);
+        L.momentum &= ~(no_decrease & ~plain);
+        const mask stall = no_decrease & plain;
+        ends_stall_overlap = stall & (xn <= T(2) * L.touch);
+        ends_stall = stall & ~ends_stall_overlap;
+        const mask moves = live & ~no_decrease;  // includes ends_contains: S = next, x = proj.x
+        const mask lagging = (xn - wsqrt<T>(next_xx) <= tol) | (L.stale >= splat_mask(4));
+        L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
+        for (int m = 0; m < 4; ++m) {
+          V3 nw = pw[0], na = pa[0], nb = pb[0];
+          for (int q = 1; q < 4; ++q) {
+            const mask from_q = proj.index[m] == splat_mask(q);
+            nw = pick(from_q, pw[q], nw);
+            na = pick(from_q, pa[q], na);
+            nb = pick(from_q, pb[q], nb);
+          }
+          L.w[m] = pick(moves, nw, L.w[m]);
+          L.a[m] = pick(moves, na, L.a[m]);
+          L.b[m] = pick(moves, nb, L.b[m]);
+          L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);
+        }
+        L.count = select(moves, proj.count, L.count);
+        L.x = pick(moves, proj.x, L.x);
+        const mask steps = moves & ~ends_contains;
+        L.d_prev = pick(steps, d, L.d_prev);
+        L.last_s = pick(steps, sw, L.last_s);
+      }
+
+      const std::uint32_t b_overlap = lane_bits(ends_overlap | ends_contains | ends_stall_overlap);
+      const std::uint32_t b_collision = lane_bits(ends_collision), b_separated = lane_bits(ends_separated);
+      const std::uint32_t b_converged = lane_bits(ends_converged), b_stall = lane_bits(ends_stall);
+      if ((b_overlap | b_collision | b_separated | b_converged | b_stall) == 0) continue;
+      for (int l = 0; l < W; ++l) {
+        const std::uint32_t bit = 1u << l;
+        if (b_overlap & bit) close(l, GjkStatus::overlap);
+        else if (b_collision & bit) close(l, GjkStatus::collision_proven);
+        else if (b_separated & bit) close(l, GjkStatus::separated_proven);
+        else if (b_converged & bit) close(l, GjkStatus::converged);
+        else if (b_stall & bit) close(l, GjkStatus::stalled);
+      }
+    }
+  }
+};

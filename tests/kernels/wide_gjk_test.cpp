@@ -1,0 +1,129 @@
+// The SIMD GJK against the scalar reference, lane by lane: for every shape-pair type, solver, precision, query
+// kind (distance or boolean) and every instruction set this CPU runs, each pair's GjkResult must be bitwise the
+// reference gjk()'s (status, iterations, simplex, x, lower bound, direction).
+#include "kernels/simd/wide_gjk.hpp"
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+namespace batchcol {
+namespace {
+
+using testing::Rng;
+
+std::vector<InstructionSet> runnable_sets() {
+  std::vector<InstructionSet> sets;
+  for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512})
+    if (kernels::simd::cpu_has(isa)) sets.push_back(isa);
+  return sets;
+}
+
+template <class T> bool same_bits(const T& a, const T& b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
+
+template <class T>
+std::string compare(const kernels::GjkResult<T>& want, const kernels::GjkResult<T>& got) {
+  if (want.status != got.status) return "status";
+  if (want.iterations != got.iterations) return "iterations " + std::to_string(want.iterations) + " vs " +
+                                                 std::to_string(got.iterations);
+  if (want.simplex.count != got.simplex.count) return "simplex count";
+  for (int m = 0; m < want.simplex.count; ++m) {
+    if (!same_bits(want.simplex.lambda[m], got.simplex.lambda[m])) return "lambda";
+    if (!same_bits(want.simplex.v[m].w, got.simplex.v[m].w)) return "simplex w";
+    if (!same_bits(want.simplex.v[m].a, got.simplex.v[m].a)) return "simplex a";
+    if (!same_bits(want.simplex.v[m].b, got.simplex.v[m].b)) return "simplex b";
+  }
+  if (!same_bits(want.x, got.x)) return "x";
+  if (!same_bits(want.lower_bound, got.lower_bound)) return "lower bound";
+  if (!same_bits(want.direction, got.direction)) return "direction";
+  return "";
+}
+
+/// Pairs of types (ta, tb): B around A at centre distances from overlapping to ~0.5 m, random rotations.
+template <class T>
+std::vector<kernels::PairSetup<T>> make_setups(Rng& rng, ShapeType ta, ShapeType tb, int count,
+                                               const QueryOptions& options, std::vector<Shape>& keep) {
+  std::vector<kernels::PairSetup<T>> setups;
+  for (int i = 0; setups.size() < std::size_t(count) && i < 20 * count; ++i) {
+    keep.push_back(ta == ShapeType::convex && i % 3 == 0
+                       ? Shape::convex(testing::random_hull_points(rng, 120, 0.05, 0.3))  // hill climbing
+                       : testing::random_shape(rng, ta));
+    const Shape& a = keep.back();
+    keep.push_back(testing::random_shape(rng, tb));
+    const Shape& b = keep.back();
+    kernels::RelativePose X;
+    X.R = testing::random_rotation(rng).toRotationMatrix();
+    X.t = testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.9);
+    Eigen::Vector3d warm = Eigen::Vector3d::Constant(std::nan(""));
+    if (i % 4 == 1) warm = testing::random_unit_vector(rng);
+    const kernels::PairSetup<T> s = kernels::setup_pair<T>(a, b, X, warm, options);
+    if (!s.done) setups.push_back(s);
+  }
+  return setups;
+}
+
+template <class T> void check_all_types(Solver solver, QueryLevel level) {
+  Rng rng(1234 + int(solver) * 7 + int(level));
+  QueryOptions options;
+  options.solver = solver;
+  options.level = level;
+  options.tolerance = 1e-9;
+  options.margin = level == QueryLevel::boolean ? 0.01 : 0.0;
+  const auto sets = runnable_sets();
+  int compared = 0, spread = 0;
+  for (const ShapeType ta : testing::bounded_shape_types()) {
+    for (const ShapeType tb : testing::bounded_shape_types()) {
+      std::vector<Shape> keep;
+      keep.reserve(4000);
+      const auto setups = make_setups<T>(rng, ta, tb, 37, options, keep);
+      if (setups.empty()) continue;  // closed forms only (sphere / capsule pairs, sphere-box)
+      std::vector<kernels::GjkResult<T>> want;
+      int lo = 1 << 30, hi = 0;
+      for (const auto& s : setups) {
+        want.push_back(kernels::gjk(s.difference(), s.initial_direction, s.params));
+        lo = std::min(lo, want.back().iterations);
+        hi = std::max(hi, want.back().iterations);
+      }
+      spread = std::max(spread, hi - lo);
+      for (const InstructionSet isa : sets) {
+        std::vector<kernels::GjkResult<T>> got(setups.size());
+        kernels::simd::gjk_lanes<T>(isa, setups.data(), setups.size(), got.data(), solver);
+        for (std::size_t i = 0; i < setups.size(); ++i) {
+          const std::string diff = compare(want[i], got[i]);
+          ASSERT_EQ(diff, "") << to_string(ta) << "-" << to_string(tb) << " pair " << i << " isa " << to_string(isa)
+                              << " solver " << to_string(solver) << " level " << to_string(level);
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_GE(spread, 4) << "lanes should finish at different iterations";
+}
+
+TEST(WideGjk, EqualsReferenceBitwiseDouble) {
+  for (const Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
+    check_all_types<double>(solver, QueryLevel::witness);
+    check_all_types<double>(solver, QueryLevel::boolean);
+  }
+}
+
+TEST(WideGjk, EqualsReferenceBitwiseFloat) {
+  for (const Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
+    check_all_types<float>(solver, QueryLevel::witness);
+    check_all_types<float>(solver, QueryLevel::boolean);
+  }
+}
+
+TEST(WideGjk, RunsEverySetThisCpuHas) {
+  const auto sets = runnable_sets();
+  EXPECT_EQ(sets.front(), InstructionSet::scalar);
+  EXPECT_EQ(sets.back(), kernels::simd::detected_instruction_set());
+  if (!kernels::simd::cpu_has(InstructionSet::avx512))
+    std::printf("this CPU has no AVX-512: the avx512 kernels are compiled but not run here\n");
+}
+
+}  // namespace
+}  // namespace batchcol
