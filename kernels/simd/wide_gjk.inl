@@ -153,25 +153,26 @@ template <class T> struct WideGjk {
     return select(drop0, p.z, select(drop1, p.x, p.y));
   }
 
-  static Proj triangle(const V3* p, int i, int j, int k) {
+  /// `want`: the lanes whose result is used; the edge cases are computed only when one of them needs them.
+  static Proj triangle(const V3* p, int i, int j, int k, mask want) {
     const real zero = splat(T(0));
     const V3 n = cross(sub(p[j], p[i]), sub(p[k], p[i]));
     const real nn = norm2(n);
-    const Proj sij = segment(p, i, j), sik = segment(p, i, k), sjk = segment(p, j, k), ski = segment(p, k, i);
-    const Proj edges = closer(closer(sij, sik), sjk);
     const V3 p0 = scale(dot(p[i], n) / nn, n);
     const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
     const mask d1 = ay > ax;
     const mask d2 = az > select(d1, ay, ax);
     const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
-    const auto area = [&](const V3& a, const V3& b, const V3& c) {
-      const real au = coordinate(a, drop0, drop1, 0), av = coordinate(a, drop0, drop1, 1);
-      const real bu = coordinate(b, drop0, drop1, 0), bv = coordinate(b, drop0, drop1, 1);
-      const real cu = coordinate(c, drop0, drop1, 0), cv = coordinate(c, drop0, drop1, 1);
+    // The four points in the kept coordinates (u, v), selected once.
+    const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
+    const real ui = coordinate(p[i], drop0, drop1, 0), vi = coordinate(p[i], drop0, drop1, 1);
+    const real uj = coordinate(p[j], drop0, drop1, 0), vj = coordinate(p[j], drop0, drop1, 1);
+    const real uk = coordinate(p[k], drop0, drop1, 0), vk = coordinate(p[k], drop0, drop1, 1);
+    const auto area = [](real au, real av, real bu, real bv, real cu, real cv) {
       return (bu - au) * (cv - av) - (bv - av) * (cu - au);
     };
-    const real C[3] = {area(p0, p[j], p[k]), area(p[i], p0, p[k]), area(p[i], p[j], p0)};
-    const real total = area(p[i], p[j], p[k]);
+    const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
+    const real total = area(ui, vi, uj, vj, uk, vk);
     const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
     const real sum = (C[0] + C[1]) + C[2];
     Proj face = empty();
@@ -181,6 +182,11 @@ template <class T> struct WideGjk {
     face.index[2] = splat_mask(k);
     for (int m = 0; m < 3; ++m) face.lambda[m] = C[m] / sum;
     face.x = add(add(scale(face.lambda[0], p[i]), scale(face.lambda[1], p[j])), scale(face.lambda[2], p[k]));
+    const mask degenerate = (nn == zero) | (total == zero);
+    const mask use_face = ~degenerate & inside & (sum != zero);
+    if (!any(want & ~use_face)) return face;
+    const Proj sij = segment(p, i, j), sik = segment(p, i, k), sjk = segment(p, j, k), ski = segment(p, k, i);
+    const Proj edges = closer(closer(sij, sik), sjk);
     // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order.
     const Proj* opposite[3] = {&sjk, &ski, &sij};
     Proj best = empty();
@@ -190,13 +196,12 @@ template <class T> struct WideGjk {
       best = pick(candidate & have, closer(best, *opposite[m]), pick(candidate, *opposite[m], best));
       have |= candidate;
     }
-    const mask degenerate = (nn == zero) | (total == zero);
-    return pick(degenerate, edges, pick(inside & (sum != zero), face, pick(have, best, edges)));
+    return pick(degenerate, edges, pick(use_face, face, pick(have, best, edges)));
   }
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
-  static Proj tetrahedron(const V3* p) {
+  static Proj tetrahedron(const V3* p, mask want) {
     const real zero = splat(T(0));
     const real V[4] = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]), -det3(p[0], p[1], p[2])};
     const real total = ((V[0] + V[1]) + V[2]) + V[3];
@@ -206,14 +211,14 @@ template <class T> struct WideGjk {
     in.count = splat_mask(4);
     in.contains = splat_mask(-1);
     for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
-    if (!any(~inside)) return in;
+    if (!any(want & ~inside)) return in;
     static constexpr int face[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
     Proj best = empty();
     mask have = splat_mask(0);
     for (int m = 0; m < 4; ++m) {
       const mask candidate = ~inside & ((total == zero) | opposite_sign(V[m], total));
-      if (!any(candidate)) continue;
-      const Proj f = triangle(p, face[m][0], face[m][1], face[m][2]);
+      if (!any(want & candidate)) continue;
+      const Proj f = triangle(p, face[m][0], face[m][1], face[m][2], want & candidate);
       best = pick(candidate & have, closer(best, f), pick(candidate, f, best));
       have |= candidate;
     }
@@ -424,8 +429,9 @@ template <class T> struct WideGjk {
         const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
         Proj proj = empty();
         if (any(live & two)) proj = pick(two, segment(pw, 0, 1), proj);
-        if (any(live & three)) proj = pick(three, triangle(pw, 0, 1, 2), proj);
-        if (any(live & (n_after == splat_mask(4)))) proj = pick(n_after == splat_mask(4), tetrahedron(pw), proj);
+        const mask four = n_after == splat_mask(4);
+        if (any(live & three)) proj = pick(three, triangle(pw, 0, 1, 2, live & three), proj);
+        if (any(live & four)) proj = pick(four, tetrahedron(pw, live & four), proj);
         const real next_xx = norm2(proj.x);
 
         ends_contains = live & proj.contains;
