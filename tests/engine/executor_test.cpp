@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 namespace batchcol {
 namespace {
@@ -56,6 +58,55 @@ TEST(Executor, BitwiseIdenticalForOneAndTwoThreadsAtEveryLevelAndPrecision) {
       for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
         EXPECT_TRUE(bitwise_equal((one.*m).x, (two.*m).x) && bitwise_equal((one.*m).z, (two.*m).z));
     }
+}
+
+// Every instruction set this CPU runs gives bitwise the same results as the scalar build (and so as the
+// reference: tests/kernels/wide_gjk_test.cpp), at every level and precision, y component included.
+TEST(Executor, BitwiseIdenticalForEveryInstructionSetThisCpuRuns) {
+  const Scene s = mixed_scene(4000, 11);
+  for (Precision p : {Precision::float64, Precision::float32})
+    for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
+      QueryOptions o;
+      o.level = level;
+      o.precision = p;
+      o.isa = InstructionSet::scalar;
+      PairResults want;
+      collide(s.shapes, s.batch, o, want);
+      for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
+        o.isa = isa;
+        PairResults got;
+        try {
+          collide(s.shapes, s.batch, o, got);
+        } catch (const InputError& e) {  // a set this CPU lacks: refused up front, never run
+          EXPECT_NE(std::string(e.what()).find("not supported by this CPU"), std::string::npos) << e.what();
+          continue;
+        }
+        EXPECT_EQ(want.status, got.status);
+        EXPECT_EQ(want.collide, got.collide);
+        EXPECT_EQ(want.iterations, got.iterations);
+        EXPECT_TRUE(bitwise_equal(want.distance, got.distance));
+        for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal, &PairResults::direction})
+          EXPECT_TRUE(bitwise_equal((want.*m).x, (got.*m).x) && bitwise_equal((want.*m).y, (got.*m).y) &&
+                      bitwise_equal((want.*m).z, (got.*m).z));
+      }
+    }
+}
+
+// BATCHCOL_ISA lowers the automatic choice; a value naming no set is an input error.
+TEST(Executor, EnvironmentVariableLowersTheInstructionSet) {
+  const char* saved = std::getenv("BATCHCOL_ISA");
+  const std::string keep = saved ? saved : "";
+  unsetenv("BATCHCOL_ISA");
+  const InstructionSet best = resolve_instruction_set();
+  EXPECT_NE(best, InstructionSet::automatic);
+  setenv("BATCHCOL_ISA", "scalar", 1);
+  EXPECT_EQ(resolve_instruction_set(), InstructionSet::scalar);
+  setenv("BATCHCOL_ISA", "avx512", 1);  // a cap above the CPU's best leaves the best
+  EXPECT_EQ(resolve_instruction_set(), best);
+  setenv("BATCHCOL_ISA", "sse9", 1);
+  EXPECT_THROW(resolve_instruction_set(), InputError);
+  if (saved) setenv("BATCHCOL_ISA", keep.c_str(), 1);
+  else unsetenv("BATCHCOL_ISA");
 }
 
 TEST(Executor, ResultsComeBackInInputOrder) {
