@@ -79,21 +79,61 @@ template <class T> struct WideGjk {
         const real d0 = dot(t0, d), d1 = dot(t1, d), d2 = dot(t2, d);
         return pick((d0 >= d1) & (d0 >= d2), t0, pick(d1 >= d2, t1, t2));
       }
-      case ShapeType::convex: {
-        // Per lane: small hulls scan, large ones climb the adjacency (kernels/support.hpp, same tie rules).
-        V3 r{zero, zero, zero};
-        for (int l = 0; l < W; ++l) {
-          if (!(live >> l & 1u)) continue;
-          const Vec3<T> p = hull_support(*s.hull[l], Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
-          r.x[l] = p.x();
-          r.y[l] = p.y();
-          r.z[l] = p.z();
-        }
-        return r;
-      }
+      case ShapeType::convex: return hull_support_lanes(s, d, live);
       case ShapeType::halfspace: break;
     }
     return {zero, zero, zero};
+  }
+
+  /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
+  /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
+  /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
+  /// first vertex with the largest dot product wins.
+  static V3 hull_support_lanes(Side& s, const V3& d, std::uint32_t live) {
+    const real zero = splat(T(0));
+    std::size_t most = 0;
+    bool all_small = true;
+    for (int l = 0; l < W; ++l) {
+      if (!(live >> l & 1u)) continue;
+      const std::size_t n = s.hull[l]->vertices.size();
+      all_small = all_small && n < kHillClimbMinVertices;
+      most = std::max(most, n);
+    }
+    V3 r{zero, zero, zero};
+    if (live == 0) return r;
+    if (!all_small) {
+      for (int l = 0; l < W; ++l) {
+        if (!(live >> l & 1u)) continue;
+        const Vec3<T> p = hull_support(*s.hull[l], Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
+        r.x[l] = p.x();
+        r.y[l] = p.y();
+        r.z[l] = p.z();
+      }
+      return r;
+    }
+    const double* base[W];
+    std::uint32_t last[W], index[W];
+    const int first_live = __builtin_ctz(live);
+    for (int l = 0; l < W; ++l) {
+      const ConvexHull& h = *s.hull[(live >> l & 1u) ? l : first_live];
+      base[l] = h.vertices.front().data();
+      last[l] = std::uint32_t(h.vertices.size() - 1);
+      index[l] = 0;
+    }
+    const auto dot_at = [&](const std::uint32_t* at) {
+      return (gather<T>(base, at, 3, 0) * d.x + gather<T>(base, at, 3, 1) * d.y) + gather<T>(base, at, 3, 2) * d.z;
+    };
+    real best = dot_at(index);
+    mask best_index = splat_mask(0);
+    for (std::uint32_t i = 1; i < most; ++i) {
+      for (int l = 0; l < W; ++l) index[l] = std::min(i, last[l]);  // a repeated vertex never wins a strict '>'
+      const real di = dot_at(index);
+      const mask better = di > best;
+      best = select(better, di, best);
+      best_index = select(better, splat_mask(Int(i)), best_index);
+    }
+    for (int l = 0; l < W; ++l) index[l] = std::uint32_t(best_index[l]);
+    return {gather<T>(base, index, 3, 0), gather<T>(base, index, 3, 1), gather<T>(base, index, 3, 2)};
   }
 
   // ---- Projection of the origin on a simplex (kernels/simplex_projection.hpp) ----
