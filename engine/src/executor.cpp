@@ -105,7 +105,8 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
   std::size_t pending = 0;
   ShapeType pending_a = ShapeType::sphere, pending_b = ShapeType::sphere;
   const auto flush = [&] {
-    kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver);
+    kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver,
+                                options.level >= QueryLevel::witness);
     for (std::size_t j = 0; j < pending; ++j)
       write_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j], s.pairs[j], out);
     pending = 0;

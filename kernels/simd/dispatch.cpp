@@ -10,8 +10,8 @@ namespace batchcol::kernels::simd {
 // One entry point per instruction set and precision, defined in isa_*.cpp.
 #define BATCHCOL_DECLARE_ISA(ns)                                                                             \
   namespace ns {                                                                                             \
-  void gjk_lanes_double(const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver);                \
-  void gjk_lanes_float(const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver);                   \
+  void gjk_lanes_double(const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver, bool);                \
+  void gjk_lanes_float(const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);                   \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -43,21 +43,21 @@ int lane_count(InstructionSet isa, Precision precision) {
 
 template <>
 void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size_t n, GjkResult<double>* out,
-                       Solver solver) {
+                       Solver solver, bool points) {
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_lanes_double(s, n, out, solver);
-    case InstructionSet::avx2: return avx2::gjk_lanes_double(s, n, out, solver);
-    default: return scalar::gjk_lanes_double(s, n, out, solver);
+    case InstructionSet::avx512: return avx512::gjk_lanes_double(s, n, out, solver, points);
+    case InstructionSet::avx2: return avx2::gjk_lanes_double(s, n, out, solver, points);
+    default: return scalar::gjk_lanes_double(s, n, out, solver, points);
   }
 }
 
 template <>
 void gjk_lanes<float>(InstructionSet isa, const PairSetup<float>* s, std::size_t n, GjkResult<float>* out,
-                      Solver solver) {
+                      Solver solver, bool points) {
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver);
-    case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver);
-    default: return scalar::gjk_lanes_float(s, n, out, solver);
+    case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver, points);
+    case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver, points);
+    default: return scalar::gjk_lanes_float(s, n, out, solver, points);
   }
 }
 

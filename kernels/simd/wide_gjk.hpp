@@ -18,13 +18,15 @@ bool cpu_has(InstructionSet isa);
 int lane_count(InstructionSet isa, Precision precision);
 
 /// Runs GJK on setups[0 .. n) with results in out[0 .. n): every setup must need GJK (done == false) and all must
-/// have the same shape types. Each result is bitwise the scalar gjk()'s on the same setup.
+/// have the same shape types. Each result is bitwise the scalar gjk()'s on the same setup. With `points` false
+/// the simplex keeps only w = a - b (enough below QueryLevel::witness, and cheaper): its a and b come back NaN.
 template <class T>
-void gjk_lanes(InstructionSet isa, const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver);
+void gjk_lanes(InstructionSet isa, const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver,
+               bool points = true);
 
 template <>
-void gjk_lanes<double>(InstructionSet, const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver);
+void gjk_lanes<double>(InstructionSet, const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver, bool);
 template <>
-void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver);
+void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);
 
 }  // namespace batchcol::kernels::simd

@@ -225,17 +225,22 @@ template <class T> struct WideGjk {
     const mask degenerate = (nn == zero) | (total == zero);
     const mask use_face = ~degenerate & inside & (sum != zero);
     if (!any(want & ~use_face)) return face;
-    const Proj sij = segment(p, i, j), sik = segment(p, i, k), sjk = segment(p, j, k), ski = segment(p, k, i);
-    const Proj edges = closer(closer(sij, sik), sjk);
-    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order.
-    const Proj* opposite[3] = {&sjk, &ski, &sij};
+    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order; each
+    // edge is computed only when a wanted lane has it as a candidate.
+    const int from[3] = {j, k, i}, to[3] = {k, i, j};
     Proj best = empty();
     mask have = splat_mask(0);
     for (int m = 0; m < 3; ++m) {
       const mask candidate = ~inside & opposite_sign(C[m], total);
-      best = pick(candidate & have, closer(best, *opposite[m]), pick(candidate, *opposite[m], best));
+      if (!any(want & ~degenerate & candidate)) continue;
+      const Proj e = segment(p, from[m], to[m]);
+      best = pick(candidate & have, closer(best, e), pick(candidate, e, best));
       have |= candidate;
     }
+    // All three edges: degenerate triangles, and the rare lanes where no weight has the wrong sign.
+    Proj edges = best;
+    if (any(want & ~use_face & (degenerate | ~have)))
+      edges = closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k));
     return pick(degenerate, edges, pick(use_face, face, pick(have, best, edges)));
   }
 
@@ -335,14 +340,14 @@ template <class T> struct WideGjk {
   }
 
   /// Writes lane l's result as the reference's GjkResult.
-  static void finish(const Lanes& L, int l, GjkStatus status, GjkResult<T>& r) {
+  static void finish(const Lanes& L, int l, GjkStatus status, GjkResult<T>& r, bool points) {
     r.status = status;
     r.iterations = int(L.k[l]);
     r.simplex.count = int(L.count[l]);
     for (int m = 0; m < 4; ++m) {
       r.simplex.v[m].w = get_lane(L.w[m], l);
-      r.simplex.v[m].a = get_lane(L.a[m], l);
-      r.simplex.v[m].b = get_lane(L.b[m], l);
+      r.simplex.v[m].a = points ? get_lane(L.a[m], l) : Vec3<T>::Constant(quiet_nan<T>());
+      r.simplex.v[m].b = points ? get_lane(L.b[m], l) : Vec3<T>::Constant(quiet_nan<T>());
       r.simplex.lambda[m] = L.lambda[m][l];
     }
     r.x = status == GjkStatus::overlap ? Vec3<T>::Zero() : get_lane(L.x, l);
@@ -373,7 +378,9 @@ template <class T> struct WideGjk {
   }
 
   /// Runs GJK on setups[0 .. n): every pair must have the same (A type, B type) and need GJK (setup.done false).
-  static void run(const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver) {
+  /// `points`: keep the points of A and B behind each simplex vertex (witness points, EPA); without it the
+  /// simplex carries only w = a - b and its a, b come back NaN.
+  static void run(const PairSetup<T>* setups, std::size_t n, GjkResult<T>* out, Solver solver, bool points) {
     if (n == 0) return;
     Lanes L;
     L.A.type = setups[0].A.type;
@@ -386,7 +393,7 @@ template <class T> struct WideGjk {
     const real zero = splat(T(0)), one = splat(T(1));
     // Finishes lane l with `status` and refills it (or empties it). Returns the lane bit if it became empty.
     const auto close = [&](int l, GjkStatus status) {
-      finish(L, l, status, out[L.pair[l]]);
+      finish(L, l, status, out[L.pair[l]], points);
       if (next < n) refill(L, l, setups[next], std::int64_t(next), solver), ++next;
       else L.pair[l] = -1;
     };
@@ -462,8 +469,10 @@ template <class T> struct WideGjk {
         for (int m = 0; m < 4; ++m) {
           const mask here = live & (L.count == splat_mask(m));
           pw[m] = pick(here, sw, L.w[m]);
-          pa[m] = pick(here, sa, L.a[m]);
-          pb[m] = pick(here, sb, L.b[m]);
+          if (points) {
+            pa[m] = pick(here, sa, L.a[m]);
+            pb[m] = pick(here, sb, L.b[m]);
+          }
         }
         const mask n_after = L.count + 1;
         const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
@@ -484,16 +493,18 @@ template <class T> struct WideGjk {
         const mask lagging = (xn - wsqrt<T>(next_xx) <= tol) | (L.stale >= splat_mask(4));
         L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
         for (int m = 0; m < 4; ++m) {
-          V3 nw = pw[0], na = pa[0], nb = pb[0];
-          for (int q = 1; q < 4; ++q) {
-            const mask from_q = proj.index[m] == splat_mask(q);
-            nw = pick(from_q, pw[q], nw);
-            na = pick(from_q, pa[q], na);
-            nb = pick(from_q, pb[q], nb);
+          mask from_q[4];
+          for (int q = 1; q < 4; ++q) from_q[q] = proj.index[m] == splat_mask(q);
+          const auto gather_slot = [&](const V3* v) {
+            V3 r = v[0];
+            for (int q = 1; q < 4; ++q) r = pick(from_q[q], v[q], r);
+            return r;
+          };
+          L.w[m] = pick(moves, gather_slot(pw), L.w[m]);
+          if (points) {
+            L.a[m] = pick(moves, gather_slot(pa), L.a[m]);
+            L.b[m] = pick(moves, gather_slot(pb), L.b[m]);
           }
-          L.w[m] = pick(moves, nw, L.w[m]);
-          L.a[m] = pick(moves, na, L.a[m]);
-          L.b[m] = pick(moves, nb, L.b[m]);
           L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);
         }
         L.count = select(moves, proj.count, L.count);
