@@ -85,6 +85,12 @@ template <class T> struct WideGjk {
     return {zero, zero, zero};
   }
 
+  // (Helpers taking or returning vectors are member functions, not lambdas: GCC does not give lambdas the
+  // `#pragma GCC target` of their region, which would compile them without AVX.)
+  static real dot_at(const double* const* base, const std::uint32_t* at, const V3& d) {
+    return (gather<T>(base, at, 3, 0) * d.x + gather<T>(base, at, 3, 1) * d.y) + gather<T>(base, at, 3, 2) * d.z;
+  }
+
   /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
   /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
   /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
@@ -120,14 +126,11 @@ template <class T> struct WideGjk {
       last[l] = std::uint32_t(h.vertices.size() - 1);
       index[l] = 0;
     }
-    const auto dot_at = [&](const std::uint32_t* at) {
-      return (gather<T>(base, at, 3, 0) * d.x + gather<T>(base, at, 3, 1) * d.y) + gather<T>(base, at, 3, 2) * d.z;
-    };
-    real best = dot_at(index);
+    real best = dot_at(base, index, d);
     mask best_index = splat_mask(0);
     for (std::uint32_t i = 1; i < most; ++i) {
       for (int l = 0; l < W; ++l) index[l] = std::min(i, last[l]);  // a repeated vertex never wins a strict '>'
-      const real di = dot_at(index);
+      const real di = dot_at(base, index, d);
       const mask better = di > best;
       best = select(better, di, best);
       best_index = select(better, splat_mask(Int(i)), best_index);
@@ -208,9 +211,6 @@ template <class T> struct WideGjk {
     const real ui = coordinate(p[i], drop0, drop1, 0), vi = coordinate(p[i], drop0, drop1, 1);
     const real uj = coordinate(p[j], drop0, drop1, 0), vj = coordinate(p[j], drop0, drop1, 1);
     const real uk = coordinate(p[k], drop0, drop1, 0), vk = coordinate(p[k], drop0, drop1, 1);
-    const auto area = [](real au, real av, real bu, real bv, real cu, real cv) {
-      return (bu - au) * (cv - av) - (bv - av) * (cu - au);
-    };
     const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
     const real total = area(ui, vi, uj, vj, uk, vk);
     const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
@@ -242,6 +242,10 @@ template <class T> struct WideGjk {
     if (any(want & ~use_face & (degenerate | ~have)))
       edges = closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k));
     return pick(degenerate, edges, pick(use_face, face, pick(have, best, edges)));
+  }
+
+  static real area(real au, real av, real bu, real bv, real cu, real cv) {
+    return (bu - au) * (cv - av) - (bv - av) * (cu - au);
   }
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
@@ -366,6 +370,13 @@ template <class T> struct WideGjk {
     b = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + L.t[0], ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + L.t[1],
          ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + L.t[2]};
     w = sub(a, b);
+  }
+
+  /// Slot m of the compacted simplex: v[q] where the projection kept old slot q (from_q[q], q >= 1), else v[0].
+  static V3 from_slot(const mask* from_q, const V3* v) {
+    V3 r = v[0];
+    for (int q = 1; q < 4; ++q) r = pick(from_q[q], v[q], r);
+    return r;
   }
 
   static V3 face_direction(const Lanes& L, const V3& x) {
@@ -495,15 +506,10 @@ template <class T> struct WideGjk {
         for (int m = 0; m < 4; ++m) {
           mask from_q[4];
           for (int q = 1; q < 4; ++q) from_q[q] = proj.index[m] == splat_mask(q);
-          const auto gather_slot = [&](const V3* v) {
-            V3 r = v[0];
-            for (int q = 1; q < 4; ++q) r = pick(from_q[q], v[q], r);
-            return r;
-          };
-          L.w[m] = pick(moves, gather_slot(pw), L.w[m]);
+          L.w[m] = pick(moves, from_slot(from_q, pw), L.w[m]);
           if (points) {
-            L.a[m] = pick(moves, gather_slot(pa), L.a[m]);
-            L.b[m] = pick(moves, gather_slot(pb), L.b[m]);
+            L.a[m] = pick(moves, from_slot(from_q, pa), L.a[m]);
+            L.b[m] = pick(moves, from_slot(from_q, pb), L.b[m]);
           }
           L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);
         }
