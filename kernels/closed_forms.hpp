@@ -40,13 +40,13 @@ template <class T> void closest_points_segments(const Vec3<T>& p0, const Vec3<T>
   cq = q0 + t * d2;
 }
 
-/// Sphere/capsule against sphere/capsule: both cores are segments (a sphere's has zero length) along local z.
+/// Two segment cores [p0, p1], [q0, q1] with swept radii: signed distance, witness points and normal (from the
+/// first to the second). `centers` (second centre minus first) orients the normal when the cores touch.
 template <class T>
-PairOutput<T> segment_cores(const ShapeCore<T>& A, const ShapeCore<T>& B, const Transform<T>& b_in_a) {
-  const Vec3<T> ha(T(0), T(0), A.size.y()), hb(T(0), T(0), B.size.y());
-  const Vec3<T> q0 = b_in_a.apply(-hb), q1 = b_in_a.apply(hb);
+PairOutput<T> segments_with_radii(const Vec3<T>& p0, const Vec3<T>& p1, const Vec3<T>& q0, const Vec3<T>& q1,
+                                  T radius_a, T radius_b, const Vec3<T>& centers) {
   Vec3<T> ca, cb;
-  closest_points_segments<T>(-ha, ha, q0, q1, ca, cb);
+  closest_points_segments<T>(p0, p1, q0, q1, ca, cb);
   const Vec3<T> v = cb - ca;
   const T dcore = v.norm();
   Vec3<T> n;
@@ -54,21 +54,28 @@ PairOutput<T> segment_cores(const ShapeCore<T>& A, const ShapeCore<T>& B, const 
     n = v / dcore;
   } else {
     // The cores touch: any unit vector orthogonal to both segments separates them by a zero-length move.
-    const Vec3<T> axis_a = ha, axis_b = q1 - q0;
+    const Vec3<T> axis_a = p1 - p0, axis_b = q1 - q0;
     const Vec3<T> c = axis_a.cross(axis_b);
     if (c.norm() > T(0)) n = c.normalized();
     else if (axis_a.norm() > T(0)) n = any_orthogonal(axis_a);
     else if (axis_b.norm() > T(0)) n = any_orthogonal(axis_b);
     else n = Vec3<T>::UnitX();
-    if (n.dot(b_in_a.t) < T(0)) n = -n;  // point from A towards B's centre when that is defined
+    if (n.dot(centers) < T(0)) n = -n;  // point from A towards B's centre when that is defined
   }
   PairOutput<T> out;
   out.status = Status::converged;
-  out.distance = dcore - A.radius - B.radius;
+  out.distance = dcore - radius_a - radius_b;
   out.normal = n;
-  out.witness_a = ca + A.radius * n;
-  out.witness_b = cb - B.radius * n;
+  out.witness_a = ca + radius_a * n;
+  out.witness_b = cb - radius_b * n;
   return out;
+}
+
+/// Sphere/capsule against sphere/capsule: both cores are segments (a sphere's has zero length) along local z.
+template <class T>
+PairOutput<T> segment_cores(const ShapeCore<T>& A, const ShapeCore<T>& B, const Transform<T>& b_in_a) {
+  const Vec3<T> ha(T(0), T(0), A.size.y()), hb(T(0), T(0), B.size.y());
+  return segments_with_radii<T>(-ha, ha, b_in_a.apply(-hb), b_in_a.apply(hb), A.radius, B.radius, b_in_a.t);
 }
 
 /// Sphere core (a point at the origin of its frame) against a box core; `box_is_a` tells which one is A.

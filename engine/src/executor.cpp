@@ -3,6 +3,7 @@
 // the scalar reference's operations, so results are bitwise identical for any thread count and instruction set.
 #include "batchcol/batch.hpp"
 #include "kernels/narrowphase.hpp"
+#include "kernels/segment_pairs_world.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 #include "validate.hpp"
 
@@ -93,6 +94,34 @@ bool prepare_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryO
   return true;
 }
 
+/// Sphere and capsule pairs with closed forms on: world segments and the closed form, in double, without the
+/// relative frame and the setup. Returns false (nothing written) when the pair is not one, or is invalid: the
+/// generic path then answers it.
+bool solve_segment_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
+                        PairResults& out) {
+  const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
+  if (ia >= shapes.size() || ib >= shapes.size()) return false;
+  const Shape& a = shapes[ia];
+  const Shape& b = shapes[ib];
+  if (!kernels::is_segment_shape(a) || !kernels::is_segment_shape(b)) return false;
+  const auto qa = detail::unit_quaternion(batch.rotation_a[i]);
+  const auto qb = detail::unit_quaternion(batch.rotation_b[i]);
+  const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
+  if (!qa || !qb || !ta.allFinite() || !tb.allFinite()) return false;
+  const kernels::WorldSegment A = kernels::world_segment(a, *qa, ta), B = kernels::world_segment(b, *qb, tb);
+  const kernels::PairOutput<double> r =
+      kernels::segments_with_radii<double>(A.p0, A.p1, B.p0, B.p1, A.radius, B.radius, tb - ta);
+  out.status[i] = r.status;
+  out.collide[i] = r.distance <= options.margin ? 1 : 0;
+  if (options.level >= QueryLevel::distance) out.distance[i] = r.distance;
+  if (options.level >= QueryLevel::witness) {
+    out.witness_a.set(i, r.witness_a);
+    out.witness_b.set(i, r.witness_b);
+    out.normal.set(i, r.normal);
+  }
+  return true;
+}
+
 /// Pairs [begin, end) of the tile, grouped by type (`order` holds offsets from begin): closed forms answer at
 /// setup, the rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
 template <class T>
@@ -113,6 +142,7 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
   };
   for (const std::uint32_t k : s.order) {
     const std::size_t i = begin + k;
+    if (options.closed_forms && solve_segment_pair(shapes, batch, options, i, out)) continue;
     PairFrame frame;
     kernels::PairSetup<T>& setup = s.setups[pending];
     if (!prepare_pair(shapes, batch, options, i, frame, setup, out)) continue;
