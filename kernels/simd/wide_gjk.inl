@@ -436,7 +436,7 @@ template <class T> struct WideGjk {
 
       V3 d = x;
       const real kk = to_real<T>(L.k);  // k + 1 of the reference (k already incremented)
-      if (solver == Solver::nesterov) {
+      if (solver == Solver::nesterov && any(live & L.momentum)) {  // else every lane steps along x
         const real delta = kk / (kk + T(2));  // T(k + 1) / T(k + 3)
         const V3 y = add(scale(delta, x), scale(one - delta, L.last_s));
         const real yn = norm(y), dn = norm(L.d_prev);
@@ -445,7 +445,7 @@ template <class T> struct WideGjk {
         const V3 dn_dir = add(divide(scale(delta, L.d_prev), dn), divide(scale(one - delta, y), yn));
         const V3 du_dir = add(scale(delta, L.d_prev), scale(one - delta, y));
         d = pick(normalized, dn_dir, pick(unnormalized, du_dir, d));
-      } else if (solver == Solver::polyak) {
+      } else if (solver == Solver::polyak && any(live & L.momentum)) {
         const real beta = one / (kk + T(1));  // T(1) / T(k + 2)
         d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
       }
