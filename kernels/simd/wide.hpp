@@ -82,3 +82,20 @@ template <class T, class S> inline wreal<T> gather(const S* const* base, const s
   for (int l = 0; l < Wide<T>::W; ++l) r[l] = T(base[l][std::size_t(index[l]) * stride + offset]);
   return r;
 }
+
+/// r[l] = *(base + byte_offset[l]) for double lanes: one hardware gather on AVX2 / AVX-512 (offsets are byte
+/// distances from `base`, computed through uintptr_t, so lanes may read from different allocations).
+template <class T> inline wreal<T> gather_bytes(const T* base, wmask<T> byte_offset) {
+  static_assert(sizeof(T) == 8, "64-bit lanes only: the offsets are 64-bit");
+  if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(wreal<T>) == 32) {
+    return _mm256_i64gather_pd(base, __m256i(byte_offset), 1);
+  } else if constexpr (BATCHCOL_SIMD_BYTES == 64 && sizeof(wreal<T>) == 64) {
+    return _mm512_i64gather_pd(__m512i(byte_offset), base, 1);
+  } else {
+    wreal<T> r{};
+    const auto start = reinterpret_cast<std::uintptr_t>(base);
+    for (int l = 0; l < Wide<T>::W; ++l)
+      r[l] = *reinterpret_cast<const T*>(start + static_cast<std::uintptr_t>(byte_offset[l]));
+    return r;
+  }
+}

@@ -91,6 +91,11 @@ template <class T> struct WideGjk {
     return (gather<T>(base, at, 3, 0) * d.x + gather<T>(base, at, 3, 1) * d.y) + gather<T>(base, at, 3, 2) * d.z;
   }
 
+  /// Component c of vertex i[l] of lane l's hull, whose vertices start `start[l]` bytes after `origin` (double).
+  static real vertex_component(const double* origin, mask start, mask i, int c) {
+    return gather_bytes(origin, start + i * Int(sizeof(Eigen::Vector3d)) + Int(c * sizeof(double)));
+  }
+
   /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
   /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
   /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
@@ -126,17 +131,38 @@ template <class T> struct WideGjk {
       last[l] = std::uint32_t(h.vertices.size() - 1);
       index[l] = 0;
     }
-    real best = dot_at(base, index, d);
-    mask best_index = splat_mask(0);
-    for (std::uint32_t i = 1; i < most; ++i) {
-      for (int l = 0; l < W; ++l) index[l] = std::min(i, last[l]);  // a repeated vertex never wins a strict '>'
-      const real di = dot_at(base, index, d);
-      const mask better = di > best;
-      best = select(better, di, best);
-      best_index = select(better, splat_mask(Int(i)), best_index);
+    if constexpr (sizeof(T) == 8 && W > 1) {
+      // Double lanes: vertex i of every lane's hull in three hardware gathers (byte offsets from lane 0's hull).
+      mask start{}, final_index{};
+      const auto origin = reinterpret_cast<std::uintptr_t>(base[0]);
+      for (int l = 0; l < W; ++l) {
+        start[l] = Int(reinterpret_cast<std::uintptr_t>(base[l]) - origin);
+        final_index[l] = Int(last[l]);
+      }
+      mask i_vec = splat_mask(0);
+      real best = (vertex_component(base[0], start, i_vec, 0) * d.x + vertex_component(base[0], start, i_vec, 1) * d.y) + vertex_component(base[0], start, i_vec, 2) * d.z;
+      mask best_index = i_vec;
+      for (std::uint32_t i = 1; i < most; ++i) {
+        i_vec = wmin(splat_mask(Int(i)), final_index);  // a repeated vertex never wins a strict '>'
+        const real di = (vertex_component(base[0], start, i_vec, 0) * d.x + vertex_component(base[0], start, i_vec, 1) * d.y) + vertex_component(base[0], start, i_vec, 2) * d.z;
+        const mask better = di > best;
+        best = select(better, di, best);
+        best_index = select(better, i_vec, best_index);
+      }
+      return {vertex_component(base[0], start, best_index, 0), vertex_component(base[0], start, best_index, 1), vertex_component(base[0], start, best_index, 2)};
+    } else {
+      real best = dot_at(base, index, d);
+      mask best_index = splat_mask(0);
+      for (std::uint32_t i = 1; i < most; ++i) {
+        for (int l = 0; l < W; ++l) index[l] = std::min(i, last[l]);  // a repeated vertex never wins a strict '>'
+        const real di = dot_at(base, index, d);
+        const mask better = di > best;
+        best = select(better, di, best);
+        best_index = select(better, splat_mask(Int(i)), best_index);
+      }
+      for (int l = 0; l < W; ++l) index[l] = std::uint32_t(best_index[l]);
+      return {gather<T>(base, index, 3, 0), gather<T>(base, index, 3, 1), gather<T>(base, index, 3, 2)};
     }
-    for (int l = 0; l < W; ++l) index[l] = std::uint32_t(best_index[l]);
-    return {gather<T>(base, index, 3, 0), gather<T>(base, index, 3, 1), gather<T>(base, index, 3, 2)};
   }
 
   // ---- Projection of the origin on a simplex (kernels/simplex_projection.hpp) ----
