@@ -358,7 +358,8 @@ class BatchReader {
     } catch (const InputError& e) {
       fail(pointer, e.what());
     }
-    return build(pointer, [&] { return Shape::convex(pts); }, "mesh '" + path + "': ");
+    // The hull is named after the mesh file (not "vertices") so a flat mesh's message says which file is flat.
+    return build(pointer, [&] { return Shape::convex(compute_convex_hull(pts, "mesh '" + path + "'")); });
   }
 
   std::uint32_t shape_index(const json& v, const std::string& pointer, std::size_t shape_count) const {

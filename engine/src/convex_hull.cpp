@@ -59,13 +59,37 @@ void build_adjacency(ConvexHull& hull) {
   }
 }
 
+// Names the flat configuration qhull refused, for the error message only (qhull itself decides what is flat).
+// Relative thresholds of 1e-12 of the point cloud's extent: far below any deliberate feature, far above rounding.
+std::string describe_flat_points(const std::vector<Eigen::Vector3d>& points) {
+  const Eigen::Vector3d& p0 = points.front();
+  std::size_t far = 0;
+  for (std::size_t i = 1; i < points.size(); ++i)
+    if ((points[i] - p0).squaredNorm() > (points[far] - p0).squaredNorm()) far = i;
+  const double extent = (points[far] - p0).norm();
+  if (!(extent > 0.0)) return "all " + std::to_string(points.size()) + " points coincide";
+  const Eigen::Vector3d axis = (points[far] - p0) / extent;
+  std::size_t off = 0;
+  double off_distance = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = (points[i] - p0).cross(axis).norm();
+    if (d > off_distance) off_distance = d, off = i;
+  }
+  if (off_distance <= 1e-12 * extent) return "all " + std::to_string(points.size()) + " points are collinear";
+  const Eigen::Vector3d normal = axis.cross(points[off] - p0).normalized();
+  double height = 0.0;
+  for (const auto& p : points) height = std::max(height, std::abs((p - p0).dot(normal)));
+  if (height <= 1e-12 * extent) return "all " + std::to_string(points.size()) + " points are coplanar";
+  return "the points are nearly coplanar";
+}
+
 }  // namespace
 
 std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
                                                       const std::string& what) {
   if (points.size() < 4)
-    throw InputError(what + ": a convex hull needs at least 4 non-coplanar points, got " +
-                     std::to_string(points.size()));
+    throw InputError(what + ": fewer than 4 non-coplanar points, no 3D convex hull: only " +
+                     std::to_string(points.size()) + " points");
   std::vector<coordT> coords;
   coords.reserve(points.size() * 3);
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -110,8 +134,8 @@ std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::V
   int curlong = 0, totlong = 0;
   qh_memfreeshort(qh, &curlong, &totlong);
   if (exit_code != 0)
-    throw InputError(what + ": fewer than 4 non-coplanar points, no 3D convex hull (qhull: " + first_line(message) +
-                     ")");
+    throw InputError(what + ": fewer than 4 non-coplanar points, no 3D convex hull: " + describe_flat_points(points) +
+                     " (qhull: " + first_line(message) + ")");
   if (hull->vertices.size() < 4 || hull->faces.size() < 4)
     throw InputError(what + ": the convex hull is degenerate (fewer than 4 vertices)");
   for (const auto& v : hull->vertices) hull->centroid += v;

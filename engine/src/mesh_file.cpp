@@ -1,52 +1,275 @@
-// Mesh input through assimp: only the vertex positions are kept (the caller takes their convex hull).
+// Mesh input through assimp (OBJ, STL, PLY, COLLADA): only the vertex positions are kept, in the file's world frame
+// (the caller takes their convex hull).
+//
+// Assimp is lenient with broken files and some of its readers crash or hang on them (found by tools/fuzz), so:
+// the path must be a readable, non-empty regular file with a supported extension; a binary STL must have exactly
+// 84 + 50 * count bytes and finite coordinates; a PLY header must end with end_header; only the readers of the
+// supported formats are registered; no assimp post-processing runs (its steps trust the file's face indices); every
+// vertex must be finite. Each problem is one InputError naming the file.
 #include "batchcol/io.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #ifdef BATCHCOL_HAVE_ASSIMP
+#include <assimp/BaseImporter.h>
 #include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
+#include <assimp/importerdesc.h>
 #include <assimp/scene.h>
 #endif
 
 namespace batchcol {
+namespace {
 
-std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path) {
-  namespace fs = std::filesystem;
-  const std::string what = "mesh '" + path + "'";
+namespace fs = std::filesystem;
+
+constexpr std::uint64_t kStlHeaderBytes = 84;    // 80-byte comment + uint32 triangle count
+constexpr std::uint64_t kStlTriangleBytes = 50;  // normal + 3 vertices (12 floats) + uint16 attribute
+
+/// Checks that `path` names a readable, non-empty regular file and returns its size in bytes.
+std::uint64_t checked_file_size(const std::string& path, const std::string& what) {
+  if (path.empty()) throw InputError(what + ": empty file name");
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) throw InputError(what + ": no such file");
+  // ENOTDIR (a parent in the path is a file) also reads as "not found": report it as what it is.
+  if (ec && ec != std::errc::no_such_file_or_directory) throw InputError(what + ": cannot access the file: " + ec.message());
+  if (status.type() == fs::file_type::not_found) throw InputError(what + ": no such file");
   if (fs::is_directory(status)) throw InputError(what + ": is a directory, expected a mesh file");
-  if (!fs::is_regular_file(status)) throw InputError(what + ": not a regular file");
-  if (!std::ifstream(path, std::ios::binary)) throw InputError(what + ": cannot open the file for reading");
+  if (!fs::is_regular_file(status)) throw InputError(what + ": not a regular file (a FIFO, device or socket)");
+  errno = 0;
+  if (!std::ifstream(path, std::ios::binary)) {
+    throw InputError(what + ": cannot open the file for reading" + (errno ? ": " + std::string(std::strerror(errno)) : ""));
+  }
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw InputError(what + ": cannot read the file size: " + ec.message());
+  if (size == 0) throw InputError(what + ": the file is empty (0 bytes)");
+  return size;
+}
+
+std::string read_bytes(const std::string& path, std::uint64_t count, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(count, '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(count))) throw InputError(what + ": read error");
+  return bytes;
+}
+
+/// An ASCII STL starts with "solid" and holds text only; a binary STL's 80-byte comment may also start with "solid",
+/// but its float data is not text. The first 512 bytes decide.
+bool looks_like_ascii_stl(const std::string& head) {
+  const std::size_t start = head.find_first_not_of(" \t\r\n");
+  if (start == std::string::npos || head.compare(start, 5, "solid") != 0) return false;
+  return std::all_of(head.begin(), head.end(), [](unsigned char c) { return c == '\t' || c == '\n' || c == '\r' || (c >= 32 && c < 127); });
+}
+
+std::uint32_t little_endian_u32(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(i)]);
+  return v;
+}
+
+float little_endian_f32(const std::string& bytes, std::size_t at) {
+  const std::uint32_t bits = little_endian_u32(bytes, at);
+  float v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+/// Binary STL: size = 84 + 50 * count exactly, count > 0, every vertex finite. ASCII STL is left to assimp.
+void check_stl(const std::string& path, std::uint64_t size, const std::string& what) {
+  const std::string head = read_bytes(path, std::min<std::uint64_t>(size, 512), what);
+  if (looks_like_ascii_stl(head)) return;
+  if (size < kStlHeaderBytes) {
+    throw InputError(what + ": truncated binary STL: " + std::to_string(size) + " bytes, shorter than the " +
+                     std::to_string(kStlHeaderBytes) + "-byte header");
+  }
+  const std::uint64_t count = little_endian_u32(head, 80);
+  const std::uint64_t expected = kStlHeaderBytes + kStlTriangleBytes * count;
+  if (size != expected) {
+    throw InputError(what + ": binary STL is truncated or its triangle count is wrong: the header declares " +
+                     std::to_string(count) + " triangles (84 + 50 x " + std::to_string(count) + " = " +
+                     std::to_string(expected) + " bytes) but the file has " + std::to_string(size) + " bytes");
+  }
+  if (count == 0) throw InputError(what + ": binary STL with zero triangles (no faces)");
+  const std::string bytes = read_bytes(path, size, what);
+  for (std::uint64_t t = 0; t < count; ++t)
+    for (int k = 0; k < 9; ++k) {  // skip the 3 normal floats, check the 9 vertex coordinates
+      const std::size_t at = kStlHeaderBytes + kStlTriangleBytes * t + 12 + 4 * static_cast<std::size_t>(k);
+      if (!std::isfinite(little_endian_f32(bytes, at))) {
+        throw InputError(what + ": binary STL triangle " + std::to_string(t) + " has a non-finite coordinate");
+      }
+    }
+}
+
+/// PLY (assimp picks its PLY reader for any file starting with "ply"). Assimp 5.2.5 loops forever on a header
+/// without end_header and overflows a heap buffer on a header that declares an element twice (both found by
+/// fuzzing), so the header grammar is checked here first: "ply", one "format ascii|binary_little_endian|
+/// binary_big_endian 1.0", then "comment"/"obj_info" lines, "element NAME COUNT" (unique names) each followed by its
+/// "property TYPE NAME" or "property list COUNT_TYPE ITEM_TYPE NAME" lines, then "end_header".
+void check_ply_header(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  // Assimp takes any capitalisation of the magic ("pLy" was a fuzzer find): so does this check.
+  if (!std::getline(in, line) || line.size() < 3) return;
+  std::string magic = line.substr(0, 3);
+  std::transform(magic.begin(), magic.end(), magic.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (magic != "ply") return;  // not a PLY file: assimp decides
+  const auto fail = [&](std::size_t number, const std::string& problem) {
+    throw InputError(what + ": PLY header line " + std::to_string(number) + ": " + problem);
+  };
+  const auto is_scalar = [](const std::string& t) {
+    static const char* const kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double",
+                                         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* k) { return t == k; });
+  };
+  if (line != "ply" && line != "ply\r") fail(1, "expected 'ply' alone on the first line");
+  std::vector<std::string> elements;
+  bool format_seen = false;
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (std::any_of(line.begin(), line.end(), [](unsigned char c) { return c < 32 && c != '\t'; }) ||
+        std::any_of(line.begin(), line.end(), [](unsigned char c) { return c >= 127; })) {
+      if (line.rfind("comment", 0) != 0 && line.rfind("obj_info", 0) != 0) fail(number, "not a text line");
+    }
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "end_header") {
+      if (!format_seen) fail(number, "end_header before the format line");
+      return;
+    }
+    if (w[0] == "format") {
+      if (format_seen || w.size() != 3 || w[2] != "1.0" ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian")) {
+        fail(number, "expected one 'format ascii|binary_little_endian|binary_big_endian 1.0' line");
+      }
+      format_seen = true;
+    } else if (w[0] == "element") {
+      if (w.size() != 3 || w[2].find_first_not_of("0123456789") != std::string::npos || w[2].size() > 10)
+        fail(number, "expected 'element NAME COUNT'");
+      if (std::find(elements.begin(), elements.end(), w[1]) != elements.end()) fail(number, "element '" + w[1] + "' declared twice");
+      elements.push_back(w[1]);
+    } else if (w[0] == "property") {
+      const bool scalar = w.size() == 3 && is_scalar(w[1]);
+      const bool list = w.size() == 5 && w[1] == "list" && is_scalar(w[2]) && is_scalar(w[3]);
+      if (elements.empty() || !(scalar || list)) fail(number, "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an element");
+    } else {
+      fail(number, "unknown keyword '" + w[0].substr(0, 40) + "'");
+    }
+  }
+  throw InputError(what + ": PLY header has no end_header line");
+}
+
+constexpr const char* kSupportedList = ".obj, .stl, .ply, .dae";
+
+std::string lowercase_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+bool is_supported_extension(const std::string& ext) {
+  return ext == ".obj" || ext == ".stl" || ext == ".ply" || ext == ".dae";
+}
+
+#ifdef BATCHCOL_HAVE_ASSIMP
+/// Assimp picks a reader by content as well as by extension, and some of its ~50 readers crash on broken input
+/// (the OFF reader did within seconds of fuzzing). Only the readers of the supported formats stay registered.
+void keep_only_supported_readers(Assimp::Importer& importer) {
+  for (std::size_t i = importer.GetImporterCount(); i-- > 0;) {
+    const aiImporterDesc* desc = importer.GetImporterInfo(i);
+    const std::string name = desc && desc->mFileExtensions ? desc->mFileExtensions : "";
+    if (name == "obj" || name == "ply" || name.rfind("stl", 0) == 0 || name.rfind("dae", 0) == 0) continue;
+    Assimp::BaseImporter* reader = importer.GetImporter(i);
+    if (importer.UnregisterLoader(reader) == aiReturn_SUCCESS) delete reader;  // unregistering returns ownership
+  }
+}
+
+/// Every vertex of every mesh a node refers to, in the file's world frame (the node transforms composed from the
+/// root: COLLADA places meshes and carries its unit scale there), duplicates removed. Iterative: a deep node
+/// hierarchy must not overflow the stack.
+std::vector<Eigen::Vector3d> scene_points(const aiScene& scene, const std::string& what) {
+  std::vector<Eigen::Vector3d> points;
+  std::size_t faces = 0;
+  const auto to_affine = [](const aiMatrix4x4& m) {
+    Eigen::Matrix4d a;
+    a << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+    return Eigen::Affine3d(a);
+  };
+  std::vector<std::pair<const aiNode*, Eigen::Affine3d>> stack;
+  if (scene.mRootNode) stack.emplace_back(scene.mRootNode, to_affine(scene.mRootNode->mTransformation));
+  while (!stack.empty()) {
+    const auto [node, transform] = stack.back();
+    stack.pop_back();
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const unsigned m = node->mMeshes[k];
+      if (m >= scene.mNumMeshes || scene.mMeshes[m] == nullptr) continue;
+      const aiMesh& mesh = *scene.mMeshes[m];
+      faces += mesh.mNumFaces;
+      for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
+        const aiVector3D& v = mesh.mVertices[i];
+        const Eigen::Vector3d p = transform * Eigen::Vector3d(v.x, v.y, v.z);
+        if (!p.allFinite()) {
+          throw InputError(what + ": vertex " + std::to_string(i) + " of mesh " + std::to_string(m) + " is not finite");
+        }
+        points.push_back(p);
+      }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c)
+      if (node->mChildren[c]) stack.emplace_back(node->mChildren[c], transform * to_affine(node->mChildren[c]->mTransformation));
+  }
+  if (points.empty()) throw InputError(what + ": the file holds no vertices");
+  if (faces == 0) throw InputError(what + ": the file holds " + std::to_string(points.size()) + " vertices but zero faces");
+  // STL repeats every vertex once per triangle: remove exact duplicates before the hull.
+  const auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  std::sort(points.begin(), points.end(), less);
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  return points;
+}
+#endif
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path) {
+  const std::string what = "mesh '" + path + "'";
+  const std::uint64_t size = checked_file_size(path, what);
+  const std::string extension = lowercase_extension(path);
+  if (!is_supported_extension(extension)) {
+    throw InputError(what + ": unsupported mesh format '" + extension + "' (supported: " + kSupportedList + ")");
+  }
+  if (extension == ".stl") check_stl(path, size, what);
+  check_ply_header(path, what);
 
 #ifdef BATCHCOL_HAVE_ASSIMP
   Assimp::Importer importer;
-  // Points only: joining duplicates shrinks STL meshes (3 copies per vertex) before the hull is computed.
-  const aiScene* scene = importer.ReadFile(path, aiProcess_JoinIdenticalVertices);
-  if (scene == nullptr) throw InputError(what + ": cannot read: " + importer.GetErrorString());
-
-  std::vector<Eigen::Vector3d> points;
-  std::size_t faces = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* mesh = scene->mMeshes[m];
-    faces += mesh->mNumFaces;
-    for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
-      const aiVector3D& v = mesh->mVertices[i];
-      const Eigen::Vector3d p(v.x, v.y, v.z);
-      if (!p.allFinite()) {
-        throw InputError(what + ": vertex " + std::to_string(i) + " of mesh " + std::to_string(m) + " is not finite");
-      }
-      points.push_back(p);
-    }
+  keep_only_supported_readers(importer);
+  // No post-processing: assimp's steps trust the face indices a broken file gives them (found by fuzzing). The node
+  // transforms are applied below and duplicate points are removed before the hull.
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path, 0);
+  } catch (const std::exception& e) {  // e.g. std::bad_alloc on a header declaring billions of elements
+    throw InputError(what + ": cannot read the mesh: " + e.what());
   }
-  if (points.empty() || faces == 0) throw InputError(what + ": the file holds no vertices or no faces");
-  return points;
+  if (scene == nullptr) throw InputError(what + ": cannot read the mesh: " + importer.GetErrorString());
+  return scene_points(*scene, what);
 #else
   throw InputError(what + ": mesh support needs assimp (apt-get install libassimp-dev)");
 #endif
