@@ -47,6 +47,10 @@ void report(benchmark::State& state, const SweepAndPrune& sap, std::size_t n) {
   state.counters["overlaps_per_box"] = 2.0 * static_cast<double>(sap.stats().pairs) / static_cast<double>(n);
   state.counters["bytes_per_object"] = static_cast<double>(sap.memory_bytes()) / static_cast<double>(n);
   state.counters["copies_per_object"] = static_cast<double>(sap.stats().entries) / static_cast<double>(n);
+  // Stage split of the last call (wall clock): grid + bucketing, per-cell sort + sweep, pair merge.
+  state.counters["bucket_ms"] = sap.stats().bucket_ms;
+  state.counters["sweep_ms"] = sap.stats().sweep_ms;
+  state.counters["emit_ms"] = sap.stats().emit_ms;
 }
 
 void BM_SapRebuild(benchmark::State& state) {

@@ -31,6 +31,12 @@ std::vector<int> digit_shifts(int bit_begin, int bit_end) {
 }
 
 void radix_sort(std::uint64_t* data, std::uint64_t* scratch, std::size_t n, const std::vector<int>& shifts) {
+  std::vector<Histogram> hist;
+  radix_sort(data, scratch, n, shifts, hist);
+}
+
+void radix_sort(std::uint64_t* data, std::uint64_t* scratch, std::size_t n, const std::vector<int>& shifts,
+                std::vector<Histogram>& hist) {
   if (n < 2 || shifts.empty()) return;
   if (n <= 64) {  // tiny inputs: a stable comparison sort on the same digits is cheaper than 256-bucket passes
     std::uint64_t mask = 0;
@@ -40,7 +46,7 @@ void radix_sort(std::uint64_t* data, std::uint64_t* scratch, std::size_t n, cons
   }
   const std::size_t chunks = std::clamp<std::size_t>(n / kMinChunk, 1, kMaxChunks);
   const std::size_t chunk_size = (n + chunks - 1) / chunks;
-  std::vector<Histogram> hist(chunks);
+  if (hist.size() < chunks) hist.resize(chunks);
   std::uint64_t* src = data;
   std::uint64_t* dst = scratch;
   for (int shift : shifts) {

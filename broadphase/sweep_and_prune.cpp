@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstring>
 #include <utility>
 
@@ -75,11 +76,20 @@ std::size_t SweepAndPrune::memory_bytes() const {
   std::size_t bytes = words_.capacity() * 8 + scratch_.capacity() * 8 + counts_.capacity() * 4 +
                       cell_start_.capacity() * 4 + entries_.capacity() * sizeof(Entry);
   for (const auto& g : group_pairs_) bytes += g.capacity() * 8;
+  for (const auto& g : group_scratch_) bytes += (g.words.capacity() + g.tmp.capacity()) * 8 + g.entries.capacity() * sizeof(Entry);
+  bytes += (first_cell_.capacity() + group_start_.capacity() + chunk_entries_.capacity()) * sizeof(std::size_t) +
+           shifts_.capacity() * sizeof(int) + radix_histograms_.capacity() * sizeof(radix_histograms_[0]) +
+           group_pairs_.capacity() * sizeof(group_pairs_[0]) + group_scratch_.capacity() * sizeof(CellScratch);
   return bytes;
 }
 
 void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs,
                         bool incremental) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  const auto t0 = Clock::now();
   validate_aabbs(boxes);
   const std::size_t n = boxes.size();
   validate_filter(filter, n);
@@ -109,16 +119,20 @@ void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vect
   stats_.incremental = incremental;
   if (!incremental) rebuild_entries_ = entries, rebuild_max_cell_ = stats_.max_cell;
   bucket(boxes);
+  const auto t1 = Clock::now();
   sort_and_sweep(filter);
+  const auto t2 = Clock::now();
   emit(pairs);
   stats_.pairs = pairs.size();
+  stats_.bucket_ms = ms(t0, t1), stats_.sweep_ms = ms(t1, t2), stats_.emit_ms = ms(t2, Clock::now());
 }
 
 std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
   const std::size_t n = boxes.size(), cells = grid_.cell_count();
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
   counts_.assign(ch.count * cells, 0);
-  std::vector<std::size_t> chunk_entries(ch.count, 0);
+  std::vector<std::size_t>& chunk_entries = chunk_entries_;
+  chunk_entries.assign(ch.count, 0);
   const float *lu = boxes.min(grid_.u), *hu = boxes.max(grid_.u), *lv = boxes.min(grid_.v), *hv = boxes.max(grid_.v);
   const SapGrid g = grid_;
   tbb::parallel_for(std::size_t{0}, ch.count, [&](std::size_t c) {
@@ -184,7 +198,9 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
   group_pairs_.resize(groups);
   const std::uint64_t entries = cell_start_[cells];
   // Group g = the cells whose entries start in [g E / groups, (g + 1) E / groups): contiguous, balanced, fixed.
-  std::vector<std::size_t> first_cell(groups + 1);
+  std::vector<std::size_t>& first_cell = first_cell_;
+  first_cell.resize(groups + 1);
+  if (group_scratch_.size() < groups) group_scratch_.resize(groups);
   for (std::size_t g = 0; g <= groups; ++g) {
     const std::uint64_t target = entries * g / groups;
     first_cell[g] = g == groups ? cells
@@ -198,8 +214,9 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::vector<std::uint64_t>& out = group_pairs_[g];
     out.clear();
-    std::vector<std::uint64_t> w, tmp;
-    std::vector<Entry> buf;
+    std::vector<std::uint64_t>& w = group_scratch_[g].words;
+    std::vector<std::uint64_t>& tmp = group_scratch_[g].tmp;
+    std::vector<Entry>& buf = group_scratch_[g].entries;
     for (std::size_t cell = first_cell[g]; cell < first_cell[g + 1]; ++cell) {
       const std::size_t s = cell_start_[cell], k = cell_start_[cell + 1] - s;
       Entry* e = all + s;
@@ -216,7 +233,7 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
           e[i] = x;
         }
       } else {
-        w.resize(k), tmp.resize(k), buf.resize(k);
+        if (w.size() < k) w.resize(k), tmp.resize(k), buf.resize(k);
         std::array<std::array<std::uint32_t, 256>, 4> hist{};
         for (std::size_t i = 0; i < k; ++i) {
           const std::uint32_t key = e[i].key;
@@ -263,7 +280,8 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
 
 void SweepAndPrune::emit(std::vector<CandidatePair>& pairs) {
   const std::size_t groups = group_pairs_.size();
-  std::vector<std::size_t> start(groups + 1, 0);
+  std::vector<std::size_t>& start = group_start_;
+  start.assign(groups + 1, 0);
   for (std::size_t g = 0; g < groups; ++g) start[g + 1] = start[g] + group_pairs_[g].size();
   const std::size_t total = start[groups];
   if (words_.size() < total) words_.resize(total);
@@ -273,9 +291,10 @@ void SweepAndPrune::emit(std::vector<CandidatePair>& pairs) {
   });
   // Object ids are < n: only the low bit_width(n - 1) bits of a and of b can differ.
   const int w = bit_width(object_count_ == 0 ? 0 : object_count_ - 1);
-  std::vector<int> shifts = digit_shifts(0, w);
-  for (int s : digit_shifts(32, 32 + w)) shifts.push_back(s);
-  radix_sort(words_.data(), scratch_.data(), total, shifts);
+  shifts_.clear();
+  for (int s = 0; s < w; s += 8) shifts_.push_back(s);        // digit_shifts(0, w) without a temporary vector
+  for (int s = 32; s < 32 + w; s += 8) shifts_.push_back(s);  // digit_shifts(32, 32 + w)
+  radix_sort(words_.data(), scratch_.data(), total, shifts_, radix_histograms_);
   pairs.resize(total);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, total, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k < r.end(); ++k)

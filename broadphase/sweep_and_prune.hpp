@@ -15,6 +15,7 @@
 #include "broadphase/pairs.hpp"
 #include "broadphase/sap_grid.hpp"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -28,6 +29,8 @@ struct SapStats {
   std::size_t max_cell = 0;       // entries in the fullest cell
   bool incremental = false;       // the last call kept the previous grid (false: axis and grid chosen afresh)
   std::size_t pairs = 0;
+  double bucket_ms = 0, sweep_ms = 0, emit_ms = 0;  // wall clock of the stages: grid + bucketing, per-cell sort and
+                                                    // sweep, merging the pairs
 };
 
 class SweepAndPrune {
@@ -69,6 +72,17 @@ class SweepAndPrune {
   std::vector<std::uint32_t> cell_start_; // entries of cell c are [cell_start_[c], cell_start_[c + 1])
   std::vector<Entry> entries_;            // by cell, then sorted by (x0, id) inside each cell
   std::vector<std::vector<std::uint64_t>> group_pairs_;  // per fixed group of cells: its pairs, written lock-free
+  // Scratch kept across calls so that a frame of a warm SAP allocates nothing.
+  struct CellScratch {
+    std::vector<std::uint64_t> words, tmp;
+    std::vector<Entry> entries;
+  };
+  std::vector<CellScratch> group_scratch_;      // per group: radix sort of its large cells
+  std::vector<std::size_t> first_cell_;         // per group: its first cell
+  std::vector<std::size_t> group_start_;        // per group: offset of its pairs in words_
+  std::vector<std::size_t> chunk_entries_;      // per bucketing chunk: cell copies
+  std::vector<int> shifts_;                     // radix digits of the pair words
+  std::vector<std::array<std::uint32_t, 256>> radix_histograms_;
 };
 
 }  // namespace batchcol::broadphase

@@ -16,5 +16,7 @@ struct Command {
 Command add_demo_command(CLI::App& parent);
 Command add_query_command(CLI::App& parent);
 Command add_bench_command(CLI::App& parent);
+Command add_stress_command(CLI::App& parent);
+Command add_accuracy_command(CLI::App& parent);
 
 }  // namespace batchcol::cli

@@ -5,4 +5,5 @@
 #include "batchcol/errors.hpp"
 #include "batchcol/io.hpp"
 #include "batchcol/pose.hpp"
+#include "batchcol/scene.hpp"
 #include "batchcol/shapes.hpp"
