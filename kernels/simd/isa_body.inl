@@ -1,0 +1,18 @@
+// The body every instruction-set translation unit (isa_*.cpp) shares: the wide layer and the kernels inside the
+// set's namespace, and the entry points dispatch.cpp calls. Included once per set, after `#pragma GCC target`
+// and the BATCHCOL_SIMD_NS / BATCHCOL_SIMD_BYTES definitions.
+namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
+
+#include "kernels/simd/wide.hpp"
+#include "kernels/simd/wide_gjk.inl"
+
+void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
+                      bool points) {
+  WideGjk<double>::run(setups, n, out, solver, points);
+}
+void gjk_lanes_float(const PairSetup<float>* setups, std::size_t n, GjkResult<float>* out, Solver solver,
+                     bool points) {
+  WideGjk<float>::run(setups, n, out, solver, points);
+}
+
+}  // namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS
