@@ -4,7 +4,9 @@
 #include "batchcol/batch.hpp"
 #include "kernels/narrowphase.hpp"
 #include "kernels/segment_pairs_world.hpp"
+#include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
+#include "results_fill.hpp"
 #include "validate.hpp"
 
 #include <tbb/blocked_range.h>
@@ -22,20 +24,41 @@ namespace {
 /// output arrays (~0.2 MB) stays in cache while its pairs are visited out of order (grouped by type).
 constexpr std::size_t kTilePairs = 1024;
 
+constexpr std::size_t kTypePairs = kShapeTypeCount * kShapeTypeCount;
+/// Start of each shape-pair type's run in a tile's `order`; group g is order[start[g] .. start[g + 1]).
+using GroupStarts = std::array<std::uint32_t, kTypePairs + 1>;
+
 /// Indices [begin, end) of the batch sorted by (type of a, type of b), stable: pairs of one kernel run back to
-/// back. Grouping stays inside a tile so that memory access stays local.
+/// back. Grouping stays inside a tile so that memory access stays local. `keys` is scratch.
 void group_by_type(const ShapeTable& shapes, const PairBatch& batch, std::size_t begin, std::size_t end,
-                   std::vector<std::uint32_t>& order) {
-  const auto key = [&](std::size_t i) -> std::size_t {
-    const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
-    if (a >= shapes.size() || b >= shapes.size()) return 0;  // invalid pairs: any group, they are rejected per pair
-    return static_cast<std::size_t>(shapes[a].type) * kShapeTypeCount + static_cast<std::size_t>(shapes[b].type);
-  };
-  std::array<std::uint32_t, kShapeTypeCount * kShapeTypeCount + 1> start{};
-  for (std::size_t i = begin; i < end; ++i) ++start[key(i) + 1];
-  for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-  order.resize(end - begin);
-  for (std::size_t i = begin; i < end; ++i) order[start[key(i)]++] = static_cast<std::uint32_t>(i - begin);
+                   std::vector<std::uint32_t>& order, std::vector<std::uint8_t>& keys, GroupStarts& groups) {
+  static_assert(kTypePairs <= 256, "keys are bytes");
+  const std::size_t n = end - begin, count = shapes.size();
+  const Shape* table = shapes.shapes().data();
+  keys.resize(n);
+  order.resize(n);
+  bool uniform = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t a = batch.shape_a[begin + k], b = batch.shape_b[begin + k];
+    // Invalid pairs go to group 0; whatever kernel runs them rejects them per pair.
+    keys[k] = a < count && b < count
+                  ? static_cast<std::uint8_t>(static_cast<std::size_t>(table[a].type) * kShapeTypeCount +
+                                              static_cast<std::size_t>(table[b].type))
+                  : std::uint8_t{0};
+    uniform = uniform && keys[k] == keys[0];
+  }
+  groups.fill(0);
+  if (n == 0) return;
+  if (uniform) {  // one type (the common case in large batches): no sort
+    for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(k);
+    for (std::size_t g = keys[0] + 1; g < groups.size(); ++g) groups[g] = static_cast<std::uint32_t>(n);
+    return;
+  }
+  GroupStarts start{};
+  for (std::size_t k = 0; k < n; ++k) ++start[keys[k] + 1];
+  for (std::size_t g = 1; g < start.size(); ++g) start[g] += start[g - 1];
+  groups = start;
+  for (std::size_t k = 0; k < n; ++k) order[start[keys[k]]++] = static_cast<std::uint32_t>(k);
 }
 
 /// World frame of shape A for one pair: outputs are computed in A's frame and mapped back with it.
@@ -55,6 +78,10 @@ template <class T> struct ChunkScratch {
   std::vector<PairFrame> frames;
   std::vector<std::uint32_t> pairs;
   std::vector<std::uint32_t> order;
+  std::vector<std::uint8_t> keys;
+  GroupStarts groups{};
+  std::vector<std::uint32_t> group_pairs;  // one group's batch indices
+  std::vector<std::uint32_t> fallback;     // pairs the SIMD closed forms left to the scalar path
 };
 
 template <class T>
@@ -122,11 +149,12 @@ bool solve_segment_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   return true;
 }
 
-/// Pairs [begin, end) of the tile, grouped by type (`order` holds offsets from begin): closed forms answer at
-/// setup, the rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
+/// The tile's pairs listed in `s.order` (offsets from begin, grouped by type): closed forms answer at setup, the
+/// rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
 template <class T>
-void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
-              std::size_t begin, ChunkScratch<T>& s, PairResults& out) {
+void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
+                 std::size_t begin, ChunkScratch<T>& s, PairResults& out) {
+  if (s.order.empty()) return;
   s.setups.resize(kChunkPairs);
   s.gjk.resize(kChunkPairs);
   s.frames.resize(kChunkPairs);
@@ -165,12 +193,54 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
   if (pending > 0) flush();
 }
 
+/// Pairs whose types both have a segment core (sphere, capsule), answered by the SIMD closed form.
+bool segment_group(std::size_t group) {
+  const auto is_segment = [](std::size_t type) {
+    return type == static_cast<std::size_t>(ShapeType::sphere) || type == static_cast<std::size_t>(ShapeType::capsule);
+  };
+  return is_segment(group / kShapeTypeCount) && is_segment(group % kShapeTypeCount);
+}
+
+template <class T>
+void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
+              std::size_t begin, std::size_t end, ChunkScratch<T>& s, PairResults& out) {
+  detail::fill_defaults(out, begin, end);
+  group_by_type(shapes, batch, begin, end, s.order, s.keys, s.groups);
+  // Sphere/capsule groups first, W pairs per register; the pairs they leave (invalid input, touching cores) join
+  // the generic per-pair path below with every other group.
+  const kernels::simd::PairView view = kernels::simd::PairView::of(shapes, batch);
+  const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
+  const kernels::simd::ClosedFormQuery query{options.level, options.margin};
+  s.fallback.clear();
+  std::size_t kept = 0;
+  for (std::size_t g = 0; g < kTypePairs; ++g) {
+    const std::uint32_t first = s.groups[g], last = s.groups[g + 1];
+    if (first == last) continue;
+    if (!options.closed_forms || !segment_group(g)) {
+      for (std::uint32_t k = first; k < last; ++k) s.order[kept++] = s.order[k];
+      continue;
+    }
+    s.group_pairs.resize(last - first);
+    for (std::uint32_t k = first; k < last; ++k) s.group_pairs[k - first] = static_cast<std::uint32_t>(begin + s.order[k]);
+    const std::size_t old = s.fallback.size();
+    s.fallback.resize(old + s.group_pairs.size());
+    const bool capsule_a = g / kShapeTypeCount == static_cast<std::size_t>(ShapeType::capsule);
+    const bool capsule_b = g % kShapeTypeCount == static_cast<std::size_t>(ShapeType::capsule);
+    const std::size_t left = kernels::simd::segment_pairs(isa, view, capsule_a, capsule_b, s.group_pairs.data(),
+                                                          s.group_pairs.size(), query, results, s.fallback.data() + old);
+    s.fallback.resize(old + left);
+  }
+  s.order.resize(kept);
+  for (const std::uint32_t i : s.fallback) s.order.push_back(static_cast<std::uint32_t>(i - begin));
+  run_generic(shapes, batch, options, isa, begin, s, out);
+}
+
 }  // namespace
 
 void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results) {
   validate(options);
   detail::validate_batch_layout(batch);
-  results.resize(batch.size());
+  detail::size_results(results, batch.size());  // each tile fills its own slice (fill_defaults)
   const std::size_t n = batch.size();
   const std::size_t tiles = (n + kTilePairs - 1) / kTilePairs;
   const InstructionSet isa = resolve_instruction_set(options.isa);
@@ -179,17 +249,19 @@ void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOption
     ChunkScratch<float> scratch_float;
     for (std::size_t t = range.begin(); t != range.end(); ++t) {
       const std::size_t begin = t * kTilePairs, end = std::min(n, begin + kTilePairs);
-      if (options.precision == Precision::float32) {
-        group_by_type(shapes, batch, begin, end, scratch_float.order);
-        run_tile(shapes, batch, options, isa, begin, scratch_float, results);
-      } else {
-        group_by_type(shapes, batch, begin, end, scratch_double.order);
-        run_tile(shapes, batch, options, isa, begin, scratch_double, results);
-      }
+      if (options.precision == Precision::float32) run_tile(shapes, batch, options, isa, begin, end, scratch_float, results);
+      else run_tile(shapes, batch, options, isa, begin, end, scratch_double, results);
     }
   };
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles), run_tiles); });
+  const auto run_all = [&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles), run_tiles); };
+  // A new arena costs tens of microseconds (as much as ~1000 closed-form pairs): only when the caller's arena has
+  // a different size.
+  if (options.threads <= 0 || options.threads == tbb::this_task_arena::max_concurrency()) {
+    run_all();
+  } else {
+    tbb::task_arena arena(options.threads);
+    arena.execute(run_all);
+  }
 }
 
 }  // namespace batchcol

@@ -1,5 +1,6 @@
 // Run-time choice of the instruction set: the CPU's best (cpuid through __builtin_cpu_supports), lowered by the
 // environment variable BATCHCOL_ISA, or an explicit request checked against the CPU.
+#include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
 #include <cstdlib>
@@ -12,6 +13,8 @@ namespace batchcol::kernels::simd {
   namespace ns {                                                                                             \
   void gjk_lanes_double(const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver, bool);                \
   void gjk_lanes_float(const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);                   \
+  std::size_t segment_pairs(const PairView&, bool, bool, const std::uint32_t*, std::size_t,                       \
+                            const ClosedFormQuery&, const ResultView&, std::uint32_t*);                          \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -58,6 +61,16 @@ void gjk_lanes<float>(InstructionSet isa, const PairSetup<float>* s, std::size_t
     case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver, points);
     case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver, points);
     default: return scalar::gjk_lanes_float(s, n, out, solver, points);
+  }
+}
+
+std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a, bool capsule_b,
+                          const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
+                          const ResultView& out, std::uint32_t* fallback) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
+    case InstructionSet::avx2: return avx2::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
+    default: return scalar::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
   }
 }
 

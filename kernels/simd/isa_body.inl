@@ -5,6 +5,7 @@ namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 
 #include "kernels/simd/wide.hpp"
 #include "kernels/simd/wide_gjk.inl"
+#include "kernels/simd/wide_segments.inl"
 
 void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
                       bool points) {
@@ -13,6 +14,15 @@ void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<
 void gjk_lanes_float(const PairSetup<float>* setups, std::size_t n, GjkResult<float>* out, Solver solver,
                      bool points) {
   WideGjk<float>::run(setups, n, out, solver, points);
+}
+
+std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, const std::uint32_t* pairs,
+                          std::size_t n, const ClosedFormQuery& query, const ResultView& out,
+                          std::uint32_t* fallback) {
+  if (capsule_a && capsule_b) return WideSegments::run<true, true>(in, pairs, n, query, out, fallback);
+  if (capsule_a) return WideSegments::run<true, false>(in, pairs, n, query, out, fallback);
+  if (capsule_b) return WideSegments::run<false, true>(in, pairs, n, query, out, fallback);
+  return WideSegments::run<false, false>(in, pairs, n, query, out, fallback);
 }
 
 }  // namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS

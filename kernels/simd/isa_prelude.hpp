@@ -4,6 +4,7 @@
 #pragma once
 
 #include "kernels/narrowphase.hpp"
+#include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
 #include <immintrin.h>

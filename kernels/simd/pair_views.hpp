@@ -1,0 +1,73 @@
+// Raw views of a PairBatch and of PairResults for the SIMD closed forms: plain pointers to the SoA component
+// arrays, so the per-instruction-set kernels see no std::vector or Eigen code (see isa_prelude.hpp).
+#pragma once
+
+#include "batchcol/batch.hpp"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace batchcol::kernels::simd {
+
+struct PairView {
+  const std::uint32_t* shape_a = nullptr;
+  const std::uint32_t* shape_b = nullptr;
+  const double* translation_a[3] = {};  // x, y, z
+  const double* translation_b[3] = {};
+  const double* rotation_a[4] = {};  // w, x, y, z
+  const double* rotation_b[4] = {};
+  // Shape fields as base pointers into the ShapeTable plus its stride in bytes (no Eigen code in the kernels).
+  const double* shape_size = nullptr;       // Shape::size[0] of shape 0; [1], [2] follow
+  const double* shape_inflation = nullptr;  // Shape::inflation of shape 0
+  std::size_t shape_stride = 0;
+  std::uint32_t shape_count = 0;
+
+  static PairView of(const ShapeTable& shapes, const PairBatch& batch) {
+    PairView v;
+    v.shape_a = batch.shape_a.data();
+    v.shape_b = batch.shape_b.data();
+    const Vec3Array* t[2] = {&batch.translation_a, &batch.translation_b};
+    const QuatArray* q[2] = {&batch.rotation_a, &batch.rotation_b};
+    const double** tv[2] = {v.translation_a, v.translation_b};
+    const double** qv[2] = {v.rotation_a, v.rotation_b};
+    for (int s = 0; s < 2; ++s) {
+      tv[s][0] = t[s]->x.data(), tv[s][1] = t[s]->y.data(), tv[s][2] = t[s]->z.data();
+      qv[s][0] = q[s]->w.data(), qv[s][1] = q[s]->x.data(), qv[s][2] = q[s]->y.data(), qv[s][3] = q[s]->z.data();
+    }
+    v.shape_count = static_cast<std::uint32_t>(shapes.size());
+    v.shape_stride = sizeof(Shape);
+    if (shapes.size() > 0) {
+      v.shape_size = shapes[0].size.data();
+      v.shape_inflation = &shapes[0].inflation;
+    }
+    return v;
+  }
+};
+
+struct ResultView {
+  Status* status = nullptr;
+  std::uint8_t* collide = nullptr;
+  double* distance = nullptr;
+  double* witness_a[3] = {};
+  double* witness_b[3] = {};
+  double* normal[3] = {};
+
+  static ResultView of(PairResults& r) {
+    ResultView v;
+    v.status = r.status.data();
+    v.collide = r.collide.data();
+    v.distance = r.distance.data();
+    Vec3Array* a[3] = {&r.witness_a, &r.witness_b, &r.normal};
+    double** d[3] = {v.witness_a, v.witness_b, v.normal};
+    for (int k = 0; k < 3; ++k) d[k][0] = a[k]->x.data(), d[k][1] = a[k]->y.data(), d[k][2] = a[k]->z.data();
+    return v;
+  }
+};
+
+/// What the closed forms need of QueryOptions.
+struct ClosedFormQuery {
+  QueryLevel level = QueryLevel::boolean;
+  double margin = 0.0;
+};
+
+}  // namespace batchcol::kernels::simd

@@ -1,0 +1,20 @@
+// Entry points of the SIMD closed forms: pairs of one shape-pair type answered W at a time straight from the
+// batch's SoA arrays into the results' (no per-pair setup), compiled once per instruction set (isa_*.cpp).
+#pragma once
+
+#include "kernels/simd/pair_views.hpp"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace batchcol::kernels::simd {
+
+/// Sphere/capsule pairs (every pair of pairs[0 .. n) has A of type capsule when `capsule_a`, else sphere, and
+/// likewise B; `pairs` ascending). Writes status, collide and what `query.level` asks (distance, witness points,
+/// normal) for the pairs it answers; returns how many it left to the scalar path, their indices in
+/// fallback[0 .. count) (invalid input, or touching cores). Results are the same for every instruction set.
+std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a, bool capsule_b,
+                          const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
+                          const ResultView& out, std::uint32_t* fallback);
+
+}  // namespace batchcol::kernels::simd

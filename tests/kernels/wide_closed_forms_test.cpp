@@ -1,0 +1,132 @@
+// SIMD closed forms for sphere/capsule pairs (kernels/simd/wide_segments.inl, run by the executor): every lane
+// equals the scalar closed form on world segments, partial and scattered blocks included; invalid input and
+// touching cores go to the scalar path; every instruction set gives bitwise the same results.
+#include "kernels/closed_forms.hpp"
+#include "kernels/segment_pairs_world.hpp"
+#include "kernels/simd/wide_gjk.hpp"
+#include "support/generators.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace batchcol {
+namespace {
+
+using testing::Rng;
+
+struct Batch {
+  ShapeTable shapes;
+  PairBatch pairs;
+};
+
+/// Spheres and capsules mixed with boxes (so that the sphere/capsule groups of a tile are scattered), plus the
+/// hard lanes: bad quaternions, out-of-range shapes, non-finite translations, crossing capsule axes (touching
+/// cores), concentric spheres. 2500 pairs = 2 full tiles and a partial one.
+Batch mixed_batch(std::uint64_t seed) {
+  Rng rng(seed);
+  Batch b;
+  std::vector<std::uint32_t> round, other;
+  for (int k = 0; k < 4; ++k) round.push_back(b.shapes.add(Shape::sphere(testing::uniform(rng, 0.01, 0.3))));
+  for (int k = 0; k < 4; ++k)
+    round.push_back(b.shapes.add(Shape::capsule(testing::uniform(rng, 0.01, 0.2), testing::uniform(rng, 0.01, 0.3))));
+  round.push_back(b.shapes.add(Shape::capsule(0.1, 0.2).inflated(0.05)));
+  other.push_back(b.shapes.add(Shape::box(0.1, 0.2, 0.3)));
+  const std::uint32_t sphere = round[0], capsule = round[5];
+  for (std::size_t i = 0; i < 2500; ++i) {
+    const bool scattered = i % 7 == 3;
+    const std::uint32_t a = scattered ? other[0] : round[rng() % round.size()];
+    const std::uint32_t c = round[rng() % round.size()];
+    Pose pa{Eigen::Vector3d::Random() * 2.0, testing::random_rotation(rng)};
+    Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.8),
+            testing::random_rotation(rng)};
+    std::uint32_t sa = a, sb = c;
+    switch (i % 97) {
+      case 5: pa.rotation.coeffs() *= 1.01; break;                             // not unit
+      case 6: pb.rotation.coeffs()[1] = std::nan(""); break;                  // NaN
+      case 7: sb = 1000; break;                                               // no such shape
+      case 8: pa.translation.y() = INFINITY; break;                           // non-finite
+      case 9: sa = sb = capsule, pb.translation = pa.translation; break;      // crossing axes: cores touch
+      case 10: sa = sb = sphere, pb.translation = pa.translation; break;     // concentric
+      default: break;
+    }
+    b.pairs.add(sa, pa, sb, pb);
+  }
+  return b;
+}
+
+TEST(WideClosedForms, SphereCapsuleLanesEqualTheScalarClosedForm) {
+  const Batch b = mixed_batch(7);
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness}) {
+    QueryOptions o;
+    o.level = level;
+    o.margin = 0.01;
+    PairResults r;
+    collide(b.shapes, b.pairs, o, r);
+    std::size_t checked = 0, invalid = 0;
+    for (std::size_t i = 0; i < b.pairs.size(); ++i) {
+      const std::uint32_t ia = b.pairs.shape_a[i], ib = b.pairs.shape_b[i];
+      const Eigen::Quaterniond qa = b.pairs.rotation_a[i], qb = b.pairs.rotation_b[i];
+      const Eigen::Vector3d ta = b.pairs.translation_a[i], tb = b.pairs.translation_b[i];
+      if (ia >= b.shapes.size() || ib >= b.shapes.size() || !is_unit_quaternion(qa) || !is_unit_quaternion(qb) ||
+          !ta.allFinite() || !tb.allFinite()) {
+        EXPECT_EQ(r.status[i], Status::invalid_input) << "pair " << i;
+        EXPECT_TRUE(std::isnan(r.distance[i]));
+        ++invalid;
+        continue;
+      }
+      if (!kernels::is_segment_shape(b.shapes[ia]) || !kernels::is_segment_shape(b.shapes[ib])) continue;
+      const kernels::WorldSegment A = kernels::world_segment(b.shapes[ia], qa.normalized(), ta);
+      const kernels::WorldSegment B = kernels::world_segment(b.shapes[ib], qb.normalized(), tb);
+      const kernels::PairOutput<double> ref =
+          kernels::segments_with_radii<double>(A.p0, A.p1, B.p0, B.p1, A.radius, B.radius, tb - ta);
+      ASSERT_EQ(r.status[i], Status::converged) << "pair " << i;
+      EXPECT_EQ(r.collide[i] != 0, ref.distance <= o.margin) << "pair " << i;
+      EXPECT_EQ(std::isnan(r.distance[i]), level < QueryLevel::distance);
+      EXPECT_EQ(std::isnan(r.witness_a.x[i]), level < QueryLevel::witness);
+      EXPECT_TRUE(std::isnan(r.direction.x[i]));  // closed forms have no search direction
+      if (level >= QueryLevel::distance) EXPECT_NEAR(r.distance[i], ref.distance, 1e-14) << "pair " << i;
+      if (level >= QueryLevel::witness) {
+        EXPECT_LT((r.witness_a[i] - ref.witness_a).norm(), 1e-14) << "pair " << i;
+        EXPECT_LT((r.witness_b[i] - ref.witness_b).norm(), 1e-14) << "pair " << i;
+        // The normal is (cb - ca) / |cb - ca|: a few ulps of the coordinates in the closest points, divided by
+        // the core distance.
+        const double core = ref.distance + A.radius + B.radius;
+        EXPECT_LT((r.normal[i] - ref.normal).norm(), 4e-16 * (1 + ta.norm() + tb.norm()) * 8 / core) << "pair " << i;
+      }
+      ++checked;
+    }
+    EXPECT_GT(checked, 1500u);
+    EXPECT_GE(invalid, 4 * 25u);
+  }
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(WideClosedForms, EveryInstructionSetThisCpuRunsGivesTheSameBits) {
+  const Batch b = mixed_batch(11);
+  QueryOptions o;
+  o.level = QueryLevel::witness;
+  o.isa = InstructionSet::scalar;
+  PairResults reference;
+  collide(b.shapes, b.pairs, o, reference);
+  for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
+    if (!kernels::simd::cpu_has(isa)) continue;
+    o.isa = isa;
+    PairResults r;
+    collide(b.shapes, b.pairs, o, r);
+    EXPECT_EQ(r.status, reference.status) << to_string(isa);
+    EXPECT_EQ(r.collide, reference.collide) << to_string(isa);
+    EXPECT_TRUE(same_bits(r.distance, reference.distance)) << to_string(isa);
+    for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
+      EXPECT_TRUE(same_bits((r.*m).x, (reference.*m).x) && same_bits((r.*m).y, (reference.*m).y) &&
+                  same_bits((r.*m).z, (reference.*m).z))
+          << to_string(isa);
+  }
+}
+
+}  // namespace
+}  // namespace batchcol
