@@ -49,11 +49,17 @@ PairOutput<T> segments_with_radii(const Vec3<T>& p0, const Vec3<T>& p1, const Ve
   closest_points_segments<T>(p0, p1, q0, q1, ca, cb);
   const Vec3<T> v = cb - ca;
   const T dcore = v.norm();
+  // Cores closer than kTouchUlps ulps of the coordinates touch: v is then rounding noise (a few ulps), and
+  // v / |v| would point anywhere; 4096 ulps keeps the noise's angle below ~1e-3 rad when the rule does not apply.
+  constexpr T kTouchUlps = T(4096);
+  const T coordinates = std::max(std::max(p0.cwiseAbs().maxCoeff(), p1.cwiseAbs().maxCoeff()),
+                                 std::max(q0.cwiseAbs().maxCoeff(), q1.cwiseAbs().maxCoeff()));
   Vec3<T> n;
-  if (dcore > T(0)) {
+  if (dcore > kTouchUlps * machine_epsilon<T>() * coordinates) {
     n = v / dcore;
   } else {
-    // The cores touch: any unit vector orthogonal to both segments separates them by a zero-length move.
+    // The cores touch: a unit vector orthogonal to both segments (the direction of least overlap when the
+    // segments cross).
     const Vec3<T> axis_a = p1 - p0, axis_b = q1 - q0;
     const Vec3<T> c = axis_a.cross(axis_b);
     if (c.norm() > T(0)) n = c.normalized();

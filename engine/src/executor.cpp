@@ -193,12 +193,20 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
   if (pending > 0) flush();
 }
 
-/// Pairs whose types both have a segment core (sphere, capsule), answered by the SIMD closed form.
-bool segment_group(std::size_t group) {
-  const auto is_segment = [](std::size_t type) {
-    return type == static_cast<std::size_t>(ShapeType::sphere) || type == static_cast<std::size_t>(ShapeType::capsule);
-  };
-  return is_segment(group / kShapeTypeCount) && is_segment(group % kShapeTypeCount);
+ShapeType type_a(std::size_t group) { return static_cast<ShapeType>(group / kShapeTypeCount); }
+ShapeType type_b(std::size_t group) { return static_cast<ShapeType>(group % kShapeTypeCount); }
+
+/// Which SIMD closed form answers a group of this shape-pair type, if any.
+enum class WideClosedForm { none, segments, boxes };
+WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) {
+  if (!options.closed_forms) return WideClosedForm::none;
+  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
+  if (segment(type_a(group)) && segment(type_b(group))) return WideClosedForm::segments;
+  // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
+  if (type_a(group) == ShapeType::box && type_b(group) == ShapeType::box && options.level == QueryLevel::boolean &&
+      options.margin == 0.0)
+    return WideClosedForm::boxes;
+  return WideClosedForm::none;
 }
 
 template <class T>
@@ -206,8 +214,8 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
               std::size_t begin, std::size_t end, ChunkScratch<T>& s, PairResults& out) {
   detail::fill_defaults(out, begin, end);
   group_by_type(shapes, batch, begin, end, s.order, s.keys, s.groups);
-  // Sphere/capsule groups first, W pairs per register; the pairs they leave (invalid input, touching cores) join
-  // the generic per-pair path below with every other group.
+  // Groups with a SIMD closed form first, W pairs per register; the pairs they leave (invalid input, touching
+  // cores, inflated boxes) join the generic per-pair path below with every other group.
   const kernels::simd::PairView view = kernels::simd::PairView::of(shapes, batch);
   const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
   const kernels::simd::ClosedFormQuery query{options.level, options.margin};
@@ -216,7 +224,8 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
   for (std::size_t g = 0; g < kTypePairs; ++g) {
     const std::uint32_t first = s.groups[g], last = s.groups[g + 1];
     if (first == last) continue;
-    if (!options.closed_forms || !segment_group(g)) {
+    const WideClosedForm kind = wide_closed_form(g, options);
+    if (kind == WideClosedForm::none) {
       for (std::uint32_t k = first; k < last; ++k) s.order[kept++] = s.order[k];
       continue;
     }
@@ -224,10 +233,13 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
     for (std::uint32_t k = first; k < last; ++k) s.group_pairs[k - first] = static_cast<std::uint32_t>(begin + s.order[k]);
     const std::size_t old = s.fallback.size();
     s.fallback.resize(old + s.group_pairs.size());
-    const bool capsule_a = g / kShapeTypeCount == static_cast<std::size_t>(ShapeType::capsule);
-    const bool capsule_b = g % kShapeTypeCount == static_cast<std::size_t>(ShapeType::capsule);
-    const std::size_t left = kernels::simd::segment_pairs(isa, view, capsule_a, capsule_b, s.group_pairs.data(),
-                                                          s.group_pairs.size(), query, results, s.fallback.data() + old);
+    std::uint32_t* left_out = s.fallback.data() + old;
+    const std::size_t left =
+        kind == WideClosedForm::segments
+            ? kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule, type_b(g) == ShapeType::capsule,
+                                           s.group_pairs.data(), s.group_pairs.size(), query, results, left_out)
+            : kernels::simd::box_pairs_boolean(isa, view, s.group_pairs.data(), s.group_pairs.size(), results,
+                                               left_out);
     s.fallback.resize(old + left);
   }
   s.order.resize(kept);

@@ -15,6 +15,8 @@ namespace batchcol::kernels::simd {
   void gjk_lanes_float(const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);                   \
   std::size_t segment_pairs(const PairView&, bool, bool, const std::uint32_t*, std::size_t,                       \
                             const ClosedFormQuery&, const ResultView&, std::uint32_t*);                          \
+  std::size_t box_pairs_boolean(const PairView&, const std::uint32_t*, std::size_t, const ResultView&,             \
+                                std::uint32_t*);                                                                 \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -71,6 +73,15 @@ std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a
     case InstructionSet::avx512: return avx512::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
     case InstructionSet::avx2: return avx2::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
     default: return scalar::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
+  }
+}
+
+std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
+                              const ResultView& out, std::uint32_t* fallback) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::box_pairs_boolean(in, pairs, n, out, fallback);
+    case InstructionSet::avx2: return avx2::box_pairs_boolean(in, pairs, n, out, fallback);
+    default: return scalar::box_pairs_boolean(in, pairs, n, out, fallback);
   }
 }
 

@@ -5,7 +5,9 @@ namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 
 #include "kernels/simd/wide.hpp"
 #include "kernels/simd/wide_gjk.inl"
+#include "kernels/simd/wide_pairs.inl"
 #include "kernels/simd/wide_segments.inl"
+#include "kernels/simd/wide_boxes.inl"
 
 void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
                       bool points) {
@@ -23,6 +25,11 @@ std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, co
   if (capsule_a) return WideSegments::run<true, false>(in, pairs, n, query, out, fallback);
   if (capsule_b) return WideSegments::run<false, true>(in, pairs, n, query, out, fallback);
   return WideSegments::run<false, false>(in, pairs, n, query, out, fallback);
+}
+
+std::size_t box_pairs_boolean(const PairView& in, const std::uint32_t* pairs, std::size_t n, const ResultView& out,
+                              std::uint32_t* fallback) {
+  return WideBoxes::run(in, pairs, n, out, fallback);
 }
 
 }  // namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS

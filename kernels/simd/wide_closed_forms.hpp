@@ -17,4 +17,10 @@ std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a
                           const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                           const ResultView& out, std::uint32_t* fallback);
 
+/// Box-box pairs (all of pairs[0 .. n), ascending) at QueryLevel::boolean with a zero margin: separating-axis
+/// test, writes status and collide; returns how many it left to the scalar path (inflated boxes, invalid input),
+/// their indices in fallback[0 .. count).
+std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
+                              const ResultView& out, std::uint32_t* fallback);
+
 }  // namespace batchcol::kernels::simd

@@ -6,21 +6,9 @@
 // Lanes this kernel does not answer -- invalid input, or cores that touch (the closest points give no normal) --
 // go back to the caller, which runs the scalar path on them.
 //
-// No include guard: included once per instruction set by isa_body.inl, after wide.hpp, inside the ISA namespace.
+// No include guard: included once per instruction set by isa_body.inl, after wide_pairs.inl.
 
-struct WideSegments {
-  using real = wreal<double>;
-  using mask = wmask<double>;
-  static constexpr int W = Wide<double>::W;
-
-  struct V3 {
-    real x, y, z;
-  };
-  static real splat(double v) { return real{} + v; }
-  static V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-  static V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-  static V3 scale(real s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
-  static real dot(const V3& a, const V3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+struct WideSegments : PairLanes {
   static real clamp01(real v) { return wmin(wmax(v, splat(0.0)), splat(1.0)); }
   /// a / b where b != 0, else 0 (the lanes where b == 0 take another branch; this keeps them free of inf/NaN).
   static real divide_or_zero(real a, real b) {
@@ -28,39 +16,7 @@ struct WideSegments {
     return select(nonzero, a / select(nonzero, b, splat(1.0)), splat(0.0));
   }
 
-  /// Lane l = a[idx[l]]: one vector load when the indices are consecutive.
-  static real load(const double* a, const std::uint32_t* idx, bool consecutive) {
-    real r;
-    if (consecutive) {
-      __builtin_memcpy(&r, a + idx[0], sizeof r);
-    } else {
-      for (int l = 0; l < W; ++l) r[l] = a[idx[l]];
-    }
-    return r;
-  }
-  static void store(double* a, const std::uint32_t* idx, bool consecutive, real v, std::uint32_t lanes) {
-    if (consecutive) {
-      __builtin_memcpy(a + idx[0], &v, sizeof v);
-    } else {
-      for (int l = 0; l < W; ++l)
-        if ((lanes >> l) & 1u) a[idx[l]] = v[l];
-    }
-  }
-  /// Byte offsets of the lanes' shapes in the ShapeTable (pair idx[l]'s entry of shape_index), and whether each
-  /// index is in range (out-of-range lanes read shape 0 and are marked invalid).
-  static mask shape_offsets(const PairView& in, const std::uint32_t* shape_index, const std::uint32_t* idx,
-                            bool consecutive, mask& in_range) {
-    typedef std::uint32_t lanes32 __attribute__((vector_size(sizeof(std::uint32_t) * W)));
-    lanes32 raw;
-    if (consecutive) {
-      __builtin_memcpy(&raw, shape_index + idx[0], sizeof raw);
-    } else {
-      for (int l = 0; l < W; ++l) raw[l] = shape_index[idx[l]];
-    }
-    const mask shape = __builtin_convertvector(raw, mask);  // zero-extended: 64-bit lanes
-    in_range = shape < (mask{} + typename Wide<double>::Int(in.shape_count));
-    return select(in_range, shape, mask{}) * typename Wide<double>::Int(in.shape_stride);
-  }
+  static real max_abs(const V3& v) { return wmax(wmax(abs(v.x), abs(v.y)), abs(v.z)); }
 
   /// One side's world segment [p0, p1] and swept radius, and whether its input is valid.
   struct Side {
@@ -71,34 +27,20 @@ struct WideSegments {
 
   template <bool Capsule>
   static Side load_side(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
-                        const double* const q[4], const std::uint32_t* idx, bool consecutive) {
+                        const double* const q[4], const Block& b) {
+    Pose p = load_pose(in, shape_index, t, q, b.idx, b.consecutive);
     Side s;
-    const V3 c{load(t[0], idx, consecutive), load(t[1], idx, consecutive), load(t[2], idx, consecutive)};
-    real w = load(q[0], idx, consecutive), x = load(q[1], idx, consecutive), y = load(q[2], idx, consecutive),
-         z = load(q[3], idx, consecutive);
-    // The executor's rule (batchcol::is_unit_quaternion): finite and | |q| - 1 | <= kUnitTolerance; NaN and
-    // infinite components fail both comparisons. Then q is normalised.
-    const real norm = wsqrt<double>(((w * w + x * x) + y * y) + z * z);
-    const real deviation = norm - splat(1.0);
-    const real zero = splat(0.0);
-    s.valid = (deviation <= splat(kUnitTolerance)) & (deviation >= splat(-kUnitTolerance)) &
-              (c.x - c.x == zero) & (c.y - c.y == zero) & (c.z - c.z == zero);
-    mask in_range;
-    const mask offset = shape_offsets(in, shape_index, idx, consecutive, in_range);
-    s.valid &= in_range;
-    const real radius = gather_bytes<double>(in.shape_size, offset) + gather_bytes<double>(in.shape_inflation, offset);
-    s.radius = radius;
+    s.valid = p.valid;
+    s.radius = field(in.shape_size, p) + field(in.shape_inflation, p);
     if (!Capsule) {
-      s.p0 = s.p1 = c;
+      s.p0 = s.p1 = p.t;
       return s;
     }
-    const real half = gather_bytes<double>(in.shape_size + 1, offset);
-    w = w / norm, x = x / norm, y = y / norm, z = z / norm;
-    // The capsule's local z axis is the third column of the rotation matrix of q.
-    const V3 axis{splat(2.0) * (x * z + w * y), splat(2.0) * (y * z - w * x),
-                  splat(1.0) - splat(2.0) * (x * x + y * y)};
-    s.p0 = sub(c, scale(half, axis));
-    s.p1 = add(c, scale(half, axis));
+    const real half = field(in.shape_size + 1, p);
+    normalize(p);
+    const V3 axis = column(p, 2);  // the capsule's local z axis
+    s.p0 = sub(p.t, scale(half, axis));
+    s.p1 = add(p.t, scale(half, axis));
     return s;
   }
 
@@ -145,50 +87,34 @@ struct WideSegments {
       for (std::size_t k = 0; k < n; ++k) fallback[fallbacks++] = pairs[k];
       return fallbacks;
     }
-    const bool distance = query.level >= QueryLevel::distance, points = query.level >= QueryLevel::witness;
     for (std::size_t k = 0; k < n; k += W) {
-      const int m = n - k < std::size_t(W) ? int(n - k) : W;
-      std::uint32_t idx[W];
-      for (int l = 0; l < W; ++l) idx[l] = pairs[k + std::size_t(l < m ? l : m - 1)];
-      const bool consecutive = m == W && idx[W - 1] - idx[0] == std::uint32_t(W - 1);  // pairs are ascending
-      const Side A = load_side<CapsuleA>(in, in.shape_a, in.translation_a, in.rotation_a, idx, consecutive);
-      const Side B = load_side<CapsuleB>(in, in.shape_b, in.translation_b, in.rotation_b, idx, consecutive);
+      const Block b = block(pairs, n, k);
+      const Side A = load_side<CapsuleA>(in, in.shape_a, in.translation_a, in.rotation_a, b);
+      const Side B = load_side<CapsuleB>(in, in.shape_b, in.translation_b, in.rotation_b, b);
       V3 ca, cb;
       closest_points<CapsuleA, CapsuleB>(A, B, ca, cb);
       const V3 v = sub(cb, ca);
       const real core = wsqrt<double>(dot(v, v));
       const real signed_distance = (core - A.radius) - B.radius;
-      const mask answered = A.valid & B.valid & (core > splat(0.0));
-      const std::uint32_t live = (m == W ? ~0u : (1u << m) - 1u) & ((1u << W) - 1u);
-      const std::uint32_t mine = lane_bits(answered) & live;
-      const bool whole = consecutive && mine == live;
-      if (whole) {
-        std::uint8_t collide[W];
-        const std::uint32_t hits = lane_bits(signed_distance <= splat(query.margin));
-        for (int l = 0; l < W; ++l) collide[l] = std::uint8_t((hits >> l) & 1u);
-        __builtin_memcpy(out.collide + idx[0], collide, W);
-        for (int l = 0; l < W; ++l) out.status[idx[0] + std::uint32_t(l)] = Status::converged;
-      } else {
-        for (int l = 0; l < m; ++l) {
-          if (!((mine >> l) & 1u)) {
-            fallback[fallbacks++] = idx[l];
-            continue;
-          }
-          out.status[idx[l]] = Status::converged;
-          out.collide[idx[l]] = signed_distance[l] <= query.margin ? 1 : 0;
-        }
-      }
-      if (distance) store(out.distance, idx, whole, signed_distance, mine);
-      if (points) {
+      // Touching cores (the scalar rule in segments_with_radii: within 4096 ulps of the coordinates) need the
+      // scalar path's normal.
+      const real coordinates = wmax(wmax(max_abs(A.p0), max_abs(A.p1)), wmax(max_abs(B.p0), max_abs(B.p1)));
+      const real touch = splat(4096 * std::numeric_limits<double>::epsilon()) * coordinates;
+      const mask answered = A.valid & B.valid & (core > touch);
+      const std::uint32_t mine = lane_bits(answered) & b.live;
+      const bool whole =
+          write_collide(b, mine, signed_distance <= splat(query.margin), out, fallback, fallbacks);
+      if (query.level >= QueryLevel::distance) store(out.distance, b.idx, whole, signed_distance, mine);
+      if (query.level >= QueryLevel::witness) {
         const real safe_core = select(answered, core, splat(1.0));
         const V3 normal{v.x / safe_core, v.y / safe_core, v.z / safe_core};
         const V3 wa = add(ca, scale(A.radius, normal)), wb = sub(cb, scale(B.radius, normal));
         const V3* vecs[3] = {&wa, &wb, &normal};
         double* const* dst[3] = {out.witness_a, out.witness_b, out.normal};
         for (int j = 0; j < 3; ++j) {
-          store(dst[j][0], idx, whole, vecs[j]->x, mine);
-          store(dst[j][1], idx, whole, vecs[j]->y, mine);
-          store(dst[j][2], idx, whole, vecs[j]->z, mine);
+          store(dst[j][0], b.idx, whole, vecs[j]->x, mine);
+          store(dst[j][1], b.idx, whole, vecs[j]->y, mine);
+          store(dst[j][2], b.idx, whole, vecs[j]->z, mine);
         }
       }
     }

@@ -1,0 +1,60 @@
+// Box-box boolean by the separating-axis theorem over the 15 candidate axes (Gottschalk, Lin, Manocha, "OBBTree",
+// SIGGRAPH 1996), W pairs per register straight from their world poses: B's rotation and centre in A's frame,
+// then all 15 tests as lane masks (no early exit: a register takes every test). |R| is padded by 1e3 eps as in
+// boxes_intersect() (kernels/closed_forms.hpp), so that the edge-edge axes of nearly parallel edges cannot
+// report a spurious separation from rounding. Plain boxes only (the caller runs this at QueryLevel::boolean with a
+// zero margin, like the scalar closed form); inflated boxes and invalid input go back to the caller.
+//
+// No include guard: included once per instruction set by isa_body.inl, after wide_pairs.inl.
+
+struct WideBoxes : PairLanes {
+  static std::size_t run(const PairView& in, const std::uint32_t* pairs, std::size_t n, const ResultView& out,
+                         std::uint32_t* fallback) {
+    std::size_t fallbacks = 0;
+    if (in.shape_count == 0) {
+      for (std::size_t k = 0; k < n; ++k) fallback[fallbacks++] = pairs[k];
+      return fallbacks;
+    }
+    const real zero = splat(0.0), pad = splat(1000 * std::numeric_limits<double>::epsilon());
+    for (std::size_t k = 0; k < n; k += W) {
+      const Block b = block(pairs, n, k);
+      Pose pa = load_pose(in, in.shape_a, in.translation_a, in.rotation_a, b.idx, b.consecutive);
+      Pose pb = load_pose(in, in.shape_b, in.translation_b, in.rotation_b, b.idx, b.consecutive);
+      const mask answered = pa.valid & pb.valid & (field(in.shape_inflation, pa) == zero) &
+                            (field(in.shape_inflation, pb) == zero);
+      const real ha[3] = {field(in.shape_size, pa), field(in.shape_size + 1, pa), field(in.shape_size + 2, pa)};
+      const real hb[3] = {field(in.shape_size, pb), field(in.shape_size + 1, pb), field(in.shape_size + 2, pb)};
+      normalize(pa);
+      normalize(pb);
+      const V3 ca[3] = {column(pa, 0), column(pa, 1), column(pa, 2)};
+      const V3 cb[3] = {column(pb, 0), column(pb, 1), column(pb, 2)};
+      const V3 d = sub(pb.t, pa.t);
+      real R[3][3], absR[3][3], t[3];  // B's rotation and centre in A's frame
+      for (int i = 0; i < 3; ++i) {
+        t[i] = dot(ca[i], d);
+        for (int j = 0; j < 3; ++j) {
+          R[i][j] = dot(ca[i], cb[j]);
+          absR[i][j] = abs(R[i][j]) + pad;
+        }
+      }
+      mask separated{};
+      for (int i = 0; i < 3; ++i)  // A's face normals
+        separated |= abs(t[i]) > ha[i] + ((hb[0] * absR[i][0] + hb[1] * absR[i][1]) + hb[2] * absR[i][2]);
+      for (int j = 0; j < 3; ++j)  // B's face normals
+        separated |= abs((t[0] * R[0][j] + t[1] * R[1][j]) + t[2] * R[2][j]) >
+                     ((ha[0] * absR[0][j] + ha[1] * absR[1][j]) + ha[2] * absR[2][j]) + hb[j];
+      for (int i = 0; i < 3; ++i) {  // edge-edge axes e_i x (R e_j), in A's frame
+        const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+        for (int j = 0; j < 3; ++j) {
+          const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+          const real dist = abs(t[i2] * R[i1][j] - t[i1] * R[i2][j]);
+          const real ra = ha[i1] * absR[i2][j] + ha[i2] * absR[i1][j];
+          const real rb = hb[j1] * absR[i][j2] + hb[j2] * absR[i][j1];
+          separated |= dist > ra + rb;
+        }
+      }
+      write_collide(b, lane_bits(answered) & b.live, ~separated, out, fallback, fallbacks);
+    }
+    return fallbacks;
+  }
+};

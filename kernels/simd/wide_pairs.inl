@@ -1,0 +1,131 @@
+// Lane helpers shared by the SIMD closed forms (wide_segments.inl, wide_boxes.inl): 3-vectors of lanes, loads and
+// stores at pair indices, shape fields through the ShapeTable's stride, and world poses with the executor's
+// validity rule.
+//
+// No include guard: included once per instruction set by isa_body.inl, after wide.hpp, inside the ISA namespace.
+
+struct PairLanes {
+  using real = wreal<double>;
+  using mask = wmask<double>;
+  using Int = typename Wide<double>::Int;
+  static constexpr int W = Wide<double>::W;
+
+  struct V3 {
+    real x, y, z;
+  };
+  static real splat(double v) { return real{} + v; }
+  static V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  static V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  static V3 scale(real s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+  static real dot(const V3& a, const V3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+  /// |v|: the sign bit cleared (vector casts between same-size types reinterpret the bits).
+  static real abs(real v) { return real(mask(v) & (mask{} + Int(0x7fffffffffffffffLL))); }
+
+  /// Lane l = a[idx[l]]: one vector load when the indices are consecutive.
+  static real load(const double* a, const std::uint32_t* idx, bool consecutive) {
+    real r;
+    if (consecutive) {
+      __builtin_memcpy(&r, a + idx[0], sizeof r);
+    } else {
+      for (int l = 0; l < W; ++l) r[l] = a[idx[l]];
+    }
+    return r;
+  }
+  /// a[idx[l]] = lane l for the lanes set in `lanes` (all of them when `whole`: one vector store).
+  static void store(double* a, const std::uint32_t* idx, bool whole, real v, std::uint32_t lanes) {
+    if (whole) {
+      __builtin_memcpy(a + idx[0], &v, sizeof v);
+    } else {
+      for (int l = 0; l < W; ++l)
+        if ((lanes >> l) & 1u) a[idx[l]] = v[l];
+    }
+  }
+
+  /// One side of W pairs: the world pose (q as given, with its norm) and the byte offset of the shape in the
+  /// ShapeTable. `valid`: the executor's rule (batchcol::is_unit_quaternion): q finite with | |q| - 1 | <=
+  /// kUnitTolerance (NaN and infinite components fail both comparisons), t finite, shape index in range
+  /// (out-of-range lanes read shape 0).
+  struct Pose {
+    V3 t;
+    real w, x, y, z, norm;
+    mask shape, valid;
+  };
+  static Pose load_pose(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
+                        const double* const q[4], const std::uint32_t* idx, bool consecutive) {
+    Pose p;
+    p.t = {load(t[0], idx, consecutive), load(t[1], idx, consecutive), load(t[2], idx, consecutive)};
+    p.w = load(q[0], idx, consecutive), p.x = load(q[1], idx, consecutive), p.y = load(q[2], idx, consecutive),
+    p.z = load(q[3], idx, consecutive);
+    p.norm = wsqrt<double>(((p.w * p.w + p.x * p.x) + p.y * p.y) + p.z * p.z);
+    const real deviation = p.norm - splat(1.0), zero = splat(0.0);
+    p.valid = (deviation <= splat(kUnitTolerance)) & (deviation >= splat(-kUnitTolerance)) &
+              (p.t.x - p.t.x == zero) & (p.t.y - p.t.y == zero) & (p.t.z - p.t.z == zero);
+    typedef std::uint32_t lanes32 __attribute__((vector_size(sizeof(std::uint32_t) * W)));
+    lanes32 raw;
+    if (consecutive) {
+      __builtin_memcpy(&raw, shape_index + idx[0], sizeof raw);
+    } else {
+      for (int l = 0; l < W; ++l) raw[l] = shape_index[idx[l]];
+    }
+    const mask shape = __builtin_convertvector(raw, mask);  // zero-extended to 64-bit lanes
+    const mask in_range = shape < (mask{} + Int(in.shape_count));
+    p.valid &= in_range;
+    p.shape = select(in_range, shape, mask{}) * Int(in.shape_stride);
+    return p;
+  }
+  /// Shape field at `base` (a field of shape 0, e.g. in.shape_size + 1) for each lane's shape.
+  static real field(const double* base, const Pose& p) { return gather_bytes<double>(base, p.shape); }
+
+  /// q / |q| (the executor normalises every quaternion it accepts).
+  static void normalize(Pose& p) {
+    p.w = p.w / p.norm, p.x = p.x / p.norm, p.y = p.y / p.norm, p.z = p.z / p.norm;
+  }
+  /// Column j of the rotation matrix of a normalised q.
+  static V3 column(const Pose& p, int j) {
+    const real w = p.w, x = p.x, y = p.y, z = p.z;
+    const real one = splat(1.0), two = splat(2.0);
+    if (j == 0) return {one - two * (y * y + z * z), two * (x * y + w * z), two * (x * z - w * y)};
+    if (j == 1) return {two * (x * y - w * z), one - two * (x * x + z * z), two * (y * z + w * x)};
+    return {two * (x * z + w * y), two * (y * z - w * x), one - two * (x * x + y * y)};
+  }
+
+  /// Block bookkeeping: the W pair indices of block k (the last block repeats its last pair), which lanes are
+  /// real, and whether the indices are consecutive (pairs are ascending).
+  struct Block {
+    std::uint32_t idx[W];
+    int lanes = 0;
+    std::uint32_t live = 0;
+    bool consecutive = false;
+  };
+  static Block block(const std::uint32_t* pairs, std::size_t n, std::size_t k) {
+    Block b;
+    b.lanes = n - k < std::size_t(W) ? int(n - k) : W;
+    for (int l = 0; l < W; ++l) b.idx[l] = pairs[k + std::size_t(l < b.lanes ? l : b.lanes - 1)];
+    b.live = (1u << b.lanes) - 1u;  // W <= 16
+    b.consecutive = b.lanes == W && b.idx[W - 1] - b.idx[0] == std::uint32_t(W - 1);
+    return b;
+  }
+
+  /// Writes status converged and collide for the answered lanes (`mine`), appends the others to `fallback`.
+  /// Returns whether the block was answered whole with consecutive indices (vector stores allowed).
+  static bool write_collide(const Block& b, std::uint32_t mine, mask collide, const ResultView& out,
+                            std::uint32_t* fallback, std::size_t& fallbacks) {
+    const std::uint32_t hits = lane_bits(collide);
+    if (b.consecutive && mine == b.live) {
+      std::uint8_t bytes[W];
+      for (int l = 0; l < W; ++l) bytes[l] = std::uint8_t((hits >> l) & 1u);
+      __builtin_memcpy(out.collide + b.idx[0], bytes, W);
+      for (int l = 0; l < W; ++l) out.status[b.idx[0] + std::uint32_t(l)] = Status::converged;
+      return true;
+    }
+    for (int l = 0; l < b.lanes; ++l) {
+      if (!((mine >> l) & 1u)) {
+        fallback[fallbacks++] = b.idx[l];
+        continue;
+      }
+      out.status[b.idx[l]] = Status::converged;
+      out.collide[b.idx[l]] = std::uint8_t((hits >> l) & 1u);
+    }
+    return false;
+  }
+};
