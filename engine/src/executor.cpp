@@ -61,6 +61,22 @@ void group_by_type(const ShapeTable& shapes, const PairBatch& batch, std::size_t
   for (std::size_t k = 0; k < n; ++k) order[start[keys[k]]++] = static_cast<std::uint32_t>(k);
 }
 
+ShapeType type_a(std::size_t group) { return static_cast<ShapeType>(group / kShapeTypeCount); }
+ShapeType type_b(std::size_t group) { return static_cast<ShapeType>(group % kShapeTypeCount); }
+
+/// Which SIMD closed form answers a group of this shape-pair type, if any.
+enum class WideClosedForm { none, segments, boxes };
+WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) {
+  if (!options.closed_forms) return WideClosedForm::none;
+  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
+  if (segment(type_a(group)) && segment(type_b(group))) return WideClosedForm::segments;
+  // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
+  if (type_a(group) == ShapeType::box && type_b(group) == ShapeType::box && options.level == QueryLevel::boolean &&
+      options.margin == 0.0)
+    return WideClosedForm::boxes;
+  return WideClosedForm::none;
+}
+
 /// World frame of shape A for one pair: outputs are computed in A's frame and mapped back with it.
 struct PairFrame {
   Eigen::Matrix3d Ra;
@@ -85,13 +101,16 @@ template <class T> struct ChunkScratch {
 };
 
 template <class T>
-void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size_t i, PairResults& out) {
+void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size_t i, QueryLevel level,
+                  PairResults& out) {
   out.status[i] = r.status;
   out.collide[i] = r.collide ? 1 : 0;
   out.distance[i] = static_cast<double>(r.distance);
-  out.witness_a.set(i, f.Ra * r.witness_a.template cast<double>() + f.ta);
-  out.witness_b.set(i, f.Ra * r.witness_b.template cast<double>() + f.ta);
-  out.normal.set(i, f.Ra * r.normal.template cast<double>());
+  if (level >= QueryLevel::witness) {  // below, these are NaN (fill_defaults) and cost 3 rotations to map
+    out.witness_a.set(i, f.Ra * r.witness_a.template cast<double>() + f.ta);
+    out.witness_b.set(i, f.Ra * r.witness_b.template cast<double>() + f.ta);
+    out.normal.set(i, f.Ra * r.normal.template cast<double>());
+  }
   out.direction.set(i, f.Ra * r.direction.template cast<double>());
   out.iterations[i] = r.iterations;
 }
@@ -165,17 +184,21 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
     kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver,
                                 options.level >= QueryLevel::witness);
     for (std::size_t j = 0; j < pending; ++j)
-      write_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j], s.pairs[j], out);
+      write_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j], s.pairs[j], options.level,
+                   out);
     pending = 0;
   };
   for (const std::uint32_t k : s.order) {
     const std::size_t i = begin + k;
-    if (options.closed_forms && solve_segment_pair(shapes, batch, options, i, out)) continue;
+    // Sphere/capsule pairs reach this path only when the SIMD closed form left them (touching cores, bad input).
+    if (options.closed_forms && wide_closed_form(s.keys[k], options) == WideClosedForm::segments &&
+        solve_segment_pair(shapes, batch, options, i, out))
+      continue;
     PairFrame frame;
     kernels::PairSetup<T>& setup = s.setups[pending];
     if (!prepare_pair(shapes, batch, options, i, frame, setup, out)) continue;
     if (setup.done) {
-      write_output(setup.out, frame, i, out);
+      write_output(setup.out, frame, i, options.level, out);
       continue;
     }
     // A chunk holds one shape-pair type (the kernels branch on the type once per chunk, not per lane).
@@ -191,22 +214,6 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
     if (++pending == kChunkPairs) flush();
   }
   if (pending > 0) flush();
-}
-
-ShapeType type_a(std::size_t group) { return static_cast<ShapeType>(group / kShapeTypeCount); }
-ShapeType type_b(std::size_t group) { return static_cast<ShapeType>(group % kShapeTypeCount); }
-
-/// Which SIMD closed form answers a group of this shape-pair type, if any.
-enum class WideClosedForm { none, segments, boxes };
-WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) {
-  if (!options.closed_forms) return WideClosedForm::none;
-  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
-  if (segment(type_a(group)) && segment(type_b(group))) return WideClosedForm::segments;
-  // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
-  if (type_a(group) == ShapeType::box && type_b(group) == ShapeType::box && options.level == QueryLevel::boolean &&
-      options.margin == 0.0)
-    return WideClosedForm::boxes;
-  return WideClosedForm::none;
 }
 
 template <class T>
