@@ -18,6 +18,9 @@ struct PairLanes {
   static V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
   static V3 scale(real s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
   static real dot(const V3& a, const V3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+  static V3 cross(const V3& a, const V3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  }
   /// |v|: the sign bit cleared (vector casts between same-size types reinterpret the bits).
   static real abs(real v) { return real(mask(v) & (mask{} + Int(0x7fffffffffffffffLL))); }
 
