@@ -74,8 +74,9 @@ struct QueryOptions {
   int threads = 0;                // 0 = all cores
   InstructionSet isa = InstructionSet::automatic;
 };
-/// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic, scalar) or "gjk" (the
-/// SIMD GJK, one pair per lane; EPA runs scalar on the overlapping pairs that asked for depth).
+/// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic: in SIMD lanes straight
+/// from the batch arrays for sphere/capsule pairs and box-box boolean, per pair otherwise) or "gjk" (the SIMD GJK,
+/// one pair per lane; EPA runs scalar on the overlapping pairs that asked for depth).
 const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options);
 
 /// A batch of pairs in structure-of-arrays layout. `warm_start`, when not empty, holds one support direction per
