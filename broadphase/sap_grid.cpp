@@ -10,10 +10,11 @@
 namespace batchcol::broadphase {
 namespace {
 
-// Cells this many mean box widths wide: a box then spans (1 + 1/k)^2 cells on average (1.36 copies at k = 6) while
-// a cell holds few enough boxes that the sweep inside it tests a handful of intervals per box. Tuned on the
-// uniform benchmark scenes (bench/broadphase_bench.cpp).
-constexpr double kCellWidthInExtents = 6.0;
+// Cells this many mean box widths wide: a box then spans (1 + 1/k)^2 cells on average (1.27 copies at k = 8) while
+// a cell holds few enough boxes that the sweep inside it tests a handful of intervals per box. k = 6 (1.36 copies)
+// swept a little less but its 28-byte records put the broad phase above 64 bytes per object (stress scene, 100k:
+// 66.6 B with the float boxes); k = 8 brings it under.
+constexpr double kCellWidthInExtents = 8.0;
 // Fewer than this many objects per cell on average costs more in per-cell bookkeeping than it saves.
 constexpr std::size_t kMinObjectsPerCell = 16;
 // Bounds the cell index to 16 bits per axis (the bucketing packs cell ranges into 64 bits).

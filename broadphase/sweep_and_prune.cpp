@@ -1,23 +1,22 @@
 // Parallel sweep-and-prune.
 // References: P. Terdiman, "Sweep-and-prune" (2007, www.codercorner.com/SAP.pdf) and the "box pruning" series
-// (codercorner.com, 2002-2017) for the inner loop: sort boxes by min on one axis, then for each box scan the boxes
-// whose min lies in [min, max] on that axis and test the two other axes; "multi box pruning" for splitting the world
-// into regions swept separately; P. Terdiman, "Radix sort revisited" (2000) for sorting float keys as integers.
+// (codercorner.com, 2002-2017) for the inner loop (sap_cell.hpp); "multi box pruning" for splitting the world into
+// regions swept separately; P. Terdiman, "Radix sort revisited" (2000) for sorting float keys as integers.
 //
 // Pipeline (each stage is split into a fixed number of chunks or cell groups, never into "one per thread", so every
 // stage computes the same thing for any thread count):
 //   1. grid: chosen by rebuild() (see sap_grid.hpp), kept by update() unless the object count changed or the scene
 //      drifted (entries or fullest cell grew past kDrift* of the rebuild's);
-//   2. bucketing, in INPUT order: a counting pass and a scatter pass read the box arrays linearly and write one
-//      32-byte record per cell a box spans (no random reads of the inputs); inside a cell, records are in id order;
-//   3. per cell, in parallel over fixed groups of cells: sort the records by (min on the sweep axis, id) (insertion
-//      sort for small cells, an LSD radix sort on the float key for larger ones; the cell fits in cache), then box
-//      pruning; a pair is kept only in the cell holding the lower corner of its overlap on the grid axes (so
-//      exactly once); each group appends to its own buffer;
+//   2. rebuild() buckets in INPUT order: a counting pass and a scatter pass read the box arrays linearly and write
+//      one record per cell a box spans; update() instead refreshes the previous frame's records in place (sap_update
+//      below) and buckets only the overflow (objects that left their cells);
+//   3. per cell, in parallel over fixed groups of cells: sort the records by min on the sweep axis (nearly sorted in
+//      update()), then box pruning within the cell, plus overflow x cell and overflow x overflow; a pair is kept only
+//      in the cell holding the lower corner of its overlap on the grid axes (so exactly once); each group appends to
+//      its own buffer;
 //   4. emit: the group buffers concatenated and radix-sorted as (a << 32 | b): unique keys, one sorted answer.
 #include "broadphase/sweep_and_prune.hpp"
 
-#include "broadphase/float_key.hpp"
 #include "broadphase/radix_sort.hpp"
 
 #include <tbb/parallel_for.h>
@@ -25,24 +24,24 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstring>
 #include <utility>
 
 namespace batchcol::broadphase {
 namespace {
 
 // Bucketing chunks: at least this many objects each (below, per-chunk cell counters cost more than they save) and at
-// most kMaxBucketChunks (the counters are chunks x cells words).
+// most kMaxBucketChunks (the counters are chunks x cells words, kept between frames: 4 chunks x n/16 cells x 4 bytes
+// = 1 byte per object at most).
 constexpr std::size_t kBucketChunkMin = 16384;
-constexpr std::size_t kMaxBucketChunks = 16;
+constexpr std::size_t kMaxBucketChunks = 4;
 // Groups of cells sorted and swept as parallel tasks, balanced by entry count; enough for load balance on a few cores.
 constexpr std::size_t kSweepGroups = 64;
-// Cells up to this size are insertion-sorted; larger ones radix-sorted.
-constexpr std::size_t kInsertionSortMax = 48;
-// update() chooses a new grid when the entries exceed kDriftEntries x (or the fullest cell kDriftMaxCell x) those of
-// the call that chose the current grid, plus some slack for small scenes.
+// update() re-buckets when the entries exceed kDriftEntries x (or the fullest cell kDriftMaxCell x) those of the call
+// that chose the current grid, plus some slack for small scenes, or when the overflow holds more than
+// 1 / kOverflowFraction of the objects (it is bucketed every frame and its tombstones are swept for nothing).
 constexpr double kDriftEntries = 1.25;
 constexpr double kDriftMaxCell = 2.0;
+constexpr std::size_t kOverflowFraction = 8;
 // Big boxes straddling many cells: when the copies exceed this many per object, coarsen the grid (x 1/2 per axis).
 constexpr std::size_t kMaxCopiesPerObject = 4;
 
@@ -60,6 +59,8 @@ int bit_width(std::size_t x) {
   return w;
 }
 
+template <class V> std::size_t bytes(const V& v) { return v.capacity() * sizeof(typename V::value_type); }
+
 }  // namespace
 
 void SweepAndPrune::rebuild(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs) {
@@ -72,15 +73,19 @@ void SweepAndPrune::update(const AabbSoa& boxes, const FilterSoa& filter, std::v
 
 void SweepAndPrune::clear() { *this = SweepAndPrune(); }
 
+std::size_t SweepAndPrune::pair_buffer_bytes() const {
+  std::size_t b = held_bytes(words_) + held_bytes(scratch_);
+  for (const auto& g : group_pairs_) b += bytes(g);
+  return b;
+}
+
 std::size_t SweepAndPrune::memory_bytes() const {
-  std::size_t bytes = words_.capacity() * 8 + scratch_.capacity() * 8 + counts_.capacity() * 4 +
-                      cell_start_.capacity() * 4 + entries_.capacity() * sizeof(Entry);
-  for (const auto& g : group_pairs_) bytes += g.capacity() * 8;
-  for (const auto& g : group_scratch_) bytes += (g.words.capacity() + g.tmp.capacity()) * 8 + g.entries.capacity() * sizeof(Entry);
-  bytes += (first_cell_.capacity() + group_start_.capacity() + chunk_entries_.capacity()) * sizeof(std::size_t) +
-           shifts_.capacity() * sizeof(int) + radix_histograms_.capacity() * sizeof(radix_histograms_[0]) +
-           group_pairs_.capacity() * sizeof(group_pairs_[0]) + group_scratch_.capacity() * sizeof(CellScratch);
-  return bytes;
+  std::size_t b = pair_buffer_bytes() + bytes(counts_) + bytes(cell_start_) + held_bytes(entries_) +
+                  bytes(overflow_ids_) + bytes(overflow_start_) + bytes(overflow_entries_);
+  for (const auto& g : group_movers_) b += bytes(g);
+  for (const auto& g : group_scratch_) b += bytes(g.words) + bytes(g.tmp) + bytes(g.entries);
+  return b + bytes(first_cell_) + bytes(group_start_) + bytes(chunk_entries_) + bytes(shifts_) +
+         bytes(radix_histograms_) + bytes(group_pairs_) + bytes(group_movers_) + bytes(group_scratch_);
 }
 
 void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs,
@@ -94,33 +99,48 @@ void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vect
   const std::size_t n = boxes.size();
   validate_filter(filter, n);
   incremental = incremental && have_order_ && object_count_ == n;
+  const SapStats previous = stats_;
   stats_ = SapStats{};
-  if (!incremental) grid_ = choose_grid(boxes);
-  std::size_t entries = count_entries(boxes);
-  const auto grew = [](std::size_t now, std::size_t then, double factor, double slack) {
-    return static_cast<double>(now) > factor * static_cast<double>(then) + slack;
-  };
-  if (incremental && (grew(entries, rebuild_entries_, kDriftEntries, 1024) ||
-                      grew(stats_.max_cell, rebuild_max_cell_, kDriftMaxCell, 64))) {
-    incremental = false;
-    grid_ = choose_grid(boxes);
-    entries = count_entries(boxes);
+  bool rebucket = true;
+  if (incremental) {
+    refresh(boxes);  // fills overflow_ids_
+    rebucket = overflow_ids_.size() * kOverflowFraction > n + 1024;
+    stats_.max_cell = previous.max_cell;
   }
+  if (!incremental) grid_ = choose_grid(boxes);
+  std::size_t entries = cell_start_.empty() ? 0 : cell_start_.back();
+  if (rebucket) {
+    entries = count_entries(boxes);
+    const auto grew = [](std::size_t now, std::size_t then, double factor, double slack) {
+      return static_cast<double>(now) > factor * static_cast<double>(then) + slack;
+    };
+    if (incremental && (grew(entries, rebuild_entries_, kDriftEntries, 1024) ||
+                        grew(stats_.max_cell, rebuild_max_cell_, kDriftMaxCell, 64))) {
+      incremental = false;
+      grid_ = choose_grid(boxes);
+      entries = count_entries(boxes);
+    }
+    while (entries > kMaxCopiesPerObject * n + 1024 && grid_.cell_count() > 1) {
+      grid_ = coarser(grid_);
+      entries = count_entries(boxes);
+    }
+    if (!incremental) rebuild_entries_ = entries, rebuild_max_cell_ = stats_.max_cell;
+    bucket(boxes);
+    choose_groups();
+    overflow_ids_.clear();
+  }
+  bucket_overflow(boxes);
   object_count_ = n;
   have_order_ = true;
-  while (entries > kMaxCopiesPerObject * n + 1024 && grid_.cell_count() > 1) {
-    grid_ = coarser(grid_);
-    entries = count_entries(boxes);
-  }
   stats_.axis = grid_.axis;
   stats_.cells_u = grid_.cells_u;
   stats_.cells_v = grid_.cells_v;
   stats_.entries = entries;
   stats_.incremental = incremental;
-  if (!incremental) rebuild_entries_ = entries, rebuild_max_cell_ = stats_.max_cell;
-  bucket(boxes);
+  stats_.rebucketed = rebucket;
+  stats_.overflow = overflow_ids_.size();
   const auto t1 = Clock::now();
-  sort_and_sweep(filter);
+  sort_and_sweep(filter, !rebucket);
   const auto t2 = Clock::now();
   emit(pairs);
   stats_.pairs = pairs.size();
@@ -131,8 +151,7 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
   const std::size_t n = boxes.size(), cells = grid_.cell_count();
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
   counts_.assign(ch.count * cells, 0);
-  std::vector<std::size_t>& chunk_entries = chunk_entries_;
-  chunk_entries.assign(ch.count, 0);
+  chunk_entries_.assign(ch.count, 0);
   const float *lu = boxes.min(grid_.u), *hu = boxes.max(grid_.u), *lv = boxes.min(grid_.v), *hv = boxes.max(grid_.v);
   const SapGrid g = grid_;
   tbb::parallel_for(std::size_t{0}, ch.count, [&](std::size_t c) {
@@ -145,10 +164,10 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
         for (int cu = cu0; cu <= cu1; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
       total += static_cast<std::size_t>(cu1 - cu0 + 1) * static_cast<std::size_t>(cv1 - cv0 + 1);
     }
-    chunk_entries[c] = total;
+    chunk_entries_[c] = total;
   });
   std::size_t entries = 0;
-  for (std::size_t e : chunk_entries) entries += e;
+  for (std::size_t e : chunk_entries_) entries += e;
   std::size_t max_cell = 0;
   for (std::size_t cell = 0; cell < cells; ++cell) {
     std::size_t total = 0;
@@ -162,8 +181,7 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
 void SweepAndPrune::bucket(const AabbSoa& boxes) {
   const std::size_t n = boxes.size(), cells = grid_.cell_count();
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
-  // Exclusive scan in (cell, chunk) order: chunk c's entries of a cell follow those of chunks < c, so every cell
-  // holds its records in increasing id order.
+  // Exclusive scan in (cell, chunk) order: chunk c's entries of a cell follow those of chunks < c.
   cell_start_.resize(cells + 1);
   std::uint32_t running = 0;
   for (std::size_t cell = 0; cell < cells; ++cell) {
@@ -175,7 +193,7 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
     }
   }
   cell_start_[cells] = running;
-  entries_.resize(running);
+  resize_tight(entries_, running);  // default-initialised (BigBufferAllocator): every record is written below
   Entry* out = entries_.data();
   const float *lx = boxes.min(grid_.axis), *hx = boxes.max(grid_.axis);
   const float *lu = boxes.min(grid_.u), *hu = boxes.max(grid_.u), *lv = boxes.min(grid_.v), *hv = boxes.max(grid_.v);
@@ -184,7 +202,7 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
     std::uint32_t* offset = counts_.data() + c * cells;
     const std::size_t end = ch.end(c, n);
     for (std::size_t i = ch.begin(c, n); i < end; ++i) {
-      const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i), sortable_key(lx[i])};
+      const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i)};
       const int cu0 = g.cell_u(e.u0), cu1 = g.cell_u(e.u1), cv0 = g.cell_v(e.v0), cv1 = g.cell_v(e.v1);
       for (int cv = cv0; cv <= cv1; ++cv)
         for (int cu = cu0; cu <= cu1; ++cu) out[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
@@ -192,88 +210,46 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
   });
 }
 
-void SweepAndPrune::sort_and_sweep(const FilterSoa& filter) {
+void SweepAndPrune::choose_groups() {
+  // Group g = the cells whose entries start in [g E / groups, (g + 1) E / groups): contiguous, balanced, fixed.
   const std::size_t cells = grid_.cell_count();
   const std::size_t groups = std::min(kSweepGroups, cells);
-  group_pairs_.resize(groups);
   const std::uint64_t entries = cell_start_[cells];
-  // Group g = the cells whose entries start in [g E / groups, (g + 1) E / groups): contiguous, balanced, fixed.
-  std::vector<std::size_t>& first_cell = first_cell_;
-  first_cell.resize(groups + 1);
-  if (group_scratch_.size() < groups) group_scratch_.resize(groups);
+  first_cell_.resize(groups + 1);
   for (std::size_t g = 0; g <= groups; ++g) {
     const std::uint64_t target = entries * g / groups;
-    first_cell[g] = g == groups ? cells
-                                : static_cast<std::size_t>(
-                                      std::lower_bound(cell_start_.begin(), cell_start_.end() - 1, target) -
-                                      cell_start_.begin());
+    first_cell_[g] = g == groups ? cells
+                                 : static_cast<std::size_t>(
+                                       std::lower_bound(cell_start_.begin(), cell_start_.end() - 1, target) -
+                                       cell_start_.begin());
   }
-  first_cell[0] = 0;
+  first_cell_[0] = 0;
+  group_pairs_.resize(groups);
+  group_movers_.resize(groups);
+  if (group_scratch_.size() < groups) group_scratch_.resize(groups);
+}
+
+void SweepAndPrune::sort_and_sweep(const FilterSoa& filter, bool nearly_sorted) {
+  const std::size_t groups = first_cell_.size() - 1;
   const SapGrid grid = grid_;
   Entry* all = entries_.data();
+  Entry* over = overflow_entries_.data();
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::vector<std::uint64_t>& out = group_pairs_[g];
     out.clear();
-    std::vector<std::uint64_t>& w = group_scratch_[g].words;
-    std::vector<std::uint64_t>& tmp = group_scratch_[g].tmp;
-    std::vector<Entry>& buf = group_scratch_[g].entries;
-    for (std::size_t cell = first_cell[g]; cell < first_cell[g + 1]; ++cell) {
+    CellScratch& scratch = group_scratch_[g];
+    for (std::size_t cell = first_cell_[g]; cell < first_cell_[g + 1]; ++cell) {
       const std::size_t s = cell_start_[cell], k = cell_start_[cell + 1] - s;
       Entry* e = all + s;
-      // Sort by (key, id). The records arrive in id order, so a stable sort by key alone is enough.
-      if (k <= kInsertionSortMax) {
-        for (std::size_t j = 1; j < k; ++j) {
-          if (e[j].key >= e[j - 1].key) continue;
-          const Entry x = e[j];
-          std::size_t i = j;
-          do {
-            e[i] = e[i - 1];
-            --i;
-          } while (i > 0 && e[i - 1].key > x.key);
-          e[i] = x;
-        }
-      } else {
-        if (w.size() < k) w.resize(k), tmp.resize(k), buf.resize(k);
-        std::array<std::array<std::uint32_t, 256>, 4> hist{};
-        for (std::size_t i = 0; i < k; ++i) {
-          const std::uint32_t key = e[i].key;
-          w[i] = static_cast<std::uint64_t>(key) << 32 | i;
-          ++hist[0][key & 0xff], ++hist[1][(key >> 8) & 0xff], ++hist[2][(key >> 16) & 0xff], ++hist[3][key >> 24];
-        }
-        std::uint64_t* src = w.data();
-        std::uint64_t* dst = tmp.data();
-        for (int d = 0; d < 4; ++d) {
-          std::uint32_t running = 0;
-          bool trivial = false;
-          for (int b = 0; b < 256; ++b) {
-            const std::uint32_t count = hist[d][b];
-            if (count == k) { trivial = true; break; }
-            hist[d][b] = running;
-            running += count;
-          }
-          if (trivial) continue;
-          const int shift = 32 + 8 * d;
-          for (std::size_t i = 0; i < k; ++i) dst[hist[d][(src[i] >> shift) & 0xff]++] = src[i];
-          std::swap(src, dst);
-        }
-        for (std::size_t i = 0; i < k; ++i) buf[i] = e[static_cast<std::uint32_t>(src[i])];
-        std::memcpy(static_cast<void*>(e), buf.data(), k * sizeof(Entry));
-      }
-      const int cu = static_cast<int>(cell % grid.cells_u), cv = static_cast<int>(cell / grid.cells_u);
-      for (std::size_t i = 0; i < k; ++i) {
-        const float hx = e[i].x1, lu = e[i].u0, hu = e[i].u1, lv = e[i].v0, hv = e[i].v1;
-        // Records are sorted by x0, so x0[i] <= x0[j] <= x1[j]: the x overlap reduces to x0[j] <= x1[i].
-        for (std::size_t j = i + 1; j < k && e[j].x0 <= hx; ++j) {
-          const Entry& f = e[j];
-          if (!((f.u0 <= hu) & (lu <= f.u1) & (f.v0 <= hv) & (lv <= f.v1))) continue;
-          // Report the pair only in the cell of the lower corner of the overlap (in both boxes' cell ranges since
-          // cell_of is monotone), so pairs straddling several shared cells appear once.
-          if (grid.cell_u(std::max(lu, f.u0)) != cu || grid.cell_v(std::max(lv, f.v0)) != cv) continue;
-          std::uint32_t a = e[i].id, b = f.id;
-          if (a > b) std::swap(a, b);
-          if (pair_passes(filter, a, b)) out.push_back(static_cast<std::uint64_t>(a) << 32 | b);
-        }
-      }
+      sort_cell(e, k, nearly_sorted, scratch.words, scratch.tmp, scratch.entries);
+      const CellSweep sweep{grid, static_cast<int>(cell % grid.cells_u), static_cast<int>(cell / grid.cells_u),
+                            filter, out};
+      sweep.within(e, k);
+      const std::size_t os = overflow_start_[cell], ok = overflow_start_[cell + 1] - os;
+      if (ok == 0) continue;
+      sort_cell(over + os, ok, false, scratch.words, scratch.tmp, scratch.entries);
+      sweep.within(over + os, ok);
+      sweep.between(e, k, over + os, ok);
     }
   });
 }
@@ -284,8 +260,8 @@ void SweepAndPrune::emit(std::vector<CandidatePair>& pairs) {
   start.assign(groups + 1, 0);
   for (std::size_t g = 0; g < groups; ++g) start[g + 1] = start[g] + group_pairs_[g].size();
   const std::size_t total = start[groups];
-  if (words_.size() < total) words_.resize(total);
-  if (scratch_.size() < total) scratch_.resize(total);
+  if (words_.size() < total) resize_tight(words_, total);
+  if (scratch_.size() < total) resize_tight(scratch_, total);
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::copy(group_pairs_[g].begin(), group_pairs_[g].end(), words_.begin() + static_cast<std::ptrdiff_t>(start[g]));
   });

@@ -2,16 +2,25 @@
 // world AABBs -> sweep-and-prune (+ halfspaces) -> one PairBatch -> batchcol::collide().
 #include "scene_state.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
 namespace batchcol {
 namespace {
 
 // Translations beyond this cannot be stored as float boxes with room for the object's size (float max ~3.4e38).
 constexpr double kMaxCoordinate = 1e30;
+// Objects are renumbered in spatial order after a rebuild when at least 1/kRenumberFraction of them were added or
+// removed since the last renumbering: a few additions barely disturb the order, and renumbering costs a pass of
+// random gathers over every per-object array.
+constexpr std::size_t kRenumberFraction = 8;
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) {
@@ -82,6 +91,17 @@ void FiniteObjects::swap_remove(std::size_t i) {
   move_last(filter.group), move_last(filter.mask), move_last(filter.body);
 }
 
+void FiniteObjects::permute(const std::vector<std::uint32_t>& order) {
+  const auto gather = [&order](auto& v) {
+    std::remove_reference_t<decltype(v)> out(v.size());
+    for (std::size_t k = 0; k < order.size(); ++k) out[k] = v[order[k]];
+    v.swap(out);
+  };
+  gather(shape), gather(slot), gather(exact_path);
+  for (auto* v : {&tx, &ty, &tz, &qw, &qx, &qy, &qz, &cx, &cy, &cz, &bx, &by, &bz, &ex, &ey, &ez, &ball}) gather(*v);
+  gather(filter.group), gather(filter.mask), gather(filter.body);
+}
+
 Pose FiniteObjects::pose(std::size_t i) const {
   return {Eigen::Vector3d(tx[i], ty[i], tz[i]), Eigen::Quaterniond(qw[i], qx[i], qy[i], qz[i])};
 }
@@ -113,6 +133,39 @@ std::size_t Scene::State::frame_buffer_bytes() const {
   for (const QuatArray* q : {&batch.rotation_a, &batch.rotation_b})
     b += bytes(q->w) + bytes(q->x) + bytes(q->y) + bytes(q->z);
   return b;
+}
+
+void Scene::State::renumber_spatially() {
+  if (changes_since_renumber * kRenumberFraction < finite.size()) return;
+  std::vector<std::uint32_t> order, new_index;
+  sap.spatial_order(order);
+  if (order.size() != finite.size()) return;  // the broad phase has no complete order (nothing to gain anyway)
+  finite.permute(order);
+  new_index.resize(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    new_index[order[k]] = static_cast<std::uint32_t>(k);
+    slots[finite.slot[k]].index = static_cast<std::uint32_t>(k);
+  }
+  sap.renumber(new_index);
+  changes_since_renumber = 0;
+  // This frame's boxes and pose records, gathered into the new order (the same values: no recomputation).
+  for (auto* v : {&boxes.min_x, &boxes.min_y, &boxes.min_z, &boxes.max_x, &boxes.max_y, &boxes.max_z}) {
+    std::vector<float> out(v->size());
+    for (std::size_t k = 0; k < order.size(); ++k) out[k] = (*v)[order[k]];
+    v->swap(out);
+  }
+  std::vector<PoseRecord> poses(pose_records.size());
+  for (std::size_t k = 0; k < order.size(); ++k) poses[k] = pose_records[order[k]];
+  pose_records.swap(poses);
+  // This frame's pairs in the new numbering, sorted again (a < b, lexicographic: the broad phase's contract).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sap_pairs.size(), 16384),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k < r.end(); ++k) {
+                        const std::uint32_t a = new_index[sap_pairs[k].a], b = new_index[sap_pairs[k].b];
+                        sap_pairs[k] = a < b ? broadphase::CandidatePair{a, b} : broadphase::CandidatePair{b, a};
+                      }
+                    });
+  tbb::parallel_sort(sap_pairs.begin(), sap_pairs.end());  // keys are unique: one answer for any thread count
 }
 
 // ---- Scene ---------------------------------------------------------------------------------------------------
@@ -155,6 +208,7 @@ ObjectHandle Scene::add(std::uint32_t shape, const Pose& pose, const CollisionFi
     s.filtered_objects += is_default(filter) ? 0 : 1;
   }
   s.topology_changed = true;
+  ++s.changes_since_renumber;
   return s.handle_of(slot);
 }
 
@@ -175,6 +229,7 @@ void Scene::remove(ObjectHandle object) {
   ++entry.generation;  // the old handle never becomes valid again (up to 2^32 reuses of one slot)
   s.free_slots.push_back(object.slot);
   s.topology_changed = true;
+  ++s.changes_since_renumber;
 }
 
 void Scene::set_pose(ObjectHandle object, const Pose& pose) {
@@ -242,8 +297,14 @@ void Scene::collide(const QueryOptions& options, SceneResults& results) {
     t.aabb_ms = ms_since(stage);
 
     const broadphase::FilterSoa& filter = s.filtered_objects > 0 ? s.finite.filter : s.no_filter;
-    if (s.topology_changed) s.sap.rebuild(s.boxes, filter, s.sap_pairs);
-    else s.sap.update(s.boxes, filter, s.sap_pairs);
+    if (s.topology_changed) {
+      s.sap.rebuild(s.boxes, filter, s.sap_pairs);
+      stage = Clock::now();
+      s.renumber_spatially();
+      t.renumber_ms = ms_since(stage);
+    } else {
+      s.sap.update(s.boxes, filter, s.sap_pairs);
+    }
     s.topology_changed = false;
     results.incremental = s.sap.stats().incremental;
     t.sap_bucket_ms = s.sap.stats().bucket_ms;

@@ -333,6 +333,49 @@ TEST(Scene, WarmFramesReuseBuffers) {
   EXPECT_GT(scene.buffer_reallocations(), reallocations);
 }
 
+TEST(Scene, RebuildRenumbersObjectsSpatiallyKeepingHandlesPosesAndResults) {
+  // The frame that rebuilds the broad phase renumbers the objects internally (spatial order): handles, poses and
+  // the pairs must not change, the next frame (no change) must give the same results in the same order, and the
+  // world boxes must still belong to their handles.
+  Rng rng(19);
+  auto shapes = mixed_shapes(rng, 2);
+  const auto bounded = static_cast<std::uint32_t>(shapes->size());
+  Scene scene(shapes);
+  const auto handles = fill(scene, rng, 1200, 6.0, bounded);
+  std::vector<Pose> poses;
+  for (ObjectHandle h : handles) poses.push_back(scene.pose(h));
+  const QueryOptions options = options_at(QueryLevel::witness, 0.01);
+  SceneResults first, second;
+  scene.collide(options, first);
+  scene.collide(options, second);
+  ASSERT_GT(first.colliding_count(), 20u);
+  EXPECT_FALSE(first.incremental);
+  EXPECT_TRUE(second.incremental);
+  EXPECT_TRUE(first.object_a == second.object_a);
+  EXPECT_TRUE(first.object_b == second.object_b);
+  EXPECT_TRUE(first.colliding == second.colliding);
+  for (std::size_t k = 0; k < first.candidate_count(); ++k) {
+    const double a = first.pairs.distance[k], b = second.pairs.distance[k];
+    EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << k;
+  }
+  for (std::size_t i = 0; i < handles.size(); ++i) {
+    EXPECT_EQ(scene.pose(handles[i]).translation, poses[i].translation);
+    EXPECT_EQ(scene.pose(handles[i]).rotation.coeffs(), poses[i].rotation.coeffs());
+  }
+  std::vector<Aabb> boxes;
+  std::vector<ObjectHandle> owners;
+  scene.last_aabbs(boxes, owners);
+  ASSERT_EQ(boxes.size(), handles.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Aabb exact = compute_aabb((*shapes)[scene.shape(owners[i])], scene.pose(owners[i]).rotation,
+                                    scene.pose(owners[i]).translation);
+    EXPECT_TRUE((boxes[i].min.array() <= exact.min.array()).all() &&
+                (boxes[i].max.array() >= exact.max.array()).all())
+        << "box " << i << " does not contain its object";
+  }
+  expect_matches_all_pairs(scene, handles, options);
+}
+
 TEST(Scene, RejectsBadInput) {
   auto shapes = std::make_shared<ShapeTable>();
   shapes->add(Shape::sphere(0.1));

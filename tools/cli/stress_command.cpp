@@ -114,11 +114,18 @@ struct StageSamples {
 
 struct SapBench {
   double rebuild_ms = 0, update_ms = 0, rebuild_ms_1thread = 0, update_ms_1thread = 0;
+  double rebuild_warm_ms = 0, rebuild_warm_ms_1thread = 0;  // rebuild() on a SAP whose buffers exist already
   std::size_t pairs = 0, bytes = 0;
-  bool update_incremental = false;
+  std::size_t pair_bytes = 0;       // the part of `bytes` that scales with the pairs (pair words, radix scratch)
+  std::size_t overflow = 0;         // objects in the update's overflow after the last update
+  double copies = 0;                // grid-cell records per object (boxes straddling cells have several)
+  bool update_incremental = false;  // every timed update kept the grid
+  double update_rebucketed = 0;     // share of the timed updates that re-bucketed every object
 };
 
-// Our sweep-and-prune alone on the same two frames as the peers: rebuild = fresh structure from scratch.
+// Our sweep-and-prune alone on the same two frames as the peers. Rebuild = a fresh structure from scratch (its buffers
+// allocated and first touched inside the timing, like the peers' fresh trees); warm rebuild = rebuild() again on the
+// same structure (what a scene does after objects were added or removed); update = the frames alternate.
 SapBench time_sap(const std::vector<Aabb>& frame, const std::vector<Aabb>& moved, int threads) {
   broadphase::AabbSoa a, b;
   a.assign(frame);
@@ -129,27 +136,36 @@ SapBench time_sap(const std::vector<Aabb>& frame, const std::vector<Aabb>& moved
   for (int t : {threads, 1}) {
     tbb::task_arena arena(t);
     arena.execute([&] {
-      std::vector<double> rebuild, update;
+      std::vector<double> rebuild, warm, update;
       for (int r = 0; r <= kSapRuns; ++r) {
         broadphase::SweepAndPrune sap;
         const double ms = time_ms([&] { sap.rebuild(a, {}, pairs); });
         if (r > 0) rebuild.push_back(ms);
         out.pairs = pairs.size();
-        out.bytes = sap.memory_bytes();
       }
       broadphase::SweepAndPrune sap;
-      sap.rebuild(a, {}, pairs);
+      for (int r = 0; r <= kSapRuns; ++r) {
+        const double ms = time_ms([&] { sap.rebuild(a, {}, pairs); });
+        if (r > 0) warm.push_back(ms);
+      }
       bool incremental = true;
+      int rebucketed = 0;
       for (int r = 0; r <= kSapRuns; ++r) {
         const double ms = time_ms([&] { sap.update(r % 2 == 0 ? b : a, {}, pairs); });
         incremental = incremental && sap.stats().incremental;
-        if (r > 0) update.push_back(ms);
+        if (r > 0) update.push_back(ms), rebucketed += sap.stats().rebucketed ? 1 : 0;
       }
       if (t == threads && !first_done) {
         out.rebuild_ms = median(rebuild), out.update_ms = median(update), out.update_incremental = incremental;
+        out.rebuild_warm_ms = median(warm);
+        out.update_rebucketed = static_cast<double>(rebucketed) / kSapRuns;
+        out.bytes = sap.memory_bytes(), out.pair_bytes = sap.pair_buffer_bytes();
+        out.overflow = sap.stats().overflow;
+        out.copies = static_cast<double>(sap.stats().entries) / static_cast<double>(std::max<std::size_t>(1, a.size()));
         first_done = true;
       } else {
         out.rebuild_ms_1thread = median(rebuild), out.update_ms_1thread = median(update);
+        out.rebuild_warm_ms_1thread = median(warm);
       }
     });
   }
@@ -201,6 +217,15 @@ int run_stress(const StressSettings& s) {
 
   const double n = static_cast<double>(s.objects);
   const double overlaps = 2.0 * static_cast<double>(sap.pairs) / n;
+  // Memory kept between frames by the broad phase, per object: the SAP's buffers that scale with the objects plus the
+  // float boxes it reads (6 floats per object, the scene's frame buffer); the pair buffers (SAP pair words and radix
+  // scratch, the output pairs) are counted per candidate pair.
+  const double broadphase_bytes_per_object =
+      (static_cast<double>(sap.bytes - sap.pair_bytes) + 6.0 * sizeof(float) * n) / n;
+  const double pair_count = static_cast<double>(sap.pairs);
+  const double pair_bytes =
+      static_cast<double>(sap.pair_bytes) + pair_count * static_cast<double>(sizeof(broadphase::CandidatePair));
+  const double pair_bytes_per_pair = sap.pairs == 0 ? 0.0 : pair_bytes / pair_count;
   nlohmann::json j = {
       {"objects", s.objects}, {"steps", s.steps}, {"threads", threads}, {"distribution", s.distribution},
       {"density", s.density}, {"move", s.move}, {"query", s.query}, {"seed", s.seed},
@@ -217,8 +242,13 @@ int run_stress(const StressSettings& s) {
       {"peak_rss_mb", peak_rss_mb()}, {"scene_bytes_per_object", static_cast<double>(scene.scene->memory_bytes()) / n},
       {"sap_rebuild_ms_median", sap.rebuild_ms}, {"sap_update_ms_median", sap.update_ms},
       {"sap_rebuild_ms_median_1thread", sap.rebuild_ms_1thread}, {"sap_update_ms_median_1thread", sap.update_ms_1thread},
-      {"sap_update_incremental", sap.update_incremental},
+      {"sap_rebuild_warm_ms_median", sap.rebuild_warm_ms},
+      {"sap_rebuild_warm_ms_median_1thread", sap.rebuild_warm_ms_1thread},
+      {"sap_update_incremental", sap.update_incremental}, {"sap_update_rebucketed_fraction", sap.update_rebucketed},
+      {"sap_update_overflow_objects", sap.overflow}, {"sap_cell_copies_per_object", sap.copies},
       {"sap_bytes_per_object", static_cast<double>(sap.bytes) / n},
+      {"broadphase_bytes_per_object", broadphase_bytes_per_object},
+      {"pair_bytes_per_pair", pair_bytes_per_pair},
       {"verified", v.equal}, {"verified_scope", v.scope}, {"verified_objects", v.objects},
       {"verified_pairs", v.pairs}, {"verified_missing", v.missing}, {"verified_extra", v.extra}};
   nlohmann::json pj = nlohmann::json::array();
@@ -243,10 +273,13 @@ int run_stress(const StressSettings& s) {
                 median(m.total), median(m.broadphase));
     std::printf("pairs: %zu candidates, %zu colliding (last step)\n", results.candidate_count(),
                 results.colliding_count());
-    std::printf("sweep-and-prune alone on the last frame: rebuild %.3f ms, update %.3f ms (%d threads); "
-                "rebuild %.3f ms, update %.3f ms (1 thread); %.1f B/object\n",
-                sap.rebuild_ms, sap.update_ms, threads, sap.rebuild_ms_1thread, sap.update_ms_1thread,
-                static_cast<double>(sap.bytes) / n);
+    std::printf("sweep-and-prune alone on the last frame: rebuild %.3f ms (warm %.3f), update %.3f ms (%d threads); "
+                "rebuild %.3f ms (warm %.3f), update %.3f ms (1 thread)\n",
+                sap.rebuild_ms, sap.rebuild_warm_ms, sap.update_ms, threads, sap.rebuild_ms_1thread,
+                sap.rebuild_warm_ms_1thread, sap.update_ms_1thread);
+    std::printf("broad-phase memory: %.1f B/object (SAP buffers + float boxes), %.1f B per candidate pair; "
+                "SAP total %.1f B/object\n",
+                broadphase_bytes_per_object, pair_bytes_per_pair, static_cast<double>(sap.bytes) / n);
     for (const auto& p : peer_timings)
       std::printf("peer %-26s rebuild %9.3f ms (%.2fx ours)  update %9.3f ms (%.2fx ours)  pairs %zu / %zu\n",
                   p.name.c_str(), p.rebuild_ms, sap.rebuild_ms > 0 ? p.rebuild_ms / sap.rebuild_ms : 0.0,

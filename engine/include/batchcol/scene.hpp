@@ -6,7 +6,9 @@
 //      inflated by options.margin and rounded outward to float;
 //   2. the parallel sweep-and-prune broad phase (full rebuild on the first frame or after objects were added or
 //      removed, incremental update after) plus, for halfspaces (infinite boxes, kept out of the sweep), a test of
-//      each halfspace against every object's box;
+//      each halfspace against every object's box; a rebuild also renumbers the objects internally in the broad
+//      phase's spatial order (handles do not change), so that every per-object pass of the following frames reads
+//      memory nearly sequentially;
 //   3. one PairBatch of all candidate pairs -> batchcol::collide() at options.level;
 // and returns every candidate pair with its objects and its narrow-phase result. Buffers are kept from frame to
 // frame: after the first frames (warm-up), a frame with about as many objects and pairs allocates nothing in the
@@ -54,6 +56,7 @@ struct ObjectHandle {
 
 /// Wall-clock milliseconds of the stages of the last Scene::collide().
 struct SceneTimings {
+  double renumber_ms = 0;      // objects renumbered in the broad phase's spatial order (frames that rebuilt it)
   double aabb_ms = 0;          // world AABBs from the poses
   double sap_bucket_ms = 0;    // sweep-and-prune: grid choice and bucketing into cells
   double sap_sweep_ms = 0;     //   per-cell sort and sweep
@@ -62,7 +65,9 @@ struct SceneTimings {
   double batch_ms = 0;         // filling the PairBatch of candidates
   double narrowphase_ms = 0;   // batchcol::collide() on the candidates
   double total_ms = 0;         // the whole call
-  double broadphase_ms() const { return aabb_ms + sap_bucket_ms + sap_sweep_ms + sap_emit_ms + halfspace_ms; }
+  double broadphase_ms() const {
+    return renumber_ms + aabb_ms + sap_bucket_ms + sap_sweep_ms + sap_emit_ms + halfspace_ms;
+  }
 };
 
 /// Everything Scene::collide() reports. Candidate k is the pair (object_a[k], object_b[k]); pairs.*[k] is its
