@@ -5,11 +5,19 @@
 // The closest face distance is a lower bound on the depth and the support value h_D(n) an upper bound; we stop
 // when they are within the tolerance. D may be flat (e.g. two crossing segments): its depth is then 0 and the
 // normal is the plane's normal, which is the exact answer for the cores (the swept radii are added by the caller).
+// Budget: on a curved D the lower bound converges as the polytope approximates D around the minimal directions.
+// When those form a continuum (two identical cylinders: the whole circle of radial directions), EPA must refine
+// all of it, and its lower bound closes as 1 / iterations^2 (measured on cylinder(0.05, 0.3) vs itself: 1.9e-6 m
+// after 1000 expansions, 2.1e-8 after 10000; tolerance 1e-12 would need ~1e6). The upper bound, attained by any
+// radial support, is exact there from the first expansions. So when the budget runs out, the result is the best
+// upper bound min h_D(n) over the expansions and its direction: a translation that certainly separates the shapes,
+// within upper - lower of the depth (status max_iterations).
 #pragma once
 
 #include "kernels/gjk.hpp"
 
 #include <functional>
+#include <limits>
 #include <queue>
 #include <vector>
 
@@ -191,6 +199,9 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
   for (int f = 0; f < 4; ++f) heap.emplace(P.faces[f].dist, f);
   int closest = 0;
+  T best_upper = std::numeric_limits<T>::infinity();  // min over the expansions of h_D(n)
+  Vec3<T> best_normal = Vec3<T>::UnitX();
+  SupportPoint<T> best_support{};
   r.status = EpaStatus::max_iterations;
   std::vector<detail::HorizonEdge> horizon;
   std::vector<int> removed, forced;
@@ -208,6 +219,13 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
     const detail::EpaFace<T> f = P.faces[closest];
     const SupportPoint<T> s = D.support(f.n);
     const T upper = f.n.dot(s.w);  // h_D(n) >= depth >= f.dist
+    if (upper < best_upper) {
+      best_upper = upper;
+      best_normal = f.n;
+      best_support = s;
+    }
+    // Stop on this face's own gap: it certifies the depth and the normal. A smaller upper bound from another
+    // direction would certify the depth only (measured: normals up to 35 mrad off at tolerance 1e-8).
     if (upper - f.dist <= tolerance) { r.status = EpaStatus::converged; break; }
 
     const int wi = static_cast<int>(V.size());
@@ -252,6 +270,15 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
     }
   }
   const detail::EpaFace<T>& f = P.faces[closest];
+  if (r.status == EpaStatus::max_iterations && best_upper < std::numeric_limits<T>::infinity()) {
+    // Budget spent: the best upper bound and its direction (see the top of the file). Its support point gives
+    // A's deepest point along n; B's witness follows from witness_a - witness_b = depth * normal.
+    r.depth = std::max(best_upper, T(0));
+    r.normal = best_normal;
+    r.witness_a = best_support.a;
+    r.witness_b = r.witness_a - r.depth * r.normal;
+    return r;
+  }
   r.depth = std::max(f.dist, T(0));
   r.normal = f.n;
   const Vec3<T> p = f.n * f.dist;

@@ -38,7 +38,8 @@ template <class T>
 PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                         const Eigen::Vector3d& warm_direction, const QueryOptions& options);
 /// From GJK's result to the pair's answer: EPA when the cores overlap and depth was asked, the swept radii, the
-/// stall acceptance and the conservative `collide`.
+/// stall acceptance (a float stall above 2 precision floors is solved again in double) and the conservative
+/// `collide`.
 template <class T>
 PairOutput<T> complete_pair(const PairSetup<T>& setup, const GjkResult<T>& gjk, const QueryOptions& options);
 

@@ -4,8 +4,9 @@
 // Assimp is lenient with broken files and some of its readers crash or hang on them (found by tools/fuzz), so:
 // the path must be a readable, non-empty regular file with a supported extension; a binary STL must have exactly
 // 84 + 50 * count bytes and finite coordinates; a PLY header must end with end_header; only the readers of the
-// supported formats are registered; no assimp post-processing runs (its steps trust the file's face indices); every
-// vertex must be finite. Each problem is one InputError naming the file.
+// supported formats are registered; a COLLADA file's declared counts and index lists must fit its size
+// (check_collada); no assimp post-processing runs (its steps trust the file's face indices); every vertex must be
+// finite. Each problem is one InputError naming the file.
 #include "batchcol/io.hpp"
 
 #include <algorithm>
@@ -175,6 +176,98 @@ void check_ply_header(const std::string& path, const std::string& what) {
   throw InputError(what + ": PLY header has no end_header line");
 }
 
+/// COLLADA: assimp 5.2.5 trusts the numbers a COLLADA file declares (found by fuzzing, tools/fuzz/known/):
+/// a non-digit inside an index list (`<p>1 2"3</p>`) makes its index reader loop, appending until ~19 GB are
+/// allocated; a `count` of 3e9 or a `vcount` entry of 3e8 is reserved as is (std::bad_alloc after minutes of
+/// swapping); a `stride` of 3e8 crashes it (SEGV). So before assimp reads the file:
+/// - the index lists <p>, <vcount>, <v>, <h> must hold only unsigned integers and whitespace;
+/// - every `count`, `stride`, `offset` and `set` attribute, every index, each list's vcount sum and an accessor's
+///   count x stride must be at most half the file size: each thing counted is at least one digit and one
+///   separator of this very file (offsets and sets index the <input> tags, which are longer still).
+/// A file passing these checks makes assimp allocate in proportion to the file's size.
+void check_collada(const std::string& path, std::uint64_t size, const std::string& what) {
+  const std::string text = read_bytes(path, size, what);
+  const std::uint64_t limit = size / 2;
+  const auto is_space = [&](std::size_t i) { return std::isspace(static_cast<unsigned char>(text[i])) != 0; };
+  const auto line_of = [&](std::size_t at) {
+    return std::to_string(1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+  };
+  const auto fail = [&](std::size_t at, const std::string& problem) {
+    throw InputError(what + ": COLLADA line " + line_of(at) + ": " + problem);
+  };
+  // An unsigned decimal of at most 18 digits (fits in 64 bits) bounded by `limit`.
+  const auto bounded = [&](const std::string& digits, std::size_t at, const std::string& name) {
+    if (digits.empty() || digits.size() > 18 || digits.find_first_not_of("0123456789") != std::string::npos)
+      fail(at, name + " '" + digits.substr(0, 40) + "' is not an unsigned integer");
+    const std::uint64_t v = std::stoull(digits);
+    if (v > limit) {
+      fail(at, name + " " + digits + " is more than this " + std::to_string(size) + "-byte file can hold (at most " +
+                   std::to_string(limit) + ")");
+    }
+    return v;
+  };
+  for (std::size_t at = text.find('<'); at != std::string::npos; at = text.find('<', at + 1)) {
+    // Comments, CDATA and processing instructions hold no markup: skip them whole.
+    using Delimiters = std::pair<const char*, const char*>;
+    for (const auto& [open, close] : {Delimiters{"<!--", "-->"}, Delimiters{"<![CDATA[", "]]>"}, Delimiters{"<?", "?>"}}) {
+      if (text.compare(at, std::strlen(open), open) != 0) continue;
+      const std::size_t end = text.find(close, at);
+      if (end == std::string::npos) return;  // unterminated: assimp's XML parser refuses the file
+      at = end;
+      break;
+    }
+    if (text[at] != '<' || at + 1 >= text.size() || text[at + 1] == '/' || text[at + 1] == '!') continue;
+    std::size_t end = at + 1;
+    while (end < text.size() && !is_space(end) && text[end] != '>' && text[end] != '/') ++end;
+    const std::string tag = text.substr(at + 1, end - at - 1);
+    // Attributes: name, optional spaces, '=', optional spaces, a quoted value; up to the tag's '>'.
+    std::uint64_t count = 0, stride = 1;
+    std::size_t close = end;
+    const auto skip_spaces = [&] { while (close < text.size() && is_space(close)) ++close; };
+    while (true) {
+      skip_spaces();
+      if (close >= text.size()) return;  // unterminated tag: assimp's XML parser refuses the file
+      if (text[close] == '>' || text[close] == '/') break;
+      const std::size_t name_start = close;
+      while (close < text.size() && !is_space(close) && text[close] != '=' && text[close] != '>') ++close;
+      const std::string name = text.substr(name_start, close - name_start);
+      skip_spaces();
+      if (close >= text.size() || text[close] != '=') return;  // malformed XML: assimp refuses it
+      ++close;
+      skip_spaces();
+      if (close >= text.size() || (text[close] != '"' && text[close] != '\'')) return;
+      const std::size_t value_end = text.find(text[close], close + 1);
+      if (value_end == std::string::npos) return;
+      const std::string value = text.substr(close + 1, value_end - close - 1);
+      close = value_end + 1;
+      if (name != "count" && name != "stride" && name != "offset" && name != "set") continue;
+      const std::uint64_t v = bounded(value, at, "<" + tag + "> " + name);
+      if (name == "count") count = v;
+      if (name == "stride") stride = v;
+    }
+    close = text.find('>', close);
+    if (close == std::string::npos) return;
+    if (tag == "accessor" && stride > 0 && count > limit / stride)
+      fail(at, "<accessor> count x stride = " + std::to_string(count) + " x " + std::to_string(stride) +
+                   " values, more than this file can hold");
+    if (tag != "p" && tag != "vcount" && tag != "v" && tag != "h") continue;
+    if (text[close - 1] == '/') continue;  // an empty <p/>
+    const std::size_t content = close + 1, content_end = text.find('<', content);
+    if (content_end == std::string::npos || text.compare(content_end, tag.size() + 2, "</" + tag) != 0)
+      fail(at, "<" + tag + "> must hold only unsigned integers");
+    std::uint64_t sum = 0;
+    for (std::size_t i = content; i < content_end;) {
+      if (is_space(i)) { ++i; continue; }
+      std::size_t j = i;
+      while (j < content_end && !is_space(j)) ++j;
+      sum += bounded(text.substr(i, j - i), at, "<" + tag + "> entry");  // each <= limit: the sum cannot overflow
+      i = j;
+    }
+    if (tag == "vcount" && sum > limit)
+      fail(at, "<vcount> sums to " + std::to_string(sum) + " vertices, more than this file can hold");
+  }
+}
+
 constexpr const char* kSupportedList = ".obj, .stl, .ply, .dae";
 
 std::string lowercase_extension(const std::string& path) {
@@ -256,6 +349,7 @@ std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path) {
   }
   if (extension == ".stl") check_stl(path, size, what);
   check_ply_header(path, what);
+  if (extension == ".dae") check_collada(path, size, what);
 
 #ifdef BATCHCOL_HAVE_ASSIMP
   Assimp::Importer importer;

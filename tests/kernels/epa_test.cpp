@@ -4,6 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
 namespace batchcol {
 namespace {
 
@@ -133,6 +139,67 @@ TEST(Epa, ExactlyAlignedBoxesRegression) {
       EXPECT_EQ(r.status, Status::converged) << t.transpose();
       EXPECT_NEAR(r.distance, -depth, 1e-12) << t.transpose();
     }
+}
+
+// Two identical cylinders at one pose: the depth is the diameter 2r, attained along every radial direction (a
+// circle of minimal directions). EPA's lower bound closes only as 1 / expansions^2 there (1.9e-6 m at 1000), so at
+// tolerance 1e-12 the budget always runs out: the status says so, and the depth is the best upper bound, exact.
+TEST(Epa, IdenticalCylindersRunOutOfBudgetWithTheExactDepth) {
+  Rng rng(12);
+  for (int trial = 0; trial < 6; ++trial) {
+    const double r = testing::uniform(rng, 0.02, 0.1), h = testing::uniform(rng, 0.2, 0.5);
+    const Shape rod = Shape::cylinder(r, h);
+    const Pose pose{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    for (int budget : {1000, 2000}) {
+      QueryOptions o = depth_options(1e-12);
+      o.epa_max_iterations = budget;
+      const auto res = testing::run_pair(rod, pose, rod, pose, o);
+      SCOPED_TRACE("trial " + std::to_string(trial) + " budget " + std::to_string(budget));
+      EXPECT_EQ(res.status, Status::max_iterations);
+      EXPECT_TRUE(res.collide);
+      EXPECT_NEAR(res.distance, -2 * r, 1e-12);  // measured 1.4e-17 (the lower bound alone: 2e-6 at 1000)
+      EXPECT_LT(std::abs(res.normal.dot(pose.rotation * Eigen::Vector3d::UnitZ())), 1e-9);  // radial
+      EXPECT_LT((res.witness_b - res.witness_a - res.distance * res.normal).norm(), 1e-12);
+    }
+  }
+}
+
+// Whatever the budget, a depth returned with max_iterations is an upper bound (moving b by it along the normal
+// separates the pair) and within the reference by no more than the approximation left: checked on random curved
+// pairs with budgets of 3..30 expansions against the same pair at tolerance 1e-9 and 5000 expansions.
+TEST(Epa, OutOfBudgetDepthIsASeparatingUpperBound) {
+  Rng rng(13);
+  const std::vector<ShapeType> curved = {ShapeType::cylinder, ShapeType::cone, ShapeType::ellipsoid, ShapeType::box,
+                                         ShapeType::convex};
+  int out_of_budget = 0;
+  double worst_ratio = 1.0;  // reported depth / reference depth
+  for (int trial = 0; trial < 300; ++trial) {
+    const Shape a = testing::random_shape(rng, curved[trial % curved.size()]);
+    const Shape b = testing::random_shape(rng, curved[(trial / 5) % curved.size()]);
+    const Pose pa{Eigen::Vector3d::Zero(), testing::random_rotation(rng)};
+    const Pose pb{0.05 * testing::random_unit_vector(rng), testing::random_rotation(rng)};
+    QueryOptions reference = depth_options(1e-9);
+    reference.epa_max_iterations = 5000;
+    const auto ref = testing::run_pair(a, pa, b, pb, reference);
+    if (!ref.collide || ref.status != Status::converged) continue;
+    QueryOptions tight = depth_options(1e-12);
+    tight.epa_max_iterations = 3 + trial % 28;
+    const auto r = testing::run_pair(a, pa, b, pb, tight);
+    if (r.status != Status::max_iterations) continue;
+    ++out_of_budget;
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    ASSERT_TRUE(std::isfinite(r.distance) && r.normal.allFinite());
+    EXPECT_LE(r.distance, ref.distance + 1e-9);  // at least as deep as the truth: an upper bound on the depth
+    EXPECT_GE(r.distance, 2 * ref.distance - 1e-9);  // and not absurdly deep (measured <= 1.87x, budget 3)
+    worst_ratio = std::max(worst_ratio, r.distance / ref.distance);
+    Pose moved = pb;
+    moved.translation += (-r.distance + 1e-9) * r.normal;  // push b out by the reported depth (world frame)
+    QueryOptions check = depth_options(1e-10);
+    check.level = QueryLevel::distance;
+    EXPECT_FALSE(testing::run_pair(a, pa, b, moved, check).collide) << "depth " << -r.distance;
+  }
+  EXPECT_GT(out_of_budget, 100);
+  std::printf("[measured] %d pairs out of budget: depth at most %.3g x the reference\n", out_of_budget, worst_ratio);
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // same polytope given independently as a box primitive; and EPA on curved shapes (sphere, capsule, ellipsoid,
 // cylinder, cone), shallow and deep, against closed-form depths. Double and float through batchcol::collide().
 // Each test prints the measured maximum error ("[measured]" lines) next to its bound.
-#include "support/generators.hpp"
+#include "support/hard_cases.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,28 +14,11 @@
 namespace batchcol {
 namespace {
 
-QueryOptions options(Precision precision, double double_tolerance = 1e-12) {
-  QueryOptions o;
-  o.level = QueryLevel::penetration;
-  o.precision = precision;
-  o.tolerance = precision == Precision::float64 ? double_tolerance : 1e-7;  // raised to the float floor
-  o.max_iterations = 1000;
-  o.epa_max_iterations = 2000;
-  o.closed_forms = false;
-  return o;
-}
-
-const char* name(Precision p) { return p == Precision::float64 ? "double" : "float"; }
-constexpr double kEpsFloat = 1.1920928955078125e-7;
-
-void expect_sane(const testing::SingleResult& r, double identity_bound) {
-  EXPECT_EQ(r.status, Status::converged);
-  ASSERT_TRUE(std::isfinite(r.distance));
-  EXPECT_LT(std::abs(r.distance), 10.0);
-  ASSERT_TRUE(r.witness_a.allFinite() && r.witness_b.allFinite() && r.normal.allFinite());
-  EXPECT_NEAR(r.normal.norm(), 1.0, 1e-6);
-  EXPECT_LE((r.witness_b - r.witness_a - r.distance * r.normal).norm(), identity_bound);
-}
+using testing::expect_sane;
+using testing::hard_case_options;
+using testing::kEpsFloat;
+using testing::kIdentity;
+using testing::precision_name;
 
 std::vector<Eigen::Vector3d> box_corners(const Eigen::Vector3d& h) {
   std::vector<Eigen::Vector3d> out;
@@ -91,17 +74,17 @@ TEST(HardCasesHulls, MessyPointsGiveTheSamePolytopeAsTheBoxPrimitive) {
         const Shape other = testing::random_shape(rng, t);
         const Pose pa{Eigen::Vector3d::Random() * 0.1, testing::random_rotation(rng)};
         const Pose pb{Eigen::Vector3d::Random() * 0.4, testing::random_rotation(rng)};
-        SCOPED_TRACE(std::string(to_string(t)) + " trial " + std::to_string(trial) + " " + name(p));
-        const auto from_hull = testing::run_pair(hull, pa, other, pb, options(p, 1e-10));
-        const auto from_box = testing::run_pair(box, pa, other, pb, options(p, 1e-10));
-        expect_sane(from_hull, 1e-6);
+        SCOPED_TRACE(std::string(to_string(t)) + " trial " + std::to_string(trial) + " " + precision_name(p));
+        const auto from_hull = testing::run_pair(hull, pa, other, pb, hard_case_options(p, QueryLevel::penetration, 1e-10));
+        const auto from_box = testing::run_pair(box, pa, other, pb, hard_case_options(p, QueryLevel::penetration, 1e-10));
+        expect_sane(from_hull, QueryLevel::penetration, 1e-6);
         EXPECT_EQ(from_hull.collide, from_box.collide);
         // Both are certified to the tolerance 1e-10 (curved partners) or exact (polytopes): 2 x 1e-10 apart at most.
         const double allowed = p == Precision::float64 ? (t == ShapeType::box || t == ShapeType::convex ? bound : 2e-10) : bound;
         EXPECT_LE(std::abs(from_hull.distance - from_box.distance), allowed);
         worst = std::max(worst, std::abs(from_hull.distance - from_box.distance));
       }
-    std::printf("[measured] messy hull vs box primitive, %s: max |difference| %.3g m\n", name(p), worst);
+    std::printf("[measured] messy hull vs box primitive, %s: max |difference| %.3g m\n", precision_name(p), worst);
   }
 }
 
@@ -114,10 +97,10 @@ TEST(HardCasesHulls, NearlyCoplanarSliverAndNeedleHulls) {
     for (Precision p : {Precision::float64, Precision::float32}) {
       // Double: exact to rounding, bound 1e-12; float: bound 16 eps_f * 0.1 m (the problem's scale).
       const double bound = p == Precision::float64 ? 1e-12 : 16 * kEpsFloat * 0.1;
-      SCOPED_TRACE("height " + std::to_string(height) + " " + name(p));
+      SCOPED_TRACE("height " + std::to_string(height) + " " + precision_name(p));
       const auto r = testing::run_pair(sliver, Pose{}, Shape::sphere(0.01), Pose::from_translation({0.03, 0.03, 0.02}),
-                                       options(p));
-      expect_sane(r, 4 * bound);
+                                       hard_case_options(p));
+      expect_sane(r, QueryLevel::penetration, 4 * bound);
       EXPECT_LE(std::abs(r.distance - (0.02 - height - 0.01)), bound);
     }
   }
@@ -132,7 +115,6 @@ struct DepthCase {
   double depth;
 };
 
-const Eigen::Quaterniond kIdentity = Eigen::Quaterniond::Identity();
 const Eigen::Quaterniond kZToMinusX = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitX());
 const Eigen::Quaterniond kZToX = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX());
 const Eigen::Quaterniond kZToY = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY());
@@ -177,9 +159,9 @@ std::vector<DepthCase> concentric_depths() {
 
 void check_depths(const std::vector<DepthCase>& cases, Precision p, double double_tolerance, double bound, double& worst) {
   for (const auto& c : cases) {
-    SCOPED_TRACE(c.name + " depth " + std::to_string(c.depth) + " " + name(p));
-    const auto r = testing::run_pair(c.a, c.pa, c.b, c.pb, options(p, double_tolerance));
-    expect_sane(r, 4 * bound);
+    SCOPED_TRACE(c.name + " depth " + std::to_string(c.depth) + " " + precision_name(p));
+    const auto r = testing::run_pair(c.a, c.pa, c.b, c.pb, hard_case_options(p, QueryLevel::penetration, double_tolerance));
+    expect_sane(r, QueryLevel::penetration, 4 * bound);
     EXPECT_TRUE(r.collide);
     EXPECT_LE(std::abs(r.distance + c.depth), bound);
     worst = std::max(worst, std::abs(r.distance + c.depth));
@@ -193,7 +175,7 @@ TEST(HardCasesEpa, CurvedShapesShallowAndDeep) {
     double worst = 0.0;
     for (double d : {1e-6, 1e-4, 1e-2, 5e-2}) check_depths(curved_depths(d), p, 1e-9, bound, worst);
     check_depths(concentric_depths(), p, 1e-9, bound, worst);
-    std::printf("[measured] EPA on curved shapes, depths 1e-6..0.08, %s: max |error| %.3g m (bound %.2g)\n", name(p),
+    std::printf("[measured] EPA on curved shapes, depths 1e-6..0.08, %s: max |error| %.3g m (bound %.2g)\n", precision_name(p),
                 worst, bound);
   }
 }

@@ -1,6 +1,6 @@
 // Numerically hard configurations: exact touching, tiny gaps, far from the origin, extreme aspect and size
 // ratios, identical poses, degenerate hulls. Answers come from the extent-gap closed form (symmetric layouts).
-#include "support/generators.hpp"
+#include "support/hard_cases.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,20 +10,15 @@ namespace {
 using testing::Rng;
 
 QueryOptions opts(QueryLevel level = QueryLevel::penetration, double tol = 1e-12) {
-  QueryOptions o;
-  o.level = level;
-  o.tolerance = tol;
-  o.max_iterations = 1000;
+  QueryOptions o = testing::hard_case_options(Precision::float64, level, tol);
   o.epa_max_iterations = 1000;
-  o.closed_forms = false;
   return o;
 }
 
 /// Places b beside a along world x (both axis-aligned, symmetric) at the given gap, then moves both by T.
 testing::SingleResult beside(const Shape& a, const Shape& b, double gap, const Eigen::Vector3d& T,
                              const QueryOptions& o, Eigen::Vector3d lateral = Eigen::Vector3d::Zero()) {
-  const double L = testing::extent(a, Eigen::Vector3d::UnitX()) + testing::extent(b, -Eigen::Vector3d::UnitX()) + gap;
-  return testing::run_pair(a, Pose::from_translation(T), b, Pose::from_translation(T + L * Eigen::Vector3d::UnitX() + lateral), o);
+  return testing::beside(a, testing::kIdentity, b, testing::kIdentity, gap, T, testing::kIdentity, o, lateral);
 }
 
 TEST(HardCases, TinyGapsDownTo1e9) {
