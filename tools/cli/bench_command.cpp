@@ -1,7 +1,8 @@
 // `batchcol bench`: times collide() on generated pairs of one shape-type pair per case, in one distance regime,
 // reports throughput and the error against the double-precision reference, and times FCL and Bullet (when found at
 // configure time) on the same pairs and thread count. --isa picks the instruction set of the SIMD kernels (auto: the
-// best this CPU runs); pair types with a closed form run their scalar analytic kernel whatever the set.
+// best this CPU runs); closed forms run in SIMD lanes for sphere/capsule pairs and box-box boolean, per pair for
+// the other closed-form types.
 #include "cli/atomic_output.hpp"
 #include "cli/bench_pairs.hpp"
 #include "cli/bench_peers.hpp"
@@ -146,7 +147,9 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
 
 void print_table(const std::vector<CaseResult>& results, const BenchSettings& s, const QueryOptions& o, Regime regime,
                  int threads) {
-  std::printf("instruction set: %s (closed-form pair types run scalar analytic kernels)\n", to_string(o.isa));
+  std::printf("instruction set: %s (closed forms: SIMD lanes for sphere/capsule pairs and box-box boolean, per pair "
+              "otherwise)\n",
+              to_string(o.isa));
   std::printf("regime %s, query %s, precision %s, solver %s, threads %d, pairs %zu, median of %d runs after 1 warm-up\n",
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(o.solver), threads, s.pairs, s.runs);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
