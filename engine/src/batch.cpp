@@ -1,8 +1,6 @@
 #include "batchcol/batch.hpp"
 #include "results_fill.hpp"
 
-#include <algorithm>
-#include <cstring>
 #include <limits>
 
 namespace batchcol {
@@ -28,7 +26,7 @@ std::size_t PairBatch::add(std::uint32_t a, const Pose& pose_a, std::uint32_t b,
 
 void PairResults::resize(std::size_t n) {
   detail::size_results(*this, n);
-  detail::fill_defaults(*this, 0, n);
+  for (std::size_t i = 0; i < n; ++i) detail::fill_pair_defaults(*this, i);
 }
 
 namespace detail {
@@ -39,20 +37,6 @@ void size_results(PairResults& r, std::size_t n) {
   r.distance.resize(n);
   for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal, &r.direction}) v->resize(n);
   r.iterations.resize(n);
-}
-
-void fill_defaults(PairResults& r, std::size_t begin, std::size_t end) {
-  if (end <= begin) return;
-  const std::size_t n = end - begin;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::memset(r.collide.data() + begin, 0, n);
-  std::memset(r.iterations.data() + begin, 0, n * sizeof(std::int32_t));
-  std::fill_n(r.status.data() + begin, n, Status::invalid_input);
-  double* arrays[13] = {r.distance.data()};
-  int k = 1;
-  for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal, &r.direction})
-    arrays[k++] = v->x.data(), arrays[k++] = v->y.data(), arrays[k++] = v->z.data();
-  for (double* a : arrays) std::fill_n(a + begin, n, nan);
 }
 
 }  // namespace detail

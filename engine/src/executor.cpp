@@ -106,7 +106,7 @@ void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size
   out.status[i] = r.status;
   out.collide[i] = r.collide ? 1 : 0;
   out.distance[i] = static_cast<double>(r.distance);
-  if (level >= QueryLevel::witness) {  // below, these are NaN (fill_defaults) and cost 3 rotations to map
+  if (level >= QueryLevel::witness) {  // below, these stay NaN (fill_pair_defaults) and cost 3 rotations
     out.witness_a.set(i, f.Ra * r.witness_a.template cast<double>() + f.ta);
     out.witness_b.set(i, f.Ra * r.witness_b.template cast<double>() + f.ta);
     out.normal.set(i, f.Ra * r.normal.template cast<double>());
@@ -168,12 +168,12 @@ bool solve_segment_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   return true;
 }
 
-/// The tile's pairs listed in `s.order` (offsets from begin, grouped by type): closed forms answer at setup, the
+/// The tile's pairs listed in s.order[0 .. count) (offsets from begin, grouped by type): closed forms answer at setup, the
 /// rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
 template <class T>
 void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
-                 std::size_t begin, ChunkScratch<T>& s, PairResults& out) {
-  if (s.order.empty()) return;
+                 std::size_t begin, std::size_t count, ChunkScratch<T>& s, PairResults& out) {
+  if (count == 0) return;
   s.setups.resize(kChunkPairs);
   s.gjk.resize(kChunkPairs);
   s.frames.resize(kChunkPairs);
@@ -188,8 +188,10 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
                    out);
     pending = 0;
   };
-  for (const std::uint32_t k : s.order) {
+  for (std::size_t n = 0; n < count; ++n) {
+    const std::uint32_t k = s.order[n];
     const std::size_t i = begin + k;
+    detail::fill_pair_defaults(out, i);  // the paths below write only what they compute
     // Sphere/capsule pairs reach this path only when the SIMD closed form left them (touching cores, bad input).
     if (options.closed_forms && wide_closed_form(s.keys[k], options) == WideClosedForm::segments &&
         solve_segment_pair(shapes, batch, options, i, out))
@@ -219,15 +221,14 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
 template <class T>
 void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
               std::size_t begin, std::size_t end, ChunkScratch<T>& s, PairResults& out) {
-  detail::fill_defaults(out, begin, end);
   group_by_type(shapes, batch, begin, end, s.order, s.keys, s.groups);
   // Groups with a SIMD closed form first, W pairs per register; the pairs they leave (invalid input, touching
   // cores, inflated boxes) join the generic per-pair path below with every other group.
   const kernels::simd::PairView view = kernels::simd::PairView::of(shapes, batch);
   const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
   const kernels::simd::ClosedFormQuery query{options.level, options.margin};
-  s.fallback.clear();
-  std::size_t kept = 0;
+  s.fallback.resize(end - begin);  // no-ops after the first tile: sizes, not contents, change
+  std::size_t kept = 0, fallbacks = 0;
   for (std::size_t g = 0; g < kTypePairs; ++g) {
     const std::uint32_t first = s.groups[g], last = s.groups[g + 1];
     if (first == last) continue;
@@ -238,20 +239,17 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
     }
     s.group_pairs.resize(last - first);
     for (std::uint32_t k = first; k < last; ++k) s.group_pairs[k - first] = static_cast<std::uint32_t>(begin + s.order[k]);
-    const std::size_t old = s.fallback.size();
-    s.fallback.resize(old + s.group_pairs.size());
-    std::uint32_t* left_out = s.fallback.data() + old;
+    std::uint32_t* left_out = s.fallback.data() + fallbacks;
     const std::size_t left =
         kind == WideClosedForm::segments
             ? kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule, type_b(g) == ShapeType::capsule,
                                            s.group_pairs.data(), s.group_pairs.size(), query, results, left_out)
             : kernels::simd::box_pairs_boolean(isa, view, s.group_pairs.data(), s.group_pairs.size(), results,
                                                left_out);
-    s.fallback.resize(old + left);
+    fallbacks += left;
   }
-  s.order.resize(kept);
-  for (const std::uint32_t i : s.fallback) s.order.push_back(static_cast<std::uint32_t>(i - begin));
-  run_generic(shapes, batch, options, isa, begin, s, out);
+  for (std::size_t f = 0; f < fallbacks; ++f) s.order[kept++] = static_cast<std::uint32_t>(s.fallback[f] - begin);
+  run_generic(shapes, batch, options, isa, begin, kept, s, out);
 }
 
 }  // namespace
@@ -259,13 +257,15 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
 void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results) {
   validate(options);
   detail::validate_batch_layout(batch);
-  detail::size_results(results, batch.size());  // each tile fills its own slice (fill_defaults)
+  detail::size_results(results, batch.size());  // every pair's fields are written once, by its kernel
   const std::size_t n = batch.size();
   const std::size_t tiles = (n + kTilePairs - 1) / kTilePairs;
   const InstructionSet isa = resolve_instruction_set(options.isa);
   const auto run_tiles = [&](const tbb::blocked_range<std::size_t>& range) {
-    ChunkScratch<double> scratch_double;
-    ChunkScratch<float> scratch_float;
+    // Reused by every task this thread runs (a task never waits on TBB, so it cannot nest on its thread):
+    // fresh scratch per task cost ~13 KB of allocation and zeroing per 1024 closed-form pairs.
+    thread_local ChunkScratch<double> scratch_double;
+    thread_local ChunkScratch<float> scratch_float;
     for (std::size_t t = range.begin(); t != range.end(); ++t) {
       const std::size_t begin = t * kTilePairs, end = std::min(n, begin + kTilePairs);
       if (options.precision == Precision::float32) run_tile(shapes, batch, options, isa, begin, end, scratch_float, results);

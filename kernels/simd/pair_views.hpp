@@ -51,15 +51,18 @@ struct ResultView {
   double* witness_a[3] = {};
   double* witness_b[3] = {};
   double* normal[3] = {};
+  double* direction[3] = {};
+  std::int32_t* iterations = nullptr;
 
   static ResultView of(PairResults& r) {
     ResultView v;
     v.status = r.status.data();
     v.collide = r.collide.data();
     v.distance = r.distance.data();
-    Vec3Array* a[3] = {&r.witness_a, &r.witness_b, &r.normal};
-    double** d[3] = {v.witness_a, v.witness_b, v.normal};
-    for (int k = 0; k < 3; ++k) d[k][0] = a[k]->x.data(), d[k][1] = a[k]->y.data(), d[k][2] = a[k]->z.data();
+    Vec3Array* a[4] = {&r.witness_a, &r.witness_b, &r.normal, &r.direction};
+    double** d[4] = {v.witness_a, v.witness_b, v.normal, v.direction};
+    for (int k = 0; k < 4; ++k) d[k][0] = a[k]->x.data(), d[k][1] = a[k]->y.data(), d[k][2] = a[k]->z.data();
+    v.iterations = r.iterations.data();
     return v;
   }
 };

@@ -63,7 +63,9 @@ struct WideBoxes : PairLanes {
           separated |= dist > ra + rb;
         }
       }
-      write_collide(b, lane_bits(answered) & b.live, ~separated, out, fallback, fallbacks);
+      const std::uint32_t mine = lane_bits(answered) & b.live;
+      const bool whole = write_collide(b, mine, ~separated, out, fallback, fallbacks);
+      write_defaults(b, whole, mine, false, false, out);
     }
     return fallbacks;
   }

@@ -11,14 +11,16 @@ namespace batchcol::kernels::simd {
 
 /// Sphere/capsule pairs (every pair of pairs[0 .. n) has A of type capsule when `capsule_a`, else sphere, and
 /// likewise B; `pairs` ascending). Writes status, collide and what `query.level` asks (distance, witness points,
-/// normal) for the pairs it answers; returns how many it left to the scalar path, their indices in
+/// normal) for the pairs it answers, NaN / 0 in every other result field; returns how many it left to the scalar
+/// path (which writes every field of those), their indices in
 /// fallback[0 .. count) (invalid input, or touching cores). Results are the same for every instruction set.
 std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a, bool capsule_b,
                           const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                           const ResultView& out, std::uint32_t* fallback);
 
 /// Box-box pairs (all of pairs[0 .. n), ascending) at QueryLevel::boolean with a zero margin: separating-axis
-/// test, writes status and collide; returns how many it left to the scalar path (inflated boxes, invalid input),
+/// test, writes status and collide (NaN / 0 in every other result field); returns how many it left to the scalar
+/// path (inflated boxes, invalid input),
 /// their indices in fallback[0 .. count).
 std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
                               const ResultView& out, std::uint32_t* fallback);

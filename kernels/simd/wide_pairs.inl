@@ -109,6 +109,24 @@ struct PairLanes {
     return b;
   }
 
+  /// What the closed forms leave NaN / 0 (the executor does not pre-fill their pairs): the distance unless
+  /// `has_distance`, witness points and normal unless `has_points`, the search direction (closed forms have none),
+  /// and iterations 0, for the answered lanes `mine`.
+  static void write_defaults(const Block& b, bool whole, std::uint32_t mine, bool has_distance, bool has_points,
+                             const ResultView& out) {
+    const real nan = splat(std::numeric_limits<double>::quiet_NaN());
+    if (!has_distance) store(out.distance, b.idx, whole, nan, mine);
+    double* const* vectors[4] = {out.witness_a, out.witness_b, out.normal, out.direction};
+    for (int k = has_points ? 3 : 0; k < 4; ++k)
+      for (int c = 0; c < 3; ++c) store(vectors[k][c], b.idx, whole, nan, mine);
+    if (whole) {
+      __builtin_memset(out.iterations + b.idx[0], 0, sizeof(std::int32_t) * W);
+    } else {
+      for (int l = 0; l < W; ++l)
+        if ((mine >> l) & 1u) out.iterations[b.idx[l]] = 0;
+    }
+  }
+
   /// Writes status converged and collide for the answered lanes (`mine`), appends the others to `fallback`.
   /// Returns whether the block was answered whole with consecutive indices (vector stores allowed).
   static bool write_collide(const Block& b, std::uint32_t mine, mask collide, const ResultView& out,

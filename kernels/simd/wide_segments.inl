@@ -104,8 +104,10 @@ struct WideSegments : PairLanes {
       const std::uint32_t mine = lane_bits(answered) & b.live;
       const bool whole =
           write_collide(b, mine, signed_distance <= splat(query.margin), out, fallback, fallbacks);
-      if (query.level >= QueryLevel::distance) store(out.distance, b.idx, whole, signed_distance, mine);
-      if (query.level >= QueryLevel::witness) {
+      const bool has_distance = query.level >= QueryLevel::distance, has_points = query.level >= QueryLevel::witness;
+      write_defaults(b, whole, mine, has_distance, has_points, out);
+      if (has_distance) store(out.distance, b.idx, whole, signed_distance, mine);
+      if (has_points) {
         const real safe_core = select(answered, core, splat(1.0));
         const V3 normal{v.x / safe_core, v.y / safe_core, v.z / safe_core};
         const V3 wa = add(ca, scale(A.radius, normal)), wb = sub(cb, scale(B.radius, normal));

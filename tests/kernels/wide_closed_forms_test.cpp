@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace batchcol {
 namespace {
@@ -166,6 +167,41 @@ TEST(WideClosedForms, BoxBoxLanesAgreeWithGjkAndCountTouching) {
   EXPECT_GE(touching, 55u);  // 60 minus those made invalid
   EXPECT_GT(colliding, 300u);
   EXPECT_GT(compared - colliding, 300u);
+}
+
+TEST(WideClosedForms, ReusedResultsGetNanInEveryFieldTheLevelDoesNotCompute) {
+  // Results are sized, not pre-filled: each kernel writes every field of its pairs. A first call at the
+  // penetration level fills the arrays with numbers; the next calls at lower levels must leave none behind.
+  for (const bool boxes : {false, true}) {
+    const Batch b = boxes ? box_batch(17) : mixed_batch(19);
+    PairResults r;
+    QueryOptions o;
+    o.level = QueryLevel::penetration;
+    collide(b.shapes, b.pairs, o, r);
+    for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance}) {
+      o.level = level;
+      collide(b.shapes, b.pairs, o, r);
+      std::size_t closed = 0;
+      for (std::size_t i = 0; i < b.pairs.size(); ++i) {
+        if (level == QueryLevel::boolean) EXPECT_TRUE(std::isnan(r.distance[i])) << i;
+        for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
+          EXPECT_TRUE(std::isnan((r.*m).x[i]) && std::isnan((r.*m).y[i]) && std::isnan((r.*m).z[i])) << i;
+        const std::uint32_t ia = b.pairs.shape_a[i], ib = b.pairs.shape_b[i];
+        if (r.status[i] == Status::invalid_input) {
+          EXPECT_EQ(r.collide[i], 0) << i;
+          EXPECT_EQ(r.iterations[i], 0) << i;
+          EXPECT_TRUE(std::isnan(r.direction.x[i])) << i;
+          continue;
+        }
+        if (kernel_for(b.shapes[ia], b.shapes[ib], o) == std::string("closed form")) {
+          EXPECT_TRUE(std::isnan(r.direction.x[i]) && std::isnan(r.direction.z[i])) << i;
+          EXPECT_EQ(r.iterations[i], 0) << i;
+          ++closed;
+        }
+      }
+      EXPECT_GT(closed, 400u);  // box-box at the distance level runs GJK: only the sphere-box pairs remain
+    }
+  }
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
