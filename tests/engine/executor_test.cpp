@@ -1,11 +1,11 @@
 // The batch executor: results in input order, bitwise identical for any thread count, per-pair statuses for bad
 // pairs, exceptions only for a malformed call, warm start.
 #include "support/generators.hpp"
+#include "support/same_results.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <cstring>
 #include <string>
 
 namespace batchcol {
@@ -35,10 +35,6 @@ Scene mixed_scene(std::size_t pairs, std::uint64_t seed) {
   return s;
 }
 
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
 TEST(Executor, BitwiseIdenticalForOneAndTwoThreadsAtEveryLevelAndPrecision) {
   const Scene s = mixed_scene(5000, 1);
   for (Precision p : {Precision::float64, Precision::float32})
@@ -51,12 +47,7 @@ TEST(Executor, BitwiseIdenticalForOneAndTwoThreadsAtEveryLevelAndPrecision) {
       collide(s.shapes, s.batch, o, one);
       o.threads = 2;
       collide(s.shapes, s.batch, o, two);
-      EXPECT_EQ(one.status, two.status);
-      EXPECT_EQ(one.collide, two.collide);
-      EXPECT_EQ(one.iterations, two.iterations);
-      EXPECT_TRUE(bitwise_equal(one.distance, two.distance));
-      for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
-        EXPECT_TRUE(bitwise_equal((one.*m).x, (two.*m).x) && bitwise_equal((one.*m).z, (two.*m).z));
+      testing::expect_same_results(one, two, std::string("1 vs 2 threads, ") + to_string(level));
     }
 }
 
@@ -81,13 +72,7 @@ TEST(Executor, BitwiseIdenticalForEveryInstructionSetThisCpuRuns) {
           EXPECT_NE(std::string(e.what()).find("not supported by this CPU"), std::string::npos) << e.what();
           continue;
         }
-        EXPECT_EQ(want.status, got.status);
-        EXPECT_EQ(want.collide, got.collide);
-        EXPECT_EQ(want.iterations, got.iterations);
-        EXPECT_TRUE(bitwise_equal(want.distance, got.distance));
-        for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal, &PairResults::direction})
-          EXPECT_TRUE(bitwise_equal((want.*m).x, (got.*m).x) && bitwise_equal((want.*m).y, (got.*m).y) &&
-                      bitwise_equal((want.*m).z, (got.*m).z));
+        testing::expect_same_results(want, got, std::string(to_string(isa)) + ", " + to_string(level));
       }
     }
 }

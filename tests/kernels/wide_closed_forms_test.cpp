@@ -5,11 +5,11 @@
 #include "kernels/segment_pairs_world.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 #include "support/generators.hpp"
+#include "support/same_results.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <string>
 
 namespace batchcol {
@@ -204,31 +204,21 @@ TEST(WideClosedForms, ReusedResultsGetNanInEveryFieldTheLevelDoesNotCompute) {
   }
 }
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
 TEST(WideClosedForms, EveryInstructionSetThisCpuRunsGivesTheSameBits) {
   for (const bool boxes : {false, true}) {
-  const Batch b = boxes ? box_batch(13) : mixed_batch(11);
-  QueryOptions o;
-  o.level = boxes ? QueryLevel::boolean : QueryLevel::witness;
-  o.isa = InstructionSet::scalar;
-  PairResults reference;
-  collide(b.shapes, b.pairs, o, reference);
-  for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
-    if (!kernels::simd::cpu_has(isa)) continue;
-    o.isa = isa;
-    PairResults r;
-    collide(b.shapes, b.pairs, o, r);
-    EXPECT_EQ(r.status, reference.status) << to_string(isa);
-    EXPECT_EQ(r.collide, reference.collide) << to_string(isa);
-    EXPECT_TRUE(same_bits(r.distance, reference.distance)) << to_string(isa);
-    for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
-      EXPECT_TRUE(same_bits((r.*m).x, (reference.*m).x) && same_bits((r.*m).y, (reference.*m).y) &&
-                  same_bits((r.*m).z, (reference.*m).z))
-          << to_string(isa);
-  }
+    const Batch b = boxes ? box_batch(13) : mixed_batch(11);
+    QueryOptions o;
+    o.level = boxes ? QueryLevel::boolean : QueryLevel::witness;
+    o.isa = InstructionSet::scalar;
+    PairResults reference;
+    collide(b.shapes, b.pairs, o, reference);
+    for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
+      if (!kernels::simd::cpu_has(isa)) continue;
+      o.isa = isa;
+      PairResults r;
+      collide(b.shapes, b.pairs, o, r);
+      testing::expect_same_results(reference, r, to_string(isa));
+    }
   }
 }
 
