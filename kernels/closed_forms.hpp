@@ -13,6 +13,15 @@
 
 namespace batchcol::kernels {
 
+/// Segment cores closer than this many ulps of their coordinates touch: their offset is then rounding noise (a
+/// few ulps) and its direction meaningless; 4096 ulps keeps the noise's angle below ~1e-3 rad when the rule does
+/// not apply. Shared with the SIMD version (kernels/simd/wide_segments.inl).
+constexpr double kSegmentTouchUlps = 4096;
+/// The separating-axis test pads |R| by this many ulps so that the nine edge-edge axes of nearly parallel edges
+/// (cross product ~ 0) cannot report a spurious separation from rounding: pairs closer than ~1e3 eps x size then
+/// count as touching. Shared with the SIMD version (kernels/simd/wide_boxes.inl).
+constexpr double kSatPaddingUlps = 1000;
+
 /// Closest points of segments [p0, p1] and [q0, q1] (either may have zero length).
 template <class T> void closest_points_segments(const Vec3<T>& p0, const Vec3<T>& p1, const Vec3<T>& q0,
                                                 const Vec3<T>& q1, Vec3<T>& cp, Vec3<T>& cq) {
@@ -49,13 +58,10 @@ PairOutput<T> segments_with_radii(const Vec3<T>& p0, const Vec3<T>& p1, const Ve
   closest_points_segments<T>(p0, p1, q0, q1, ca, cb);
   const Vec3<T> v = cb - ca;
   const T dcore = v.norm();
-  // Cores closer than kTouchUlps ulps of the coordinates touch: v is then rounding noise (a few ulps), and
-  // v / |v| would point anywhere; 4096 ulps keeps the noise's angle below ~1e-3 rad when the rule does not apply.
-  constexpr T kTouchUlps = T(4096);
   const T coordinates = std::max(std::max(p0.cwiseAbs().maxCoeff(), p1.cwiseAbs().maxCoeff()),
                                  std::max(q0.cwiseAbs().maxCoeff(), q1.cwiseAbs().maxCoeff()));
   Vec3<T> n;
-  if (dcore > kTouchUlps * machine_epsilon<T>() * coordinates) {
+  if (dcore > T(kSegmentTouchUlps) * machine_epsilon<T>() * coordinates) {
     n = v / dcore;
   } else {
     // The cores touch: a unit vector orthogonal to both segments (the direction of least overlap when the
@@ -132,9 +138,7 @@ PairOutput<T> sphere_box(const ShapeCore<T>& sphere, const ShapeCore<T>& box, co
 template <class T> bool boxes_intersect(const Vec3<T>& ha, const Vec3<T>& hb, const Transform<T>& b_in_a) {
   const Mat3<T>& R = b_in_a.R;
   const Vec3<T>& t = b_in_a.t;
-  // |R| is padded so that the nine edge-edge axes of nearly parallel edges (cross product ~ 0) cannot report a
-  // spurious separation from rounding: pairs closer than ~1e3 eps x size then count as touching.
-  const Mat3<T> absR = R.cwiseAbs().array() + T(1000) * machine_epsilon<T>();
+  const Mat3<T> absR = R.cwiseAbs().array() + T(kSatPaddingUlps) * machine_epsilon<T>();
   for (int i = 0; i < 3; ++i)
     if (std::abs(t[i]) > ha[i] + hb.dot(absR.row(i))) return false;
   for (int j = 0; j < 3; ++j)

@@ -3,6 +3,7 @@
 // or the scalar kernels can be emitted with AVX-512 instructions and picked by the linker for baseline code.
 #pragma once
 
+#include "kernels/closed_forms.hpp"
 #include "kernels/narrowphase.hpp"
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"

@@ -1,9 +1,9 @@
 // Box-box boolean by the separating-axis theorem over the 15 candidate axes (Gottschalk, Lin, Manocha, "OBBTree",
 // SIGGRAPH 1996), W pairs per register straight from their world poses: B's rotation and centre in A's frame,
-// then all 15 tests as lane masks (no early exit: a register takes every test). |R| is padded by 1e3 eps as in
-// boxes_intersect() (kernels/closed_forms.hpp), so that the edge-edge axes of nearly parallel edges cannot
-// report a spurious separation from rounding. Plain boxes only (the caller runs this at QueryLevel::boolean with a
-// zero margin, like the scalar closed form); inflated boxes and invalid input go back to the caller.
+// then all 15 tests as lane masks (no early exit: a register takes every test). |R| is padded by kSatPaddingUlps
+// as in boxes_intersect() (kernels/closed_forms.hpp). Plain boxes only (the caller runs this at
+// QueryLevel::boolean with a zero margin, like the scalar closed form); inflated boxes and invalid input go back
+// to the caller.
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide_pairs.inl.
 
@@ -15,7 +15,7 @@ struct WideBoxes : PairLanes {
       for (std::size_t k = 0; k < n; ++k) fallback[fallbacks++] = pairs[k];
       return fallbacks;
     }
-    const real zero = splat(0.0), pad = splat(1000 * std::numeric_limits<double>::epsilon());
+    const real zero = splat(0.0), pad = splat(kSatPaddingUlps * std::numeric_limits<double>::epsilon());
     for (std::size_t k = 0; k < n; k += W) {
       const Block b = block(pairs, n, k);
       Pose pa = load_pose(in, in.shape_a, in.translation_a, in.rotation_a, b.idx, b.consecutive);

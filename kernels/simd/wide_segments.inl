@@ -96,10 +96,10 @@ struct WideSegments : PairLanes {
       const V3 v = sub(cb, ca);
       const real core = wsqrt<double>(dot(v, v));
       const real signed_distance = (core - A.radius) - B.radius;
-      // Touching cores (the scalar rule in segments_with_radii: within 4096 ulps of the coordinates) need the
-      // scalar path's normal.
+      // Touching cores (the scalar rule in segments_with_radii: within kSegmentTouchUlps of the coordinates)
+      // need the scalar path's normal.
       const real coordinates = wmax(wmax(max_abs(A.p0), max_abs(A.p1)), wmax(max_abs(B.p0), max_abs(B.p1)));
-      const real touch = splat(4096 * std::numeric_limits<double>::epsilon()) * coordinates;
+      const real touch = splat(kSegmentTouchUlps * std::numeric_limits<double>::epsilon()) * coordinates;
       const mask answered = A.valid & B.valid & (core > touch);
       const std::uint32_t mine = lane_bits(answered) & b.live;
       const bool whole =
