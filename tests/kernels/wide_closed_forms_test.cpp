@@ -138,7 +138,7 @@ Batch box_batch(std::uint64_t seed) {
   return b;
 }
 
-TEST(WideClosedForms, BoxBoxLanesAgreeWithGjkAndCountTouching) {
+TEST(WideClosedForms, BoxBoxLanesAgreeWithTheScalarSatAndGjkAndCountTouching) {
   const Batch b = box_batch(3);
   QueryOptions sat;
   sat.level = QueryLevel::boolean;
@@ -149,7 +149,7 @@ TEST(WideClosedForms, BoxBoxLanesAgreeWithGjkAndCountTouching) {
   PairResults fast, reference;
   collide(b.shapes, b.pairs, sat, fast);
   collide(b.shapes, b.pairs, gjk, reference);
-  std::size_t compared = 0, colliding = 0, touching = 0;
+  std::size_t compared = 0, colliding = 0, touching = 0, scalar_compared = 0;
   for (std::size_t i = 0; i < b.pairs.size(); ++i) {
     ASSERT_EQ(fast.status[i] == Status::invalid_input, reference.status[i] == Status::invalid_input) << i;
     if (fast.status[i] == Status::invalid_input) continue;
@@ -161,10 +161,22 @@ TEST(WideClosedForms, BoxBoxLanesAgreeWithGjkAndCountTouching) {
     // Within rounding of touching either answer is right.
     if (!reference.collide[i] && reference.distance[i] < 1e-9) continue;
     EXPECT_EQ(fast.collide[i], reference.collide[i]) << "pair " << i << " distance " << reference.distance[i];
+    // The scalar reference of the same test, in A's frame (only plain box-box pairs run it).
+    const Shape& a = b.shapes[b.pairs.shape_a[i]];
+    const Shape& c = b.shapes[b.pairs.shape_b[i]];
+    if (a.type == ShapeType::box && c.type == ShapeType::box && a.inflation == 0 && c.inflation == 0) {
+      const Eigen::Matrix3d Ra = b.pairs.rotation_a[i].normalized().toRotationMatrix();
+      kernels::Transform<double> b_in_a;
+      b_in_a.R = Ra.transpose() * b.pairs.rotation_b[i].normalized().toRotationMatrix();
+      b_in_a.t = Ra.transpose() * (b.pairs.translation_b[i] - b.pairs.translation_a[i]);
+      EXPECT_EQ(fast.collide[i] != 0, kernels::boxes_intersect<double>(a.size, c.size, b_in_a)) << "pair " << i;
+      ++scalar_compared;
+    }
     ++compared;
     colliding += fast.collide[i];
   }
   EXPECT_GE(touching, 55u);  // 60 minus those made invalid
+  EXPECT_GT(scalar_compared, 1500u);
   EXPECT_GT(colliding, 300u);
   EXPECT_GT(compared - colliding, 300u);
 }
