@@ -38,6 +38,26 @@ template <class T> Vec3<T> mul_transposed(const Mat3<T>& R, const Vec3<T>& v) {
                  (R(0, 2) * v.x() + R(1, 2) * v.y()) + R(2, 2) * v.z());
 }
 
+/// Rotation matrix of the unit quaternion (w, x, y, z), entry by entry in the order the SIMD closed forms use
+/// (PairLanes::column in simd/wide_pairs.inl).
+template <class T> Mat3<T> rotation_matrix(T w, T x, T y, T z) {
+  Mat3<T> R;
+  T* m = R.data();  // column-major: R(i, j) = m[i + 3 j]
+  m[0] = T(1) - T(2) * (y * y + z * z), m[1] = T(2) * (x * y + w * z), m[2] = T(2) * (x * z - w * y);
+  m[3] = T(2) * (x * y - w * z), m[4] = T(1) - T(2) * (x * x + z * z), m[5] = T(2) * (y * z + w * x);
+  m[6] = T(2) * (x * z + w * y), m[7] = T(2) * (y * z - w * x), m[8] = T(1) - T(2) * (x * x + y * y);
+  return R;
+}
+/// A^T B, entry (i, j) = column i of A . column j of B with dot3's association.
+template <class T> Mat3<T> transposed_product(const Mat3<T>& A, const Mat3<T>& B) {
+  Mat3<T> P;
+  const T *a = A.data(), *b = B.data();
+  T* p = P.data();
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) p[i + 3 * j] = (a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1]) + a[3 * i + 2] * b[3 * j + 2];
+  return P;
+}
+
 /// A rigid transform x_parent = R x_local + t, in precision T.
 template <class T> struct Transform {
   Mat3<T> R = Mat3<T>::Identity();

@@ -85,31 +85,32 @@ PairOutput<float> redo_in_double(const PairSetup<float>& s, const GjkResult<floa
 }  // namespace
 
 template <class T>
-PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                        const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
-  PairSetup<T> s;
+void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a, const Eigen::Vector3d& warm_direction,
+                     const QueryOptions& opt, PairSetup<T>& s) {
   s.A = make_core<T>(a);
   s.B = make_core<T>(b);
   const ShapeCore<T>& A = s.A;
   const ShapeCore<T>& B = s.B;
   s.X.R = b_in_a.R.cast<T>();
   s.X.t = b_in_a.t.cast<T>();
+  s.done = false;
   // The separating-axis test is exact for boolean queries on plain boxes with a zero margin.
   if (opt.closed_forms && a.type == ShapeType::box && b.type == ShapeType::box && opt.level == QueryLevel::boolean &&
       opt.margin == 0.0 && A.radius == T(0) && B.radius == T(0)) {
+    s.out = PairOutput<T>{};
     finish(s.out, opt, true, boxes_intersect(A.size, B.size, s.X));
     s.done = true;
-    return s;
+    return;
   }
   if (closed_form(A, B, s.X, opt, s.out)) {
     finish(s.out, opt, false, false);
     s.done = true;
-    return s;
+    return;
   }
 
   // GJK on the cores; the swept radii are added afterwards.
   s.radii = A.radius + B.radius;
-  s.scale = T(a.bounding_radius() + b.bounding_radius() + b_in_a.t.norm());
+  s.scale = T(a.bounding_radius() + b.bounding_radius() + norm3(b_in_a.t));
   s.floor = tolerance_floor(s.scale);
   GjkParams<T>& params = s.params;
   params.solver = opt.solver;
@@ -123,6 +124,13 @@ PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in
   const Vec3<T> warm = warm_direction.cast<T>();
   const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
   s.initial_direction = use_warm ? warm : s.difference().center();
+}
+
+template <class T>
+PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                        const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
+  PairSetup<T> s;
+  setup_pair_into(a, b, b_in_a, warm_direction, opt, s);
   return s;
 }
 
@@ -240,6 +248,10 @@ template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const
                                                const Eigen::Vector3d&, const QueryOptions&);
 template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
                                              const Eigen::Vector3d&, const QueryOptions&);
+template void setup_pair_into<double>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
+                                       const QueryOptions&, PairSetup<double>&);
+template void setup_pair_into<float>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
+                                      const QueryOptions&, PairSetup<float>&);
 template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const RelativePose&,
                                               const Eigen::Vector3d&, const QueryOptions&);
 template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,

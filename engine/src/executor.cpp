@@ -107,36 +107,37 @@ void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size
   out.collide[i] = r.collide ? 1 : 0;
   out.distance[i] = static_cast<double>(r.distance);
   if (level >= QueryLevel::witness) {  // below, these stay NaN (fill_pair_defaults) and cost 3 rotations
-    out.witness_a.set(i, f.Ra * r.witness_a.template cast<double>() + f.ta);
-    out.witness_b.set(i, f.Ra * r.witness_b.template cast<double>() + f.ta);
-    out.normal.set(i, f.Ra * r.normal.template cast<double>());
+    out.witness_a.set(i, kernels::mul<double>(f.Ra, r.witness_a.template cast<double>()) + f.ta);
+    out.witness_b.set(i, kernels::mul<double>(f.Ra, r.witness_b.template cast<double>()) + f.ta);
+    out.normal.set(i, kernels::mul<double>(f.Ra, r.normal.template cast<double>()));
   }
-  out.direction.set(i, f.Ra * r.direction.template cast<double>());
+  out.direction.set(i, kernels::mul<double>(f.Ra, r.direction.template cast<double>()));
   out.iterations[i] = r.iterations;
 }
 
 /// Validates pair i, computes B's pose in A's frame (double) and the setup. Returns false for an invalid pair
-/// (status invalid_input written; everything else stays NaN / 0 from PairResults::resize).
+/// (status invalid_input written; everything else stays NaN / 0 from fill_pair_defaults). The pose arithmetic is
+/// spelled out (kernels/math.hpp) so that every path computing a relative pose gets the same bits.
 template <class T>
 bool prepare_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
                   PairFrame& frame, kernels::PairSetup<T>& setup, PairResults& out) {
   const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
-  const auto qa = detail::unit_quaternion(batch.rotation_a[i]);
-  const auto qb = detail::unit_quaternion(batch.rotation_b[i]);
+  double qa[4] = {batch.rotation_a.w[i], batch.rotation_a.x[i], batch.rotation_a.y[i], batch.rotation_a.z[i]};
+  double qb[4] = {batch.rotation_b.w[i], batch.rotation_b.x[i], batch.rotation_b.y[i], batch.rotation_b.z[i]};
   const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
-  if (ia >= shapes.size() || ib >= shapes.size() || !qa || !qb || !ta.allFinite() || !tb.allFinite()) {
+  if (ia >= shapes.size() || ib >= shapes.size() || !detail::normalize_unit_quaternion(qa) ||
+      !detail::normalize_unit_quaternion(qb) || !ta.allFinite() || !tb.allFinite()) {
     out.status[i] = Status::invalid_input;
     return false;
   }
-  frame.Ra = qa->toRotationMatrix();
+  frame.Ra = kernels::rotation_matrix(qa[0], qa[1], qa[2], qa[3]);
   frame.ta = ta;
-  const Eigen::Matrix3d Rb = qb->toRotationMatrix();
   kernels::RelativePose b_in_a;
-  b_in_a.R = frame.Ra.transpose() * Rb;
-  b_in_a.t = frame.Ra.transpose() * (tb - ta);
+  b_in_a.R = kernels::transposed_product(frame.Ra, kernels::rotation_matrix(qb[0], qb[1], qb[2], qb[3]));
+  b_in_a.t = kernels::mul_transposed<double>(frame.Ra, tb - ta);
   Eigen::Vector3d warm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  if (!batch.warm_start.empty()) warm = frame.Ra.transpose() * batch.warm_start[i];
-  setup = kernels::setup_pair<T>(shapes[ia], shapes[ib], b_in_a, warm, options);
+  if (!batch.warm_start.empty()) warm = kernels::mul_transposed<double>(frame.Ra, batch.warm_start[i]);
+  kernels::setup_pair_into<T>(shapes[ia], shapes[ib], b_in_a, warm, options, setup);
   return true;
 }
 

@@ -192,27 +192,29 @@ template <class T> struct WideGjk {
     r.contains = splat_mask(0);
     return r;
   }
-  static Proj vertex(const V3* p, int i) {
+  /// The vertex q (input index `id` in each lane).
+  static Proj vertex(const V3& q, mask id) {
     Proj r = empty();
-    r.x = p[i];
+    r.x = q;
     r.count = splat_mask(1);
-    r.index[0] = splat_mask(i);
+    r.index[0] = id;
     r.lambda[0] = splat(T(1));
     return r;
   }
-  static Proj segment(const V3* p, int i, int j) {
-    const V3 t = sub(p[j], p[i]);
+  /// The segment from qi to qj (input indices i, j in each lane).
+  static Proj segment(const V3& qi, const V3& qj, mask i, mask j) {
+    const V3 t = sub(qj, qi);
     const real tt = norm2(t);
-    const real u = (-dot(p[i], t)) / tt;
+    const real u = (-dot(qi, t)) / tt;
     Proj r = empty();
     r.count = splat_mask(2);
-    r.index[0] = splat_mask(i);
-    r.index[1] = splat_mask(j);
+    r.index[0] = i;
+    r.index[1] = j;
     r.lambda[0] = T(1) - u;
     r.lambda[1] = u;
-    r.x = add(scale(r.lambda[0], p[i]), scale(r.lambda[1], p[j]));
+    r.x = add(scale(r.lambda[0], qi), scale(r.lambda[1], qj));
     const real zero = splat(T(0)), one = splat(T(1));
-    return pick((tt == zero) | (u <= zero), vertex(p, i), pick(u >= one, vertex(p, j), r));
+    return pick((tt == zero) | (u <= zero), vertex(qi, i), pick(u >= one, vertex(qj, j), r));
   }
   static Proj closer(const Proj& a, const Proj& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
 
@@ -222,51 +224,72 @@ template <class T> struct WideGjk {
     return select(drop0, p.z, select(drop1, p.x, p.y));
   }
 
-  /// `want`: the lanes whose result is used; the edge cases are computed only when one of them needs them.
-  static Proj triangle(const V3* p, int i, int j, int k, mask want) {
+  /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
+  /// remaining candidate (`taken[m]` says which), so a round costs one sub-projection for all lanes, and the
+  /// number of rounds is the largest candidate count of one lane (usually 1-2), not the number of distinct
+  /// candidates over the lanes (up to 3 edges or 4 faces).
+  template <int M> static mask next_round(mask (&remaining)[M], mask (&taken)[M]) {
+    mask round = splat_mask(0);  // lanes that took a candidate this round
+    for (int m = 0; m < M; ++m) {
+      taken[m] = remaining[m] & ~round;
+      round |= remaining[m];
+      remaining[m] &= ~taken[m];
+    }
+    return round;
+  }
+
+  /// Triangle q[0], q[1], q[2] (input indices id[]) per lane. `want`: the lanes whose result is used; the edge
+  /// cases are computed only when one of them needs them.
+  static Proj triangle(const V3 (&q)[3], const mask (&id)[3], mask want) {
     const real zero = splat(T(0));
-    const V3 n = cross(sub(p[j], p[i]), sub(p[k], p[i]));
+    const V3 n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
     const real nn = norm2(n);
-    const V3 p0 = scale(dot(p[i], n) / nn, n);
+    const V3 p0 = scale(dot(q[0], n) / nn, n);
     const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
     const mask d1 = ay > ax;
     const mask d2 = az > select(d1, ay, ax);
     const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
     // The four points in the kept coordinates (u, v), selected once.
     const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
-    const real ui = coordinate(p[i], drop0, drop1, 0), vi = coordinate(p[i], drop0, drop1, 1);
-    const real uj = coordinate(p[j], drop0, drop1, 0), vj = coordinate(p[j], drop0, drop1, 1);
-    const real uk = coordinate(p[k], drop0, drop1, 0), vk = coordinate(p[k], drop0, drop1, 1);
+    const real ui = coordinate(q[0], drop0, drop1, 0), vi = coordinate(q[0], drop0, drop1, 1);
+    const real uj = coordinate(q[1], drop0, drop1, 0), vj = coordinate(q[1], drop0, drop1, 1);
+    const real uk = coordinate(q[2], drop0, drop1, 0), vk = coordinate(q[2], drop0, drop1, 1);
     const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
     const real total = area(ui, vi, uj, vj, uk, vk);
     const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
     const real sum = (C[0] + C[1]) + C[2];
     Proj face = empty();
     face.count = splat_mask(3);
-    face.index[0] = splat_mask(i);
-    face.index[1] = splat_mask(j);
-    face.index[2] = splat_mask(k);
+    for (int m = 0; m < 3; ++m) face.index[m] = id[m];
     for (int m = 0; m < 3; ++m) face.lambda[m] = C[m] / sum;
-    face.x = add(add(scale(face.lambda[0], p[i]), scale(face.lambda[1], p[j])), scale(face.lambda[2], p[k]));
+    face.x = add(add(scale(face.lambda[0], q[0]), scale(face.lambda[1], q[1])), scale(face.lambda[2], q[2]));
     const mask degenerate = (nn == zero) | (total == zero);
     const mask use_face = ~degenerate & inside & (sum != zero);
     if (!any(want & ~use_face)) return face;
-    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order; each
-    // edge is computed only when a wanted lane has it as a candidate.
-    const int from[3] = {j, k, i}, to[3] = {k, i, j};
+    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order
+    // (edge m joins vertices m + 1 and m + 2).
+    mask remaining[3], taken[3];
+    for (int m = 0; m < 3; ++m) remaining[m] = want & ~degenerate & ~inside & opposite_sign(C[m], total);
     Proj best = empty();
     mask have = splat_mask(0);
-    for (int m = 0; m < 3; ++m) {
-      const mask candidate = ~inside & opposite_sign(C[m], total);
-      if (!any(want & ~degenerate & candidate)) continue;
-      const Proj e = segment(p, from[m], to[m]);
-      best = pick(candidate & have, closer(best, e), pick(candidate, e, best));
-      have |= candidate;
+    for (;;) {
+      const mask round = next_round(remaining, taken);
+      if (!any(round)) break;
+      V3 from = q[1], to = q[2];
+      mask from_id = id[1], to_id = id[2];
+      for (int m = 1; m < 3; ++m) {
+        from = pick(taken[m], q[(m + 1) % 3], from), to = pick(taken[m], q[(m + 2) % 3], to);
+        from_id = select(taken[m], id[(m + 1) % 3], from_id), to_id = select(taken[m], id[(m + 2) % 3], to_id);
+      }
+      const Proj e = segment(from, to, from_id, to_id);
+      best = pick(round & have, closer(best, e), pick(round, e, best));
+      have |= round;
     }
     // All three edges: degenerate triangles, and the rare lanes where no weight has the wrong sign.
     Proj edges = best;
     if (any(want & ~use_face & (degenerate | ~have)))
-      edges = closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k));
+      edges = closer(closer(segment(q[0], q[1], id[0], id[1]), segment(q[0], q[2], id[0], id[2])),
+                     segment(q[1], q[2], id[1], id[2]));
     return pick(degenerate, edges, pick(use_face, face, pick(have, best, edges)));
   }
 
@@ -287,15 +310,25 @@ template <class T> struct WideGjk {
     in.contains = splat_mask(-1);
     for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
     if (!any(want & ~inside)) return in;
+    // Outside (or flat): the faces the origin sees, m = 0..3 in the reference's order (face m omits vertex m).
     static constexpr int face[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    mask remaining[4], taken[4];
+    for (int m = 0; m < 4; ++m) remaining[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
     Proj best = empty();
     mask have = splat_mask(0);
-    for (int m = 0; m < 4; ++m) {
-      const mask candidate = ~inside & ((total == zero) | opposite_sign(V[m], total));
-      if (!any(want & candidate)) continue;
-      const Proj f = triangle(p, face[m][0], face[m][1], face[m][2], want & candidate);
-      best = pick(candidate & have, closer(best, f), pick(candidate, f, best));
-      have |= candidate;
+    for (;;) {
+      const mask round = next_round(remaining, taken);
+      if (!any(round)) break;
+      V3 q[3] = {p[face[0][0]], p[face[0][1]], p[face[0][2]]};
+      mask id[3] = {splat_mask(face[0][0]), splat_mask(face[0][1]), splat_mask(face[0][2])};
+      for (int m = 1; m < 4; ++m)
+        for (int c = 0; c < 3; ++c) {
+          q[c] = pick(taken[m], p[face[m][c]], q[c]);
+          id[c] = select(taken[m], splat_mask(face[m][c]), id[c]);
+        }
+      const Proj f = triangle(q, id, round);
+      best = pick(round & have, closer(best, f), pick(round, f, best));
+      have |= round;
     }
     return pick(inside, in, best);
   }
@@ -311,16 +344,33 @@ template <class T> struct WideGjk {
     real lower{};
     mask momentum{}, normalize{}, boolean_only{};
     real tolerance{}, relative{}, touch{}, core_margin{};
-    std::int64_t pair[W];  // pair index of each lane, -1 when empty
+    std::int64_t pair[W];      // pair index of each lane, -1 when empty
+    std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
   };
 
+  /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
+  /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
+  static void start(Lanes& L) {
+    if (L.fresh == 0) return;
+    V3 sw, sa, sb;
+    minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
+    mask m = splat_mask(0);
+    for (int l = 0; l < W; ++l) m[l] = (L.fresh >> l & 1u) ? -1 : 0;
+    L.w[0] = pick(m, sw, L.w[0]);
+    L.a[0] = pick(m, sa, L.a[0]);
+    L.b[0] = pick(m, sb, L.b[0]);
+    L.x = pick(m, sw, L.x);
+    L.last_s = pick(m, sw, L.last_s);
+    L.fresh = 0;
+  }
+
   static void load_side(Side& s, const ShapeCore<T>& c, int l) {
-    s.type = c.type;
     s.s0[l] = c.size.x();
     s.s1[l] = c.size.y();
     s.s2[l] = c.size.z();
-    for (int v = 0; v < 3; ++v)
-      for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = c.triangle[v][i];
+    if (s.type == ShapeType::triangle)
+      for (int v = 0; v < 3; ++v)
+        for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = c.triangle[v][i];
     s.hull[l] = c.hull;
     s.hint[l] = SupportHint{};
   }
@@ -332,8 +382,8 @@ template <class T> struct WideGjk {
   }
   static Vec3<T> get_lane(const V3& v, int l) { return Vec3<T>(v.x[l], v.y[l], v.z[l]); }
 
-  /// Starts pair `p` in lane l: the reference's initialisation, with the first support point computed by the
-  /// scalar Minkowski support itself.
+  /// Starts pair `p` in lane l: the reference's initialisation up to the first support point, which start()
+  /// computes for all freshly refilled lanes at once.
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
     L.pair[l] = p;
     for (int i = 0; i < 3; ++i)
@@ -343,18 +393,10 @@ template <class T> struct WideGjk {
     load_side(L.B, s.B, l);
     Vec3<T> init = s.initial_direction;
     if (!(kernels::norm2(init) > T(0))) init = Vec3<T>::UnitX();
-    MinkowskiDifference<T> D{&s.A, &s.B, s.X, {}, {}};
-    const SupportPoint<T> first = D.support(-init);
-    L.A.hint[l] = D.hint_a;
-    L.B.hint[l] = D.hint_b;
-    set_lane(L.w[0], l, first.w);
-    set_lane(L.a[0], l, first.a);
-    set_lane(L.b[0], l, first.b);
+    L.fresh |= 1u << l;
     L.lambda[0][l] = T(1);
     L.count[l] = 1;
-    set_lane(L.x, l, first.w);
     set_lane(L.d_prev, l, init);
-    set_lane(L.last_s, l, first.w);
     set_lane(L.direction, l, Vec3<T>::Zero());
     L.lower[l] = -std::numeric_limits<T>::infinity();
     L.k[l] = 0;
@@ -441,6 +483,7 @@ template <class T> struct WideGjk {
     };
 
     for (std::uint32_t active = active_bits(); active != 0; active = active_bits()) {
+      start(L);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
@@ -514,9 +557,13 @@ template <class T> struct WideGjk {
         const mask n_after = L.count + 1;
         const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
         Proj proj = empty();
-        if (any(live & two)) proj = pick(two, segment(pw, 0, 1), proj);
+        if (any(live & two)) proj = pick(two, segment(pw[0], pw[1], splat_mask(0), splat_mask(1)), proj);
         const mask four = n_after == splat_mask(4);
-        if (any(live & three)) proj = pick(three, triangle(pw, 0, 1, 2, live & three), proj);
+        if (any(live & three)) {
+          const V3 q[3] = {pw[0], pw[1], pw[2]};
+          const mask id[3] = {splat_mask(0), splat_mask(1), splat_mask(2)};
+          proj = pick(three, triangle(q, id, live & three), proj);
+        }
         if (any(live & four)) proj = pick(four, tetrahedron(pw, live & four), proj);
         const real next_xx = norm2(proj.x);
 

@@ -42,6 +42,7 @@ struct CaseResult {
   double error_median = 0, error_max = 0;
   std::size_t error_pairs = 0, disagreements = 0;
   double reference_min = 0, reference_max = 0;
+  double iterations_mean = 0;  // GJK iterations plus EPA expansions per pair (0 for closed forms)
   std::string note, kernel;
   PeerReport peers;
 };
@@ -108,13 +109,16 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
   out.pairs_per_second = median > 0 ? n / median : 0.0;
 
   std::vector<double> errors;
+  double iterations = 0;
   for (std::size_t i = 0; i < results.size(); ++i) {
+    iterations += results.iterations[i];
     out.disagreements += (results.collide[i] != 0) != (p.reference[i] <= options.margin) ? 1 : 0;
     if (options.level != QueryLevel::boolean && std::isfinite(results.distance[i])) {
       errors.push_back(std::abs(results.distance[i] - p.reference[i]));
     }
   }
   out.error_pairs = errors.size();
+  out.iterations_mean = iterations / n;
   out.error_median = median_of(errors);
   out.error_max = errors.empty() ? 0.0 : *std::max_element(errors.begin(), errors.end());
   if (options.level == QueryLevel::boolean) {
@@ -139,7 +143,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
                       {"pairs", s.pairs}, {"isa", to_string(o.isa)}, {"kernel", r.kernel}, {"pairs_per_second", r.pairs_per_second},
                       {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
                       {"error_pairs", r.error_pairs}, {"collide_disagreements", r.disagreements},
-                      {"reference_min", r.reference_min}, {"reference_max", r.reference_max},
+                      {"reference_min", r.reference_min}, {"reference_max", r.reference_max}, {"iterations_mean", r.iterations_mean},
                       {"timed_runs", s.runs}, {"peers", peers}, {"peers_missing", r.peers.notes}};
   if (!r.note.empty()) j["note"] = r.note;
   return j;
@@ -154,12 +158,12 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(o.solver), threads, s.pairs, s.runs);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
-  std::printf("%-22s %-11s %10s %11s %10s %10s", "case", "kernel", "ns/pair", "pairs/s", boolean ? "disagree" : "err_med",
-              boolean ? "" : "err_max");
+  std::printf("%-22s %-11s %6s %10s %11s %10s %10s", "case", "kernel", "iters", "ns/pair", "pairs/s",
+              boolean ? "disagree" : "err_med", boolean ? "" : "err_max");
   std::printf("   %-s\n", "peers: name ns/pair ratio err_max|disagree");
   for (const CaseResult& r : results) {
-    std::printf("%-22s %-11s %10.1f %11.4g ", r.bench_case.name().c_str(), r.kernel.c_str(), r.ns_per_pair,
-                r.pairs_per_second);
+    std::printf("%-22s %-11s %6.2f %10.1f %11.4g ", r.bench_case.name().c_str(), r.kernel.c_str(), r.iterations_mean,
+                r.ns_per_pair, r.pairs_per_second);
     if (boolean) std::printf("%10zu %10s", r.disagreements, "");
     else std::printf("%10.2e %10.2e", r.error_median, r.error_max);
     for (const PeerTiming& t : r.peers.timings) {
