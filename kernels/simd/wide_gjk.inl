@@ -201,21 +201,40 @@ template <class T> struct WideGjk {
     r.lambda[0] = splat(T(1));
     return r;
   }
-  /// The segment from qi to qj (input indices i, j in each lane).
-  static Proj segment(const V3& qi, const V3& qj, mask i, mask j) {
+  /// Closest point of a segment, kept small while candidates are compared (7 registers instead of a Proj's 13):
+  /// kind 0 = vertex i, 1 = vertex j, 2 = interior point (1 - u) qi + u qj.
+  struct Edge {
+    V3 x;
+    real u;
+    mask kind, i, j;
+  };
+  static Edge pick(mask m, const Edge& a, const Edge& b) {
+    return {pick(m, a.x, b.x), select(m, a.u, b.u), select(m, a.kind, b.kind), select(m, a.i, b.i), select(m, a.j, b.j)};
+  }
+  static Edge closer(const Edge& a, const Edge& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
+  /// The segment from qi to qj (input indices i, j in each lane): the reference's segment(), same operations.
+  static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
     const V3 t = sub(qj, qi);
     const real tt = norm2(t);
     const real u = (-dot(qi, t)) / tt;
-    Proj r = empty();
-    r.count = splat_mask(2);
-    r.index[0] = i;
-    r.index[1] = j;
-    r.lambda[0] = T(1) - u;
-    r.lambda[1] = u;
-    r.x = add(scale(r.lambda[0], qi), scale(r.lambda[1], qj));
     const real zero = splat(T(0)), one = splat(T(1));
-    return pick((tt == zero) | (u <= zero), vertex(qi, i), pick(u >= one, vertex(qj, j), r));
+    const mask at_i = (tt == zero) | (u <= zero), at_j = ~at_i & (u >= one);
+    const V3 inner = add(scale(one - u, qi), scale(u, qj));
+    return {pick(at_i, qi, pick(at_j, qj, inner)), u, select(at_i, splat_mask(0), select(at_j, splat_mask(1), splat_mask(2))), i, j};
   }
+  static Proj to_proj(const Edge& e) {
+    const mask inner = e.kind == splat_mask(2), at_j = e.kind == splat_mask(1);
+    const real zero = splat(T(0)), one = splat(T(1));
+    Proj r = empty();
+    r.x = e.x;
+    r.count = select(inner, splat_mask(2), splat_mask(1));
+    r.index[0] = select(at_j, e.j, e.i);
+    r.index[1] = select(inner, e.j, splat_mask(0));
+    r.lambda[0] = select(inner, one - e.u, one);
+    r.lambda[1] = select(inner, e.u, zero);
+    return r;
+  }
+  static Proj segment(const V3& qi, const V3& qj, mask i, mask j) { return to_proj(edge(qi, qj, i, j)); }
   static Proj closer(const Proj& a, const Proj& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
 
   static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
@@ -270,7 +289,7 @@ template <class T> struct WideGjk {
     // (edge m joins vertices m + 1 and m + 2).
     mask remaining[3], taken[3];
     for (int m = 0; m < 3; ++m) remaining[m] = want & ~degenerate & ~inside & opposite_sign(C[m], total);
-    Proj best = empty();
+    Edge best{};
     mask have = splat_mask(0);
     for (;;) {
       const mask round = next_round(remaining, taken);
@@ -281,16 +300,16 @@ template <class T> struct WideGjk {
         from = pick(taken[m], q[(m + 1) % 3], from), to = pick(taken[m], q[(m + 2) % 3], to);
         from_id = select(taken[m], id[(m + 1) % 3], from_id), to_id = select(taken[m], id[(m + 2) % 3], to_id);
       }
-      const Proj e = segment(from, to, from_id, to_id);
+      const Edge e = edge(from, to, from_id, to_id);
       best = pick(round & have, closer(best, e), pick(round, e, best));
       have |= round;
     }
     // All three edges: degenerate triangles, and the rare lanes where no weight has the wrong sign.
-    Proj edges = best;
+    Edge edges = best;
     if (any(want & ~use_face & (degenerate | ~have)))
-      edges = closer(closer(segment(q[0], q[1], id[0], id[1]), segment(q[0], q[2], id[0], id[2])),
-                     segment(q[1], q[2], id[1], id[2]));
-    return pick(degenerate, edges, pick(use_face, face, pick(have, best, edges)));
+      edges = closer(closer(edge(q[0], q[1], id[0], id[1]), edge(q[0], q[2], id[0], id[2])), edge(q[1], q[2], id[1], id[2]));
+    if (!any(want & use_face)) return to_proj(pick(degenerate, edges, pick(have, best, edges)));
+    return pick(use_face, face, to_proj(pick(degenerate, edges, pick(have, best, edges))));
   }
 
   static real area(real au, real av, real bu, real bv, real cu, real cv) {
