@@ -44,6 +44,10 @@ template <class T> struct WideGjk {
     real tri[9]{};                         // triangle vertices
     const ConvexHull* hull[W] = {};
     SupportHint hint[W] = {};
+    // Per-lane hull facts cached at refill (a support call reads them instead of chasing each lane's hull).
+    const double* first_vertex[W] = {};  // hull->vertices.front().data()
+    std::uint32_t vertex_count[W] = {};
+    std::uint32_t small = 0;  // lanes whose hull has fewer than kHillClimbMinVertices vertices (linear scan)
   };
 
   static V3 support(Side& s, const V3& d, std::uint32_t live) {
@@ -102,17 +106,9 @@ template <class T> struct WideGjk {
   /// first vertex with the largest dot product wins.
   static V3 hull_support_lanes(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
-    std::size_t most = 0;
-    bool all_small = true;
-    for (int l = 0; l < W; ++l) {
-      if (!(live >> l & 1u)) continue;
-      const std::size_t n = s.hull[l]->vertices.size();
-      all_small = all_small && n < kHillClimbMinVertices;
-      most = std::max(most, n);
-    }
     V3 r{zero, zero, zero};
     if (live == 0) return r;
-    if (!all_small) {
+    if (live & ~s.small) {
       for (int l = 0; l < W; ++l) {
         if (!(live >> l & 1u)) continue;
         const Vec3<T> p = hull_support(*s.hull[l], Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
@@ -122,13 +118,15 @@ template <class T> struct WideGjk {
       }
       return r;
     }
+    std::uint32_t most = 0;
     const double* base[W];
     std::uint32_t last[W], index[W];
     const int first_live = __builtin_ctz(live);
     for (int l = 0; l < W; ++l) {
-      const ConvexHull& h = *s.hull[(live >> l & 1u) ? l : first_live];
-      base[l] = h.vertices.front().data();
-      last[l] = std::uint32_t(h.vertices.size() - 1);
+      const int from = (live >> l & 1u) ? l : first_live;  // idle lanes scan a live lane's hull
+      base[l] = s.first_vertex[from];
+      last[l] = s.vertex_count[from] - 1;
+      most = std::max(most, s.vertex_count[from]);
       index[l] = 0;
     }
     if constexpr (sizeof(T) == 8 && W > 1) {
@@ -392,6 +390,12 @@ template <class T> struct WideGjk {
         for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = c.triangle[v][i];
     s.hull[l] = c.hull;
     s.hint[l] = SupportHint{};
+    if (s.type == ShapeType::convex) {
+      s.first_vertex[l] = c.hull->vertices.front().data();
+      s.vertex_count[l] = std::uint32_t(c.hull->vertices.size());
+      const std::uint32_t bit = 1u << l;
+      s.small = c.hull->vertices.size() < kHillClimbMinVertices ? s.small | bit : s.small & ~bit;
+    }
   }
 
   template <class V> static void set_lane(V3& v, int l, const V& p) {
