@@ -59,8 +59,8 @@ template <class T> void finish(PairOutput<T>& o, const QueryOptions& opt, bool k
 /// 0.6 m cylinder-ellipsoid pair 1e-6 m apart).
 constexpr int kStallFloors = 2;
 
-template <class T> bool stall_above_floor(const PairSetup<T>& s, const GjkResult<T>& g) {
-  return g.x.norm() - g.lower_bound > std::max(s.params.tolerance, T(kStallFloors) * s.floor);
+template <class T> bool stall_above_floor(const GjkCompletion<T>& c, const GjkResult<T>& g) {
+  return g.x.norm() - g.lower_bound > std::max(c.tolerance, T(kStallFloors) * c.floor);
 }
 
 template <class T> ShapeCore<double> widen(const ShapeCore<T>& c) {
@@ -135,32 +135,19 @@ PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in
 }
 
 template <class T>
-PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const QueryOptions& opt) {
-  const ShapeCore<T>& A = s.A;
-  const ShapeCore<T>& B = s.B;
-  const GjkParams<T>& params = s.params;
-  const T radii = s.radii, scale = s.scale, floor = s.floor;
-  PairOutput<T> out;
+bool complete_from_gjk(const GjkCompletion<T>& c, const GjkResult<T>& g, const QueryOptions& opt,
+                       PairOutput<T>& out) {
+  out = PairOutput<T>{};
   out.iterations = g.iterations;
   out.direction = g.direction;
 
   switch (g.status) {
-    case GjkStatus::separated_proven: finish(out, opt, true, false); return out;
-    case GjkStatus::collision_proven: finish(out, opt, true, true); return out;
-    case GjkStatus::overlap: {
-      if (opt.level < QueryLevel::penetration) { finish(out, opt, true, true); return out; }
-      const EpaResult<T> e = epa(s.difference(), g.simplex, params.tolerance, scale, opt.epa_max_iterations);
-      out.iterations += e.iterations;
-      out.status = e.status == EpaStatus::converged || e.status == EpaStatus::flat ? Status::converged
-                   : e.status == EpaStatus::max_iterations                          ? Status::max_iterations
-                                                                                     : Status::degenerate;
-      out.normal = e.normal;
-      out.distance = -e.depth - radii;
-      out.witness_a = e.witness_a + A.radius * e.normal;
-      out.witness_b = e.witness_b - B.radius * e.normal;
+    case GjkStatus::separated_proven: finish(out, opt, true, false); return true;
+    case GjkStatus::collision_proven: finish(out, opt, true, true); return true;
+    case GjkStatus::overlap:
+      if (opt.level == QueryLevel::penetration) return false;  // EPA needs the cores
       finish(out, opt, true, true);
-      return out;
-    }
+      return true;
     default: break;
   }
   // Separated or touching cores: x = witness_a - witness_b of the cores.
@@ -168,8 +155,8 @@ PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const 
   const Vec3<T> n = -g.x / xn;  // xn > 0 here: x == 0 ends GJK with GjkStatus::overlap
   out.status = Status::converged;
   if (g.status == GjkStatus::max_iterations) out.status = Status::max_iterations;
-  if (g.status == GjkStatus::stalled && stall_above_floor(s, g)) {
-    if constexpr (std::is_same_v<T, float>) return redo_in_double(s, g, opt);
+  if (g.status == GjkStatus::stalled && stall_above_floor(c, g)) {
+    if constexpr (std::is_same_v<T, float>) return false;  // redone in double on the cores
     // Double has no wider type to fall back on. Its stall is accepted when the certified error is within what the
     // arithmetic can certify. Two limits: (1) the lower bound <s, d>/|d| inherits the direction error of d,
     // ~ eps scale / |x|, times the lateral extent of D (~ scale); (2) a Frank-Wolfe step decreases |x|^2 by
@@ -177,20 +164,46 @@ PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const 
     // distance itself is usually far more accurate than this certificate (measured against closed forms by the
     // hard-case tests: 1.2e-10 m at tolerance 1e-12 on curved shapes 1e-9 m apart). Limit (1) is capped at the
     // larger of |x| and limit (2): it must not grow without bound as |x| -> 0.
+    const T scale = c.scale, floor = c.floor;
     const T sqrt_limit = T(4) * std::sqrt(machine_epsilon<T>()) * scale;
     const T certifiable = std::max(std::min(T(4) * floor * (T(1) + scale / xn), std::max(xn, sqrt_limit)), sqrt_limit);
-    if (xn - g.lower_bound > std::max(params.tolerance, certifiable)) out.status = Status::degenerate;
+    if (xn - g.lower_bound > std::max(c.tolerance, certifiable)) out.status = Status::degenerate;
   }
-  out.distance = xn - radii;
+  out.distance = xn - c.radii;
   out.normal = n;
-  out.witness_a = g.witness_a() + A.radius * n;
-  out.witness_b = g.witness_b() - B.radius * n;
+  out.witness_a = g.witness_a() + c.radius_a * n;
+  out.witness_b = g.witness_b() - c.radius_b * n;
   // collide: when the gap certified the distance (or the budget ran out), it is decided conservatively, false
   // only when a separating plane beyond the margin is certified (a loose tolerance must not turn a shallow
   // overlap into a separation). After an accepted stall the certificate is at the arithmetic's limit and the
   // distance estimate decides.
   if (g.status == GjkStatus::stalled) finish(out, opt, false, false);
-  else finish(out, opt, true, !(g.lower_bound > params.core_margin));
+  else finish(out, opt, true, !(g.lower_bound > c.core_margin));
+  return true;
+}
+
+template <class T>
+PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const QueryOptions& opt) {
+  const GjkCompletion<T> c{s.A.radius, s.B.radius, s.radii, s.scale, s.floor, s.params.tolerance,
+                           s.params.core_margin};
+  PairOutput<T> out;
+  if (complete_from_gjk(c, g, opt, out)) return out;
+  if (g.status != GjkStatus::overlap) {
+    if constexpr (std::is_same_v<T, float>) return redo_in_double(s, g, opt);
+  }
+  // Overlapping cores at QueryLevel::penetration: depth and witnesses by EPA.
+  const EpaResult<T> e = epa(s.difference(), g.simplex, s.params.tolerance, s.scale, opt.epa_max_iterations);
+  out = PairOutput<T>{};
+  out.iterations = g.iterations + e.iterations;
+  out.direction = g.direction;
+  out.status = e.status == EpaStatus::converged || e.status == EpaStatus::flat ? Status::converged
+               : e.status == EpaStatus::max_iterations                          ? Status::max_iterations
+                                                                                 : Status::degenerate;
+  out.normal = e.normal;
+  out.distance = -e.depth - s.radii;
+  out.witness_a = e.witness_a + s.A.radius * e.normal;
+  out.witness_b = e.witness_b - s.B.radius * e.normal;
+  finish(out, opt, true, true);
   return out;
 }
 
@@ -256,6 +269,10 @@ template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const 
                                               const Eigen::Vector3d&, const QueryOptions&);
 template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,
                                             const Eigen::Vector3d&, const QueryOptions&);
+template bool complete_from_gjk<double>(const GjkCompletion<double>&, const GjkResult<double>&, const QueryOptions&,
+                                         PairOutput<double>&);
+template bool complete_from_gjk<float>(const GjkCompletion<float>&, const GjkResult<float>&, const QueryOptions&,
+                                        PairOutput<float>&);
 template PairOutput<double> complete_pair<double>(const PairSetup<double>&, const GjkResult<double>&,
                                                   const QueryOptions&);
 template PairOutput<float> complete_pair<float>(const PairSetup<float>&, const GjkResult<float>&,

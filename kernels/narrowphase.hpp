@@ -42,6 +42,18 @@ PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in
 template <class T>
 void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a, const Eigen::Vector3d& warm_direction,
                      const QueryOptions& options, PairSetup<T>& s);
+/// What completing a pair needs of its setup when GJK's ending needs no cores (see complete_from_gjk).
+template <class T> struct GjkCompletion {
+  T radius_a = T(0), radius_b = T(0);  // swept radii of A and B
+  T radii = T(0), scale = T(0), floor = T(0), tolerance = T(0), core_margin = T(0);  // as in PairSetup
+};
+/// complete_pair() for every GJK ending that needs no cores, written into `out`; returns false (and the caller
+/// runs complete_pair on the full setup) for overlapping cores at QueryLevel::penetration (EPA) and for a float
+/// stall above 2 precision floors (redone in double). complete_pair() itself starts with this function, so both
+/// give the same bits.
+template <class T>
+bool complete_from_gjk(const GjkCompletion<T>& c, const GjkResult<T>& g, const QueryOptions& options,
+                       PairOutput<T>& out);
 /// From GJK's result to the pair's answer: EPA when the cores overlap and depth was asked, the swept radii, the
 /// stall acceptance (a float stall above 2 precision floors is solved again in double) and the conservative
 /// `collide`.
@@ -56,6 +68,10 @@ extern template PairOutput<double> solve_pair<double>(const Shape&, const Shape&
                                                       const Eigen::Vector3d&, const QueryOptions&);
 extern template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
                                                     const Eigen::Vector3d&, const QueryOptions&);
+extern template bool complete_from_gjk<double>(const GjkCompletion<double>&, const GjkResult<double>&,
+                                                const QueryOptions&, PairOutput<double>&);
+extern template bool complete_from_gjk<float>(const GjkCompletion<float>&, const GjkResult<float>&,
+                                               const QueryOptions&, PairOutput<float>&);
 extern template void setup_pair_into<double>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
                                               const QueryOptions&, PairSetup<double>&);
 extern template void setup_pair_into<float>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,

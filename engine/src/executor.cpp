@@ -77,6 +77,25 @@ WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) 
   return WideClosedForm::none;
 }
 
+/// Whether a group's pairs run through the SIMD GJK straight from the batch arrays (kernels::simd::gjk_pairs):
+/// below QueryLevel::penetration (EPA stays per pair), without warm start, and for type pairs that have no
+/// closed form in setup_pair_into() (closed_form(): halfspaces, sphere/capsule pairs, sphere-box; the box-box
+/// separating-axis test). Triangles keep the per-pair path.
+bool wide_gjk_group(std::size_t group, const QueryOptions& options, const PairBatch& batch) {
+  if (options.level >= QueryLevel::penetration || !batch.warm_start.empty()) return false;
+  const ShapeType a = type_a(group), b = type_b(group);
+  const auto plain = [](ShapeType t) { return t != ShapeType::triangle && t != ShapeType::halfspace; };
+  if (!plain(a) || !plain(b)) return false;
+  if (!options.closed_forms) return true;
+  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
+  const auto either = [&](ShapeType x, ShapeType y) { return (a == x && b == y) || (a == y && b == x); };
+  if (segment(a) && segment(b)) return false;
+  if (either(ShapeType::sphere, ShapeType::box)) return false;
+  if (either(ShapeType::box, ShapeType::box) && options.level == QueryLevel::boolean && options.margin == 0.0)
+    return false;
+  return true;
+}
+
 /// World frame of shape A for one pair: outputs are computed in A's frame and mapped back with it.
 struct PairFrame {
   Eigen::Matrix3d Ra;
@@ -223,8 +242,9 @@ template <class T>
 void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
               std::size_t begin, std::size_t end, ChunkScratch<T>& s, PairResults& out) {
   group_by_type(shapes, batch, begin, end, s.order, s.keys, s.groups);
-  // Groups with a SIMD closed form first, W pairs per register; the pairs they leave (invalid input, touching
-  // cores, inflated boxes) join the generic per-pair path below with every other group.
+  // Groups with a SIMD closed form or the batch-array GJK first; the pairs they leave (invalid input, touching
+  // cores, inflated boxes, float stalls redone in double) join the generic per-pair path below with every other
+  // group.
   const kernels::simd::PairView view = kernels::simd::PairView::of(shapes, batch);
   const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
   const kernels::simd::ClosedFormQuery query{options.level, options.margin};
@@ -234,20 +254,24 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
     const std::uint32_t first = s.groups[g], last = s.groups[g + 1];
     if (first == last) continue;
     const WideClosedForm kind = wide_closed_form(g, options);
-    if (kind == WideClosedForm::none) {
+    const bool gjk = kind == WideClosedForm::none && wide_gjk_group(g, options, batch);
+    if (kind == WideClosedForm::none && !gjk) {
       for (std::uint32_t k = first; k < last; ++k) s.order[kept++] = s.order[k];
       continue;
     }
     s.group_pairs.resize(last - first);
     for (std::uint32_t k = first; k < last; ++k) s.group_pairs[k - first] = static_cast<std::uint32_t>(begin + s.order[k]);
     std::uint32_t* left_out = s.fallback.data() + fallbacks;
-    const std::size_t left =
-        kind == WideClosedForm::segments
-            ? kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule, type_b(g) == ShapeType::capsule,
-                                           s.group_pairs.data(), s.group_pairs.size(), query, results, left_out)
-            : kernels::simd::box_pairs_boolean(isa, view, s.group_pairs.data(), s.group_pairs.size(), results,
-                                               left_out);
-    fallbacks += left;
+    const std::uint32_t* pairs = s.group_pairs.data();
+    const std::size_t count = s.group_pairs.size();
+    if (gjk) {
+      fallbacks += kernels::simd::gjk_pairs<T>(isa, view, type_a(g), type_b(g), pairs, count, options, results, left_out);
+    } else if (kind == WideClosedForm::segments) {
+      fallbacks += kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule,
+                                                type_b(g) == ShapeType::capsule, pairs, count, query, results, left_out);
+    } else {
+      fallbacks += kernels::simd::box_pairs_boolean(isa, view, pairs, count, results, left_out);
+    }
   }
   for (std::size_t f = 0; f < fallbacks; ++f) s.order[kept++] = static_cast<std::uint32_t>(s.fallback[f] - begin);
   run_generic(shapes, batch, options, isa, begin, kept, s, out);

@@ -17,6 +17,10 @@ namespace batchcol::kernels::simd {
                             const ClosedFormQuery&, const ResultView&, std::uint32_t*);                          \
   std::size_t box_pairs_boolean(const PairView&, const std::uint32_t*, std::size_t, const ResultView&,             \
                                 std::uint32_t*);                                                                 \
+  std::size_t gjk_pairs_double(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,           \
+                               const QueryOptions&, const ResultView&, std::uint32_t*);                            \
+  std::size_t gjk_pairs_float(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,            \
+                              const QueryOptions&, const ResultView&, std::uint32_t*);                             \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -82,6 +86,28 @@ std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std:
     case InstructionSet::avx512: return avx512::box_pairs_boolean(in, pairs, n, out, fallback);
     case InstructionSet::avx2: return avx2::box_pairs_boolean(in, pairs, n, out, fallback);
     default: return scalar::box_pairs_boolean(in, pairs, n, out, fallback);
+  }
+}
+
+template <>
+std::size_t gjk_pairs<double>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
+                              const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
+                              const ResultView& out, std::uint32_t* fallback) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+  }
+}
+
+template <>
+std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
+                             const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
+                             const ResultView& out, std::uint32_t* fallback) {
+  switch (isa) {
+    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
   }
 }
 

@@ -8,6 +8,7 @@ namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 #include "kernels/simd/wide_pairs.inl"
 #include "kernels/simd/wide_segments.inl"
 #include "kernels/simd/wide_boxes.inl"
+#include "kernels/simd/wide_gjk_pairs.inl"
 
 void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
                       bool points) {
@@ -16,6 +17,15 @@ void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<
 void gjk_lanes_float(const PairSetup<float>* setups, std::size_t n, GjkResult<float>* out, Solver solver,
                      bool points) {
   WideGjk<float>::run(setups, n, out, solver, points);
+}
+
+std::size_t gjk_pairs_double(const PairView& in, ShapeType a, ShapeType b, const std::uint32_t* pairs, std::size_t n,
+                             const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
+  return WideGjkPairs<double>::run(in, a, b, pairs, n, options, out, fallback);
+}
+std::size_t gjk_pairs_float(const PairView& in, ShapeType a, ShapeType b, const std::uint32_t* pairs, std::size_t n,
+                            const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
+  return WideGjkPairs<float>::run(in, a, b, pairs, n, options, out, fallback);
 }
 
 std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, const std::uint32_t* pairs,

@@ -21,6 +21,7 @@ struct PairView {
   const double* shape_inflation = nullptr;  // Shape::inflation of shape 0
   std::size_t shape_stride = 0;
   std::uint32_t shape_count = 0;
+  const ShapeTable::KernelFacts* shape_facts = nullptr;  // by shape index
 
   static PairView of(const ShapeTable& shapes, const PairBatch& batch) {
     PairView v;
@@ -36,6 +37,7 @@ struct PairView {
     }
     v.shape_count = static_cast<std::uint32_t>(shapes.size());
     v.shape_stride = sizeof(Shape);
+    v.shape_facts = shapes.kernel_facts().data();
     if (shapes.size() > 0) {
       v.shape_size = shapes[0].size.data();
       v.shape_inflation = &shapes[0].inflation;

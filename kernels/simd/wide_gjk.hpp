@@ -4,6 +4,7 @@
 
 #include "batchcol/batch.hpp"
 #include "kernels/narrowphase.hpp"
+#include "kernels/simd/pair_views.hpp"
 
 #include <cstddef>
 
@@ -28,5 +29,22 @@ template <>
 void gjk_lanes<double>(InstructionSet, const PairSetup<double>*, std::size_t, GjkResult<double>*, Solver, bool);
 template <>
 void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);
+
+/// GJK pairs of one shape-pair type (A of type_a, B of type_b) straight from the batch arrays into the result
+/// arrays: pose validation, B's pose in A's frame, setup, GJK, completion and the world-frame output, with the
+/// executor's scalar path's bits. Preconditions: neither type is triangle or halfspace, no closed form applies to
+/// the type pair under `options`, options.level < penetration, no warm start; pairs[0 .. n) ascending. Returns how
+/// many pairs it left to the scalar path (invalid input, a float stall redone in double), listed in
+/// fallback[0 .. count) (room for n); every field of the others is written.
+template <class T>
+std::size_t gjk_pairs(InstructionSet isa, const PairView& in, ShapeType type_a, ShapeType type_b,
+                      const std::uint32_t* pairs, std::size_t n, const QueryOptions& options, const ResultView& out,
+                      std::uint32_t* fallback);
+template <>
+std::size_t gjk_pairs<double>(InstructionSet, const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,
+                              const QueryOptions&, const ResultView&, std::uint32_t*);
+template <>
+std::size_t gjk_pairs<float>(InstructionSet, const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,
+                             const QueryOptions&, const ResultView&, std::uint32_t*);
 
 }  // namespace batchcol::kernels::simd

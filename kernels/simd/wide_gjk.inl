@@ -487,17 +487,37 @@ template <class T> struct WideGjk {
     Lanes L;
     L.A.type = setups[0].A.type;
     L.B.type = setups[0].B.type;
+    SetupSource source{setups, n, out, solver, points};
+    drive(L, source, solver, points);
+  }
+
+  /// Feeds the lanes from an array of setups; each lane's GjkResult goes to out[its index].
+  struct SetupSource {
+    const PairSetup<T>* setups;
+    std::size_t n;
+    GjkResult<T>* out;
+    Solver solver;
+    bool points;
     std::size_t next = 0;
-    for (int l = 0; l < W; ++l) {
-      if (next < n) refill(L, l, setups[next], std::int64_t(next), solver), ++next;
-      else L.pair[l] = -1;
+    bool load(Lanes& L, int l) {
+      if (next >= n) return false;
+      refill(L, l, setups[next], std::int64_t(next), solver);
+      ++next;
+      return true;
     }
+    void done(const Lanes& L, int l, GjkStatus status) { finish(L, l, status, out[L.pair[l]], points); }
+  };
+
+  /// The lanes' loop. `source.load(L, l)` starts the next pair in lane l (false when none is left);
+  /// `source.done(L, l, status)` takes lane l's finished pair. L's shape types must be set.
+  template <class Source> static void drive(Lanes& L, Source& source, Solver solver, bool points) {
+    for (int l = 0; l < W; ++l)
+      if (!source.load(L, l)) L.pair[l] = -1;
     const real zero = splat(T(0)), one = splat(T(1));
-    // Finishes lane l with `status` and refills it (or empties it). Returns the lane bit if it became empty.
+    // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
-      finish(L, l, status, out[L.pair[l]], points);
-      if (next < n) refill(L, l, setups[next], std::int64_t(next), solver), ++next;
-      else L.pair[l] = -1;
+      source.done(L, l, status);
+      if (!source.load(L, l)) L.pair[l] = -1;
     };
     const auto active_bits = [&] {
       std::uint32_t bits = 0;

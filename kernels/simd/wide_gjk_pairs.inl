@@ -1,0 +1,206 @@
+// GJK pairs straight from the batch arrays: the executor's per-pair work (pose validation, B's pose in A's frame,
+// the setup, completion, the world-frame output) done without a PairSetup per pair. Poses are validated and the
+// relative poses computed W pairs per register in double (PairLanes), a chunk at a time; each lane then takes its
+// pair's shapes and parameters from those arrays when it is refilled, runs WideGjk's loop, and writes its answer
+// into the result arrays. Every operation repeats the executor's scalar path (prepare_pair, setup_pair_into,
+// complete_pair, write_output) in the same order, so the results are the same bits (tested in
+// tests/kernels/wide_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone in double) go
+// back to that path.
+//
+// No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl and wide_pairs.inl.
+
+template <class T> struct WideGjkPairs {
+  using G = WideGjk<T>;
+  using Lanes = typename G::Lanes;
+  using P = PairLanes;
+  static constexpr int W = G::W;
+  static constexpr int Wd = P::W;
+  /// Pairs whose relative poses are computed ahead of the lanes: a few KB, in L1.
+  static constexpr std::size_t kChunk = 64;
+
+  /// Valid pairs of the current chunk, in double: B's pose in A's frame and A's world pose (row-major).
+  struct Chunk {
+    double R[9][kChunk], t[3][kChunk], Ra[9][kChunk], ta[3][kChunk];
+    std::uint32_t pair[kChunk], shape_a[kChunk], shape_b[kChunk];
+    std::size_t count = 0;
+  };
+
+  /// What a lane keeps of its pair until it finishes: where the answer goes and how it is completed.
+  struct LanePair {
+    std::uint32_t pair = 0;
+    double Ra[9], ta[3];
+    GjkCompletion<T> completion;
+  };
+
+  struct Source {
+    const PairView& in;
+    const QueryOptions& options;
+    ShapeType type_a, type_b;
+    const std::uint32_t* pairs;
+    std::size_t n;
+    const ResultView& out;
+    std::uint32_t* fallback;
+    std::size_t fallbacks = 0;
+    std::size_t read = 0;  // pairs[0 .. read) went through the pose stage
+    std::size_t next = 0;  // chunk slot the next load takes
+    Chunk chunk;
+    LanePair lane[W];
+    PairSetup<T> setup;  // refill()'s input, rebuilt per load
+
+    /// Validates the next kChunk pairs and computes their poses, W per register (prepare_pair's rule and
+    /// arithmetic); invalid ones go to the fallback.
+    void fill_chunk() {
+      chunk.count = 0;
+      next = 0;
+      const std::size_t end = std::min(n, read + kChunk);
+      for (std::size_t k = read; k < end; k += Wd) {
+        const auto b = P::block(pairs + read, end - read, k - read);
+        const P::Pose pa = load(b, true), pb = load(b, false);
+        P::Pose qa = pa, qb = pb;
+        P::normalize(qa);
+        P::normalize(qb);
+        const P::V3 ca[3] = {P::column(qa, 0), P::column(qa, 1), P::column(qa, 2)};
+        const P::V3 cb[3] = {P::column(qb, 0), P::column(qb, 1), P::column(qb, 2)};
+        const P::V3 d = P::sub(pb.t, pa.t);
+        typename P::real R[9], t[3];
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) R[3 * i + j] = P::dot(ca[i], cb[j]);
+          t[i] = P::dot(ca[i], d);
+        }
+        const std::uint32_t valid = lane_bits(pa.valid & pb.valid);
+        for (int l = 0; l < b.lanes; ++l) {
+          const std::uint32_t i = b.idx[l];
+          if (!(valid >> l & 1u)) {
+            fallback[fallbacks++] = i;
+            continue;
+          }
+          const std::size_t s = chunk.count++;
+          chunk.pair[s] = i;
+          chunk.shape_a[s] = in.shape_a[i];
+          chunk.shape_b[s] = in.shape_b[i];
+          for (int e = 0; e < 9; ++e) chunk.R[e][s] = R[e][l];
+          chunk.ta[0][s] = pa.t.x[l], chunk.ta[1][s] = pa.t.y[l], chunk.ta[2][s] = pa.t.z[l];
+          for (int c = 0; c < 3; ++c) {
+            chunk.t[c][s] = t[c][l];
+            const P::V3& col = ca[c];  // column c of Ra: entries (0, c), (1, c), (2, c)
+            chunk.Ra[c][s] = col.x[l], chunk.Ra[3 + c][s] = col.y[l], chunk.Ra[6 + c][s] = col.z[l];
+          }
+        }
+      }
+      read = end;
+    }
+    P::Pose load(const typename P::Block& b, bool side_a) const {
+      return P::load_pose(in, side_a ? in.shape_a : in.shape_b, side_a ? in.translation_a : in.translation_b,
+                          side_a ? in.rotation_a : in.rotation_b, b.idx, b.consecutive);
+    }
+
+    /// make_core(): the core of shape `index` of type `type`, in precision T.
+    void core(ShapeCore<T>& c, ShapeType type, std::uint32_t index) const {
+      const auto* bytes = reinterpret_cast<const unsigned char*>(in.shape_size) + std::size_t(index) * in.shape_stride;
+      const double* size = reinterpret_cast<const double*>(bytes);
+      const double inflation =
+          *reinterpret_cast<const double*>(reinterpret_cast<const unsigned char*>(in.shape_inflation) +
+                                           std::size_t(index) * in.shape_stride);
+      c.type = type;
+      c.radius = T(inflation);
+      c.size = Vec3<T>::Zero();
+      c.hull = nullptr;
+      switch (type) {
+        case ShapeType::sphere: c.radius += T(size[0]); break;
+        case ShapeType::capsule:
+          c.radius += T(size[0]);
+          c.size = Vec3<T>(T(0), T(size[1]), T(0));
+          break;
+        case ShapeType::convex: c.hull = in.shape_facts[index].hull; break;
+        default: c.size = Vec3<T>(T(size[0]), T(size[1]), T(size[2])); break;
+      }
+    }
+    static Vec3<T> center(const ShapeCore<T>& c) {
+      return c.type == ShapeType::convex ? Vec3<T>(c.hull->centroid.template cast<T>()) : Vec3<T>::Zero();
+    }
+
+    /// setup_pair_into() for a pair without closed form or warm start, then WideGjk's refill.
+    bool load(Lanes& L, int l) {
+      while (next == chunk.count) {
+        if (read == n) return false;
+        fill_chunk();
+      }
+      const std::size_t s = next++;
+      PairSetup<T>& q = setup;
+      core(q.A, type_a, chunk.shape_a[s]);
+      core(q.B, type_b, chunk.shape_b[s]);
+      Vec3<double> t(chunk.t[0][s], chunk.t[1][s], chunk.t[2][s]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) q.X.R(i, j) = T(chunk.R[3 * i + j][s]);
+      q.X.t = t.template cast<T>();
+      q.radii = q.A.radius + q.B.radius;
+      q.scale = T(in.shape_facts[chunk.shape_a[s]].bounding_radius + in.shape_facts[chunk.shape_b[s]].bounding_radius +
+                  norm3(t));
+      q.floor = tolerance_floor(q.scale);
+      GjkParams<T>& p = q.params;
+      p.solver = options.solver;
+      p.tolerance = std::max(T(options.tolerance), q.floor);
+      p.relative_tolerance = T(options.relative_tolerance);
+      p.max_iterations = options.max_iterations;
+      p.boolean_only = options.level == QueryLevel::boolean;
+      p.core_margin = T(options.margin) + q.radii;
+      p.normalize_momentum = !(q.A.strictly_convex() && q.B.strictly_convex());
+      p.touch_tolerance = q.floor;
+      q.initial_direction = center(q.A) - q.X.apply(center(q.B));
+      G::refill(L, l, q, std::int64_t(s), options.solver);
+
+      LanePair& lp = lane[l];
+      lp.pair = chunk.pair[s];
+      for (int e = 0; e < 9; ++e) lp.Ra[e] = chunk.Ra[e][s];
+      for (int c = 0; c < 3; ++c) lp.ta[c] = chunk.ta[c][s];
+      lp.completion = {q.A.radius, q.B.radius, q.radii, q.scale, q.floor, p.tolerance, p.core_margin};
+      return true;
+    }
+
+    /// complete_pair() and write_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
+    /// the fallback (computed again on the scalar path).
+    void done(const Lanes& L, int l, GjkStatus status) {
+      const bool points = options.level >= QueryLevel::witness;
+      GjkResult<T> g;
+      G::finish(L, l, status, g, points);
+      const LanePair& lp = lane[l];
+      PairOutput<T> r;
+      if (!complete_from_gjk(lp.completion, g, options, r)) {
+        fallback[fallbacks++] = lp.pair;
+        return;
+      }
+      const std::uint32_t i = lp.pair;
+      out.status[i] = r.status;
+      out.collide[i] = r.collide ? 1 : 0;
+      out.distance[i] = double(r.distance);
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      const auto rotate = [&](const Vec3<T>& v, double* const* dst, bool translate) {
+        const double x = double(v.x()), y = double(v.y()), z = double(v.z());
+        for (int c = 0; c < 3; ++c) {
+          const double w = (lp.Ra[3 * c] * x + lp.Ra[3 * c + 1] * y) + lp.Ra[3 * c + 2] * z;
+          dst[c][i] = translate ? w + lp.ta[c] : w;
+        }
+      };
+      if (points) {
+        rotate(r.witness_a, out.witness_a, true);
+        rotate(r.witness_b, out.witness_b, true);
+        rotate(r.normal, out.normal, false);
+      } else {
+        for (int c = 0; c < 3; ++c) out.witness_a[c][i] = out.witness_b[c][i] = out.normal[c][i] = nan;
+      }
+      rotate(r.direction, out.direction, false);
+      out.iterations[i] = r.iterations;
+    }
+  };
+
+  static std::size_t run(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                         std::size_t n, const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
+    if (n == 0) return 0;
+    Lanes L;
+    L.A.type = type_a;
+    L.B.type = type_b;
+    Source source{in, options, type_a, type_b, pairs, n, out, fallback};
+    G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
+    return source.fallbacks;
+  }
+};
