@@ -109,21 +109,8 @@ void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a,
   }
 
   // GJK on the cores; the swept radii are added afterwards.
-  s.radii = A.radius + B.radius;
-  s.scale = T(a.bounding_radius() + b.bounding_radius() + norm3(b_in_a.t));
-  s.floor = tolerance_floor(s.scale);
-  GjkParams<T>& params = s.params;
-  params.solver = opt.solver;
-  params.tolerance = std::max(T(opt.tolerance), s.floor);
-  params.relative_tolerance = T(opt.relative_tolerance);
-  params.max_iterations = opt.max_iterations;
-  params.boolean_only = opt.level == QueryLevel::boolean;
-  params.core_margin = T(opt.margin) + s.radii;
-  params.normalize_momentum = !(A.strictly_convex() && B.strictly_convex());
-  params.touch_tolerance = s.floor;  // 16 ulps of the problem size
-  const Vec3<T> warm = warm_direction.cast<T>();
-  const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
-  s.initial_direction = use_warm ? warm : s.difference().center();
+  set_gjk_parameters(s, a.bounding_radius(), b.bounding_radius(), norm3(b_in_a.t), Vec3<T>(warm_direction.cast<T>()),
+                     opt);
 }
 
 template <class T>

@@ -64,6 +64,28 @@ PairOutput<T> complete_pair(const PairSetup<T>& setup, const GjkResult<T>& gjk, 
 /// tolerance is raised to this floor, since support values and |x| are only known to a few ulps of the scale.
 template <class T> T tolerance_floor(T scale) { return T(16) * machine_epsilon<T>() * scale; }
 
+/// The rest of a GJK setup once its cores and relative pose X are set: swept radii, scale (bounding radii of A
+/// and B plus |t|, in double), precision floor, parameters and first direction (`warm` when finite and non-zero,
+/// else the centre difference). Shared by setup_pair_into() and the batch-array GJK (simd/wide_gjk_pairs.inl).
+template <class T>
+void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, double t_norm,
+                        const Vec3<T>& warm, const QueryOptions& opt) {
+  s.radii = s.A.radius + s.B.radius;
+  s.scale = T(bounding_a + bounding_b + t_norm);
+  s.floor = tolerance_floor(s.scale);
+  GjkParams<T>& params = s.params;
+  params.solver = opt.solver;
+  params.tolerance = std::max(T(opt.tolerance), s.floor);
+  params.relative_tolerance = T(opt.relative_tolerance);
+  params.max_iterations = opt.max_iterations;
+  params.boolean_only = opt.level == QueryLevel::boolean;
+  params.core_margin = T(opt.margin) + s.radii;
+  params.normalize_momentum = !(s.A.strictly_convex() && s.B.strictly_convex());
+  params.touch_tolerance = s.floor;  // 16 ulps of the problem size
+  const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
+  s.initial_direction = use_warm ? warm : s.difference().center();
+}
+
 extern template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const RelativePose&,
                                                       const Eigen::Vector3d&, const QueryOptions&);
 extern template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,

@@ -46,6 +46,7 @@ template <class T> struct WideGjkPairs {
     Chunk chunk;
     LanePair lane[W];
     PairSetup<T> setup;  // refill()'s input, rebuilt per load
+    const Vec3<T> no_warm = Vec3<T>::Constant(std::numeric_limits<T>::quiet_NaN());
 
     /// Validates the next kChunk pairs and computes their poses, W per register (prepare_pair's rule and
     /// arithmetic); invalid ones go to the fallback.
@@ -115,9 +116,6 @@ template <class T> struct WideGjkPairs {
         default: c.size = Vec3<T>(T(size[0]), T(size[1]), T(size[2])); break;
       }
     }
-    static Vec3<T> center(const ShapeCore<T>& c) {
-      return c.type == ShapeType::convex ? Vec3<T>(c.hull->centroid.template cast<T>()) : Vec3<T>::Zero();
-    }
 
     /// setup_pair_into() for a pair without closed form or warm start, then WideGjk's refill.
     bool load(Lanes& L, int l) {
@@ -133,27 +131,15 @@ template <class T> struct WideGjkPairs {
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) q.X.R(i, j) = T(chunk.R[3 * i + j][s]);
       q.X.t = t.template cast<T>();
-      q.radii = q.A.radius + q.B.radius;
-      q.scale = T(in.shape_facts[chunk.shape_a[s]].bounding_radius + in.shape_facts[chunk.shape_b[s]].bounding_radius +
-                  norm3(t));
-      q.floor = tolerance_floor(q.scale);
-      GjkParams<T>& p = q.params;
-      p.solver = options.solver;
-      p.tolerance = std::max(T(options.tolerance), q.floor);
-      p.relative_tolerance = T(options.relative_tolerance);
-      p.max_iterations = options.max_iterations;
-      p.boolean_only = options.level == QueryLevel::boolean;
-      p.core_margin = T(options.margin) + q.radii;
-      p.normalize_momentum = !(q.A.strictly_convex() && q.B.strictly_convex());
-      p.touch_tolerance = q.floor;
-      q.initial_direction = center(q.A) - q.X.apply(center(q.B));
+      set_gjk_parameters(q, in.shape_facts[chunk.shape_a[s]].bounding_radius,
+                         in.shape_facts[chunk.shape_b[s]].bounding_radius, norm3(t), no_warm, options);
       G::refill(L, l, q, std::int64_t(s), options.solver);
 
       LanePair& lp = lane[l];
       lp.pair = chunk.pair[s];
       for (int e = 0; e < 9; ++e) lp.Ra[e] = chunk.Ra[e][s];
       for (int c = 0; c < 3; ++c) lp.ta[c] = chunk.ta[c][s];
-      lp.completion = {q.A.radius, q.B.radius, q.radii, q.scale, q.floor, p.tolerance, p.core_margin};
+      lp.completion = {q.A.radius, q.B.radius, q.radii, q.scale, q.floor, q.params.tolerance, q.params.core_margin};
       return true;
     }
 
