@@ -26,8 +26,9 @@ struct WideSegments : PairLanes {
   };
 
   template <bool Capsule>
-  static Side load_side(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
-                        const double* const q[4], const Block& b) {
+  __attribute__((always_inline)) static Side load_side(const PairView& in, const std::uint32_t* shape_index,
+                                                       const double* const t[3], const double* const q[4],
+                                                       const Block& b) {
     Pose p = load_pose(in, shape_index, t, q, b.idx, b.consecutive);
     Side s;
     s.valid = p.valid;
