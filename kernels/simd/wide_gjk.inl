@@ -7,6 +7,11 @@
 //
 // No include guard: included once per instruction set by isa_*.cpp after wide.hpp, inside the ISA namespace.
 
+// AI: always inline. The loop's small helpers must stay inside it; GCC's own heuristics outline some of them
+// depending on how many callers the loop has (measured: +600 instructions per cylinder pair when drive() gained a
+// second instantiation).
+#define AI __attribute__((always_inline))
+
 template <class T> struct WideGjk {
   using real = wreal<T>;
   using mask = wmask<T>;
@@ -171,7 +176,7 @@ template <class T> struct WideGjk {
     real lambda[4];
     mask contains;
   };
-  static Proj pick(mask m, const Proj& a, const Proj& b) {
+  AI static Proj pick(mask m, const Proj& a, const Proj& b) {
     Proj r;
     r.x = pick(m, a.x, b.x);
     r.count = select(m, a.count, b.count);
@@ -206,12 +211,12 @@ template <class T> struct WideGjk {
     real u;
     mask kind, i, j;
   };
-  static Edge pick(mask m, const Edge& a, const Edge& b) {
+  AI static Edge pick(mask m, const Edge& a, const Edge& b) {
     return {pick(m, a.x, b.x), select(m, a.u, b.u), select(m, a.kind, b.kind), select(m, a.i, b.i), select(m, a.j, b.j)};
   }
-  static Edge closer(const Edge& a, const Edge& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
+  AI static Edge closer(const Edge& a, const Edge& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
   /// The segment from qi to qj (input indices i, j in each lane): the reference's segment(), same operations.
-  static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
+  AI static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
     const V3 t = sub(qj, qi);
     const real tt = norm2(t);
     const real u = (-dot(qi, t)) / tt;
@@ -220,7 +225,7 @@ template <class T> struct WideGjk {
     const V3 inner = add(scale(one - u, qi), scale(u, qj));
     return {pick(at_i, qi, pick(at_j, qj, inner)), u, select(at_i, splat_mask(0), select(at_j, splat_mask(1), splat_mask(2))), i, j};
   }
-  static Proj to_proj(const Edge& e) {
+  AI static Proj to_proj(const Edge& e) {
     const mask inner = e.kind == splat_mask(2), at_j = e.kind == splat_mask(1);
     const real zero = splat(T(0)), one = splat(T(1));
     Proj r = empty();
@@ -451,7 +456,7 @@ template <class T> struct WideGjk {
   }
 
   /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp).
-  static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
+  AI static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
     a = support(L.A, dir, live);
     const V3 m = neg(dir);
     const real* R = L.R;
@@ -651,3 +656,5 @@ template <class T> struct WideGjk {
     }
   }
 };
+
+#undef AI
