@@ -129,10 +129,14 @@ double Shape::bounding_radius() const {
 
 std::uint32_t ShapeTable::add(Shape shape) {
   if (shapes_.size() >= std::numeric_limits<std::uint32_t>::max()) throw InputError("shape table is full");
-  facts_.reserve(shapes_.size() + 1);  // both vectors grow together or not at all
   shapes_.push_back(std::move(shape));
   const Shape& added = shapes_.back();
-  facts_.push_back({added.bounding_radius(), added.hull.get()});
+  try {
+    facts_.push_back({added.bounding_radius(), added.hull.get()});
+  } catch (...) {
+    shapes_.pop_back();  // both vectors grow together or not at all
+    throw;
+  }
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

@@ -4,7 +4,7 @@
 // pair's shapes and parameters from those arrays when it is refilled, runs WideGjk's loop, and writes its answer
 // into the result arrays. Every operation repeats the executor's scalar path (prepare_pair, setup_pair_into,
 // complete_pair, write_output) in the same order, so the results are the same bits (tested in
-// tests/kernels/wide_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone in double) go
+// tests/engine/executor_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone in double) go
 // back to that path.
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl and wide_pairs.inl.

@@ -1,4 +1,5 @@
-// Lane helpers shared by the SIMD closed forms (wide_segments.inl, wide_boxes.inl): 3-vectors of lanes, loads and
+// Lane helpers shared by the SIMD closed forms (wide_segments.inl, wide_boxes.inl) and the batch-array GJK
+// (wide_gjk_pairs.inl): 3-vectors of lanes, loads and
 // stores at pair indices, shape fields through the ShapeTable's stride, and world poses with the executor's
 // validity rule.
 //
@@ -45,9 +46,9 @@ struct PairLanes {
   }
 
   /// One side of W pairs: the world pose (q as given, with its norm) and the byte offset of the shape in the
-  /// ShapeTable. `valid`: the executor's rule (batchcol::is_unit_quaternion): q finite with | |q| - 1 | <=
-  /// kUnitTolerance (NaN and infinite components fail both comparisons), t finite, shape index in range
-  /// (out-of-range lanes read shape 0).
+  /// ShapeTable. `valid`: the executor's rule (detail::normalize_unit_quaternion in engine/src/validate.hpp, with
+  /// the same norm): q finite with | |q| - 1 | <= kUnitTolerance (NaN and infinite components fail both
+  /// comparisons), t finite, shape index in range (out-of-range lanes read shape 0).
   struct Pose {
     V3 t;
     real w, x, y, z, norm;
