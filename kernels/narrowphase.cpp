@@ -42,6 +42,19 @@ bool closed_form(const ShapeCore<T>& A, const ShapeCore<T>& B, const Transform<T
   return false;
 }
 
+}  // namespace
+
+bool may_have_closed_form(ShapeType a, ShapeType b, const QueryOptions& opt) {
+  if (a == ShapeType::halfspace || b == ShapeType::halfspace) return true;
+  if (!opt.closed_forms) return false;
+  const auto either = [&](ShapeType x, ShapeType y) { return (a == x && b == y) || (a == y && b == x); };
+  if (is_point_or_segment(a) && is_point_or_segment(b)) return true;
+  if (either(ShapeType::sphere, ShapeType::box)) return true;
+  return either(ShapeType::box, ShapeType::box) && opt.level == QueryLevel::boolean && opt.margin == 0.0;
+}
+
+namespace {
+
 /// Keeps only what the query level asked for (the rest is NaN) and sets `collide`.
 template <class T> void finish(PairOutput<T>& o, const QueryOptions& opt, bool known_collide, bool collide) {
   o.collide = known_collide ? collide : (o.distance <= T(opt.margin));

@@ -42,6 +42,10 @@ PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in
 template <class T>
 void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a, const Eigen::Vector3d& warm_direction,
                      const QueryOptions& options, PairSetup<T>& s);
+/// Whether setup_pair_into() may answer a pair of types (a, b) by a closed form under `options` (closed_form()
+/// beside it, and the box-box separating-axis test, which also needs plain boxes). Pairs of other type pairs
+/// always run GJK.
+bool may_have_closed_form(ShapeType a, ShapeType b, const QueryOptions& options);
 /// What completing a pair needs of its setup when GJK's ending needs no cores (see complete_from_gjk).
 template <class T> struct GjkCompletion {
   T radius_a = T(0), radius_b = T(0);  // swept radii of A and B

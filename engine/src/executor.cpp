@@ -78,22 +78,13 @@ WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) 
 }
 
 /// Whether a group's pairs run through the SIMD GJK straight from the batch arrays (kernels::simd::gjk_pairs):
-/// below QueryLevel::penetration (EPA stays per pair), without warm start, and for type pairs that have no
-/// closed form in setup_pair_into() (closed_form(): halfspaces, sphere/capsule pairs, sphere-box; the box-box
-/// separating-axis test). Triangles keep the per-pair path.
+/// below QueryLevel::penetration (EPA stays per pair), without warm start, for types other than triangle and
+/// halfspace, when setup_pair_into() has no closed form for the type pair.
 bool wide_gjk_group(std::size_t group, const QueryOptions& options, const PairBatch& batch) {
   if (options.level >= QueryLevel::penetration || !batch.warm_start.empty()) return false;
   const ShapeType a = type_a(group), b = type_b(group);
   const auto plain = [](ShapeType t) { return t != ShapeType::triangle && t != ShapeType::halfspace; };
-  if (!plain(a) || !plain(b)) return false;
-  if (!options.closed_forms) return true;
-  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
-  const auto either = [&](ShapeType x, ShapeType y) { return (a == x && b == y) || (a == y && b == x); };
-  if (segment(a) && segment(b)) return false;
-  if (either(ShapeType::sphere, ShapeType::box)) return false;
-  if (either(ShapeType::box, ShapeType::box) && options.level == QueryLevel::boolean && options.margin == 0.0)
-    return false;
-  return true;
+  return plain(a) && plain(b) && !kernels::may_have_closed_form(a, b, options);
 }
 
 /// World frame of shape A for one pair: outputs are computed in A's frame and mapped back with it.
@@ -118,21 +109,6 @@ template <class T> struct ChunkScratch {
   std::vector<std::uint32_t> group_pairs;  // one group's batch indices
   std::vector<std::uint32_t> fallback;     // pairs the SIMD closed forms left to the scalar path
 };
-
-template <class T>
-void write_output(const kernels::PairOutput<T>& r, const PairFrame& f, std::size_t i, QueryLevel level,
-                  PairResults& out) {
-  out.status[i] = r.status;
-  out.collide[i] = r.collide ? 1 : 0;
-  out.distance[i] = static_cast<double>(r.distance);
-  if (level >= QueryLevel::witness) {  // below, these stay NaN (fill_pair_defaults) and cost 3 rotations
-    out.witness_a.set(i, kernels::mul<double>(f.Ra, r.witness_a.template cast<double>()) + f.ta);
-    out.witness_b.set(i, kernels::mul<double>(f.Ra, r.witness_b.template cast<double>()) + f.ta);
-    out.normal.set(i, kernels::mul<double>(f.Ra, r.normal.template cast<double>()));
-  }
-  out.direction.set(i, kernels::mul<double>(f.Ra, r.direction.template cast<double>()));
-  out.iterations[i] = r.iterations;
-}
 
 /// Validates pair i, computes B's pose in A's frame (double) and the setup. Returns false for an invalid pair
 /// (status invalid_input written; everything else stays NaN / 0 from fill_pair_defaults). The pose arithmetic is
@@ -194,6 +170,7 @@ template <class T>
 void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
                  std::size_t begin, std::size_t count, ChunkScratch<T>& s, PairResults& out) {
   if (count == 0) return;
+  const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
   s.setups.resize(kChunkPairs);
   s.gjk.resize(kChunkPairs);
   s.frames.resize(kChunkPairs);
@@ -204,8 +181,8 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
     kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver,
                                 options.level >= QueryLevel::witness);
     for (std::size_t j = 0; j < pending; ++j)
-      write_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j], s.pairs[j], options.level,
-                   out);
+      kernels::simd::write_pair_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j].Ra,
+                                       s.frames[j].ta, s.pairs[j], options.level, results);
     pending = 0;
   };
   for (std::size_t n = 0; n < count; ++n) {
@@ -220,7 +197,7 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
     kernels::PairSetup<T>& setup = s.setups[pending];
     if (!prepare_pair(shapes, batch, options, i, frame, setup, out)) continue;
     if (setup.done) {
-      write_output(setup.out, frame, i, options.level, out);
+      kernels::simd::write_pair_output(setup.out, frame.Ra, frame.ta, i, options.level, results);
       continue;
     }
     // A chunk holds one shape-pair type (the kernels branch on the type once per chunk, not per lane).

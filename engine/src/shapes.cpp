@@ -123,20 +123,14 @@ double Shape::bounding_radius() const {
     case ShapeType::halfspace: return std::numeric_limits<double>::infinity();
   }
   const bool squares = type == ShapeType::box || type == ShapeType::cylinder || type == ShapeType::cone;
-  if (squares && !std::isfinite(core)) core = std::hypot(std::hypot(size.x(), size.y()), type == ShapeType::box ? size.z() : 0.0);
+  if (squares && !std::isfinite(core))
+    core = std::hypot(std::hypot(size.x(), size.y()), type == ShapeType::box ? size.z() : 0.0);
   return core + inflation;
 }
 
 std::uint32_t ShapeTable::add(Shape shape) {
   if (shapes_.size() >= std::numeric_limits<std::uint32_t>::max()) throw InputError("shape table is full");
   shapes_.push_back(std::move(shape));
-  const Shape& added = shapes_.back();
-  try {
-    facts_.push_back({added.bounding_radius(), added.hull.get()});
-  } catch (...) {
-    shapes_.pop_back();  // both vectors grow together or not at all
-    throw;
-  }
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

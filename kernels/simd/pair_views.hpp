@@ -3,9 +3,11 @@
 #pragma once
 
 #include "batchcol/batch.hpp"
+#include "kernels/pair_output.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 namespace batchcol::kernels::simd {
 
@@ -21,7 +23,7 @@ struct PairView {
   const double* shape_inflation = nullptr;  // Shape::inflation of shape 0
   std::size_t shape_stride = 0;
   std::uint32_t shape_count = 0;
-  const ShapeTable::KernelFacts* shape_facts = nullptr;  // by shape index
+  const Shape* shapes = nullptr;  // the table itself, for the per-lane setup of the batch-array GJK
 
   static PairView of(const ShapeTable& shapes, const PairBatch& batch) {
     PairView v;
@@ -37,7 +39,7 @@ struct PairView {
     }
     v.shape_count = static_cast<std::uint32_t>(shapes.size());
     v.shape_stride = sizeof(Shape);
-    v.shape_facts = shapes.kernel_facts().data();
+    v.shapes = shapes.shapes().data();
     if (shapes.size() > 0) {
       v.shape_size = shapes[0].size.data();
       v.shape_inflation = &shapes[0].inflation;
@@ -68,6 +70,30 @@ struct ResultView {
     return v;
   }
 };
+
+/// Writes pair i's answer, computed in A's frame, to the result arrays in the world frame (A's rotation Ra and
+/// translation ta): the executor's per-pair path and the batch-array GJK both write through this.
+/// Witness points and normal are NaN below QueryLevel::witness.
+template <class T>
+void write_pair_output(const PairOutput<T>& r, const Eigen::Matrix3d& Ra, const Eigen::Vector3d& ta, std::size_t i,
+                       QueryLevel level, const ResultView& out) {
+  out.status[i] = r.status;
+  out.collide[i] = r.collide ? 1 : 0;
+  out.distance[i] = static_cast<double>(r.distance);
+  const auto put = [&](double* const* dst, const Eigen::Vector3d& v) {
+    for (int c = 0; c < 3; ++c) dst[c][i] = v[c];
+  };
+  if (level >= QueryLevel::witness) {
+    put(out.witness_a, mul<double>(Ra, r.witness_a.template cast<double>()) + ta);
+    put(out.witness_b, mul<double>(Ra, r.witness_b.template cast<double>()) + ta);
+    put(out.normal, mul<double>(Ra, r.normal.template cast<double>()));
+  } else {
+    const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    put(out.witness_a, nan), put(out.witness_b, nan), put(out.normal, nan);
+  }
+  put(out.direction, mul<double>(Ra, r.direction.template cast<double>()));
+  out.iterations[i] = r.iterations;
+}
 
 /// What the closed forms need of QueryOptions.
 struct ClosedFormQuery {

@@ -28,7 +28,8 @@ template <class T> struct WideGjkPairs {
   /// What a lane keeps of its pair until it finishes: where the answer goes and how it is completed.
   struct LanePair {
     std::uint32_t pair = 0;
-    double Ra[9], ta[3];
+    Eigen::Matrix3d Ra;
+    Eigen::Vector3d ta;
     GjkCompletion<T> completion;
   };
 
@@ -56,12 +57,11 @@ template <class T> struct WideGjkPairs {
       const std::size_t end = std::min(n, read + kChunk);
       for (std::size_t k = read; k < end; k += Wd) {
         const auto b = P::block(pairs + read, end - read, k - read);
-        const P::Pose pa = load(b, true), pb = load(b, false);
-        P::Pose qa = pa, qb = pb;
-        P::normalize(qa);
-        P::normalize(qb);
-        const P::V3 ca[3] = {P::column(qa, 0), P::column(qa, 1), P::column(qa, 2)};
-        const P::V3 cb[3] = {P::column(qb, 0), P::column(qb, 1), P::column(qb, 2)};
+        P::Pose pa = load(b, true), pb = load(b, false);
+        P::normalize(pa);
+        P::normalize(pb);
+        const P::V3 ca[3] = {P::column(pa, 0), P::column(pa, 1), P::column(pa, 2)};
+        const P::V3 cb[3] = {P::column(pb, 0), P::column(pb, 1), P::column(pb, 2)};
         const P::V3 d = P::sub(pb.t, pa.t);
         typename P::real R[9], t[3];
         for (int i = 0; i < 3; ++i) {
@@ -95,28 +95,6 @@ template <class T> struct WideGjkPairs {
                           side_a ? in.rotation_a : in.rotation_b, b.idx, b.consecutive);
     }
 
-    /// make_core(): the core of shape `index` of type `type`, in precision T.
-    void core(ShapeCore<T>& c, ShapeType type, std::uint32_t index) const {
-      const auto* bytes = reinterpret_cast<const unsigned char*>(in.shape_size) + std::size_t(index) * in.shape_stride;
-      const double* size = reinterpret_cast<const double*>(bytes);
-      const double inflation =
-          *reinterpret_cast<const double*>(reinterpret_cast<const unsigned char*>(in.shape_inflation) +
-                                           std::size_t(index) * in.shape_stride);
-      c.type = type;
-      c.radius = T(inflation);
-      c.size = Vec3<T>::Zero();
-      c.hull = nullptr;
-      switch (type) {
-        case ShapeType::sphere: c.radius += T(size[0]); break;
-        case ShapeType::capsule:
-          c.radius += T(size[0]);
-          c.size = Vec3<T>(T(0), T(size[1]), T(0));
-          break;
-        case ShapeType::convex: c.hull = in.shape_facts[index].hull; break;
-        default: c.size = Vec3<T>(T(size[0]), T(size[1]), T(size[2])); break;
-      }
-    }
-
     /// setup_pair_into() for a pair without closed form or warm start, then WideGjk's refill.
     bool load(Lanes& L, int l) {
       while (next == chunk.count) {
@@ -125,20 +103,23 @@ template <class T> struct WideGjkPairs {
       }
       const std::size_t s = next++;
       PairSetup<T>& q = setup;
-      core(q.A, type_a, chunk.shape_a[s]);
-      core(q.B, type_b, chunk.shape_b[s]);
-      Vec3<double> t(chunk.t[0][s], chunk.t[1][s], chunk.t[2][s]);
+      const Shape& a = in.shapes[chunk.shape_a[s]];
+      const Shape& b = in.shapes[chunk.shape_b[s]];
+      q.A = make_core<T>(a);
+      q.B = make_core<T>(b);
+      const Vec3<double> t(chunk.t[0][s], chunk.t[1][s], chunk.t[2][s]);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) q.X.R(i, j) = T(chunk.R[3 * i + j][s]);
       q.X.t = t.template cast<T>();
-      set_gjk_parameters(q, in.shape_facts[chunk.shape_a[s]].bounding_radius,
-                         in.shape_facts[chunk.shape_b[s]].bounding_radius, norm3(t), no_warm, options);
+      set_gjk_parameters(q, a.bounding_radius(), b.bounding_radius(), norm3(t), no_warm, options);
       G::refill(L, l, q, std::int64_t(s), options.solver);
 
       LanePair& lp = lane[l];
       lp.pair = chunk.pair[s];
-      for (int e = 0; e < 9; ++e) lp.Ra[e] = chunk.Ra[e][s];
-      for (int c = 0; c < 3; ++c) lp.ta[c] = chunk.ta[c][s];
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) lp.Ra(i, j) = chunk.Ra[3 * i + j][s];
+        lp.ta[i] = chunk.ta[i][s];
+      }
       lp.completion = {q.A.radius, q.B.radius, q.radii, q.scale, q.floor, q.params.tolerance, q.params.core_margin};
       return true;
     }
@@ -146,36 +127,15 @@ template <class T> struct WideGjkPairs {
     /// complete_pair() and write_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
     /// the fallback (computed again on the scalar path).
     void done(const Lanes& L, int l, GjkStatus status) {
-      const bool points = options.level >= QueryLevel::witness;
       GjkResult<T> g;
-      G::finish(L, l, status, g, points);
+      G::finish(L, l, status, g, options.level >= QueryLevel::witness);
       const LanePair& lp = lane[l];
       PairOutput<T> r;
       if (!complete_from_gjk(lp.completion, g, options, r)) {
         fallback[fallbacks++] = lp.pair;
         return;
       }
-      const std::uint32_t i = lp.pair;
-      out.status[i] = r.status;
-      out.collide[i] = r.collide ? 1 : 0;
-      out.distance[i] = double(r.distance);
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      const auto rotate = [&](const Vec3<T>& v, double* const* dst, bool translate) {
-        const double x = double(v.x()), y = double(v.y()), z = double(v.z());
-        for (int c = 0; c < 3; ++c) {
-          const double w = (lp.Ra[3 * c] * x + lp.Ra[3 * c + 1] * y) + lp.Ra[3 * c + 2] * z;
-          dst[c][i] = translate ? w + lp.ta[c] : w;
-        }
-      };
-      if (points) {
-        rotate(r.witness_a, out.witness_a, true);
-        rotate(r.witness_b, out.witness_b, true);
-        rotate(r.normal, out.normal, false);
-      } else {
-        for (int c = 0; c < 3; ++c) out.witness_a[c][i] = out.witness_b[c][i] = out.normal[c][i] = nan;
-      }
-      rotate(r.direction, out.direction, false);
-      out.iterations[i] = r.iterations;
+      write_pair_output(r, lp.Ra, lp.ta, lp.pair, options.level, out);
     }
   };
 

@@ -83,22 +83,13 @@ Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const 
 /// Stores each shape once; pairs refer to shapes by index, so many instances of one mesh cost one mesh.
 class ShapeTable {
  public:
-  /// Numbers of shape i the SIMD kernels read by index (internal; kept in step with the shapes: the table only
-  /// grows and hands out const shapes).
-  struct KernelFacts {
-    double bounding_radius = 0.0;          // Shape::bounding_radius()
-    const ConvexHull* hull = nullptr;      // Shape::hull.get()
-  };
-
   std::uint32_t add(Shape shape);
   std::size_t size() const { return shapes_.size(); }
   const Shape& operator[](std::size_t i) const { return shapes_[i]; }
   const std::vector<Shape>& shapes() const { return shapes_; }
-  const std::vector<KernelFacts>& kernel_facts() const { return facts_; }
 
  private:
   std::vector<Shape> shapes_;
-  std::vector<KernelFacts> facts_;
 };
 
 }  // namespace batchcol
