@@ -1,5 +1,6 @@
-// Raw views of a PairBatch and of PairResults for the SIMD closed forms: plain pointers to the SoA component
-// arrays, so the per-instruction-set kernels see no std::vector or Eigen code (see isa_prelude.hpp).
+// Raw views of a PairBatch and of PairResults for the SIMD kernels: plain pointers to the SoA component arrays
+// (and to the shapes), so the per-instruction-set kernels index no std::vector; and the world-frame output writer
+// the executor and the batch-array GJK share. Included before any `#pragma GCC target` (see isa_prelude.hpp).
 #pragma once
 
 #include "batchcol/batch.hpp"

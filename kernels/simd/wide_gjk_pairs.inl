@@ -2,10 +2,10 @@
 // the setup, completion, the world-frame output) done without a PairSetup per pair. Poses are validated and the
 // relative poses computed W pairs per register in double (PairLanes), a chunk at a time; each lane then takes its
 // pair's shapes and parameters from those arrays when it is refilled, runs WideGjk's loop, and writes its answer
-// into the result arrays. Every operation repeats the executor's scalar path (prepare_pair, setup_pair_into,
-// complete_pair, write_output) in the same order, so the results are the same bits (tested in
-// tests/engine/executor_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone in double) go
-// back to that path.
+// into the result arrays. Every operation is the executor's scalar path's (prepare_pair's arithmetic, make_core,
+// set_gjk_parameters, complete_from_gjk, write_pair_output), in the same order, so the results are the same bits
+// (tested in tests/engine/executor_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone
+// in double) go back to that path.
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl and wide_pairs.inl.
 
@@ -124,7 +124,7 @@ template <class T> struct WideGjkPairs {
       return true;
     }
 
-    /// complete_pair() and write_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
+    /// complete_pair() and write_pair_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
     /// the fallback (computed again on the scalar path).
     void done(const Lanes& L, int l, GjkStatus status) {
       GjkResult<T> g;
