@@ -19,6 +19,21 @@ namespace {
 
 const char* const kAxis[3] = {"x", "y", "z"};
 
+// Whether a box in [begin, end) has a non-finite coordinate or min > max: branch-free per box so that the loop
+// vectorises (the exact index is searched only in a range that has one). A NaN fails every comparison; -inf fails
+// lo >= -FLT_MAX, +inf fails hi <= FLT_MAX, and lo = +inf or hi = -inf either fails lo <= hi or makes the other
+// coordinate infinite too.
+bool any_bad_box(const AabbSoa& b, std::size_t begin, std::size_t end) {
+  unsigned bad = 0;
+  for (int a = 0; a < 3; ++a) {
+    const float* lo = b.min(a);
+    const float* hi = b.max(a);
+    for (std::size_t i = begin; i < end; ++i)
+      bad |= static_cast<unsigned>(!((lo[i] <= hi[i]) & (lo[i] >= -FLT_MAX) & (hi[i] <= FLT_MAX)));
+  }
+  return bad != 0;
+}
+
 // The double coordinate must round to a finite float: beyond FLT_MAX the cast would give inf (or be undefined).
 void check_coordinate(std::size_t i, const char* which, int axis, double value) {
   if (!std::isfinite(value) || std::fabs(value) > static_cast<double>(FLT_MAX)) {
@@ -89,6 +104,7 @@ void validate_aabbs(const AabbSoa& b) {
   const std::size_t bad = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, 4096), n,
       [&](const tbb::blocked_range<std::size_t>& r, std::size_t best) {
+        if (r.begin() >= best || !any_bad_box(b, r.begin(), r.end())) return best;
         for (std::size_t i = r.begin(); i < r.end() && i < best; ++i)
           for (int a = 0; a < 3; ++a) {
             const float lo = b.min(a)[i], hi = b.max(a)[i];

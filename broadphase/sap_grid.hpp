@@ -26,19 +26,29 @@ struct SapGrid {
   /// Cell index of a coordinate: floor((x - origin) / width) clamped to [0, cells). Every step (a rounded
   /// subtraction, a rounded product by a positive constant, a clamp, a truncation of a non-negative value) is
   /// monotone in x, so x <= y implies cell(x) <= cell(y) whatever the rounding: that is all exactness needs.
+  /// Branch-free so that loops over many boxes vectorise. t is NaN only when inv_width = 0 (one cell) and x - origin
+  /// overflowed to +-inf; the first select maps it to 0, the right cell. +-inf for coordinates near the float range
+  /// (several cells) clamp to the border cells.
   static int cell_of(float x, float origin, float inv_width, int cells) {
-    if (cells == 1) return 0;
-    const float t = (x - origin) * inv_width;  // may overflow to +-inf for coordinates near the float range: clamped
-    if (!(t > 0.0f)) return 0;
-    if (t >= static_cast<float>(cells - 1)) return cells - 1;
+    float t = (x - origin) * inv_width;
+    t = t > 0.0f ? t : 0.0f;
+    const float last = static_cast<float>(cells - 1);
+    t = t < last ? t : last;
     return static_cast<int>(t);
   }
 };
 
 /// Sweep axis = the axis of largest variance of the box centres (ties: the lower axis); the grid over the two other
 /// axes spans the range of the centres with cells about kCellWidthInExtents mean box widths wide, at most
-/// max(1, n / kMinObjectsPerCell) cells and at most kMaxCellsPerAxis per axis. Deterministic for any thread count.
+/// max(1, n / kMinObjectsPerCell) cells and at most kMaxCellsPerAxis per axis. The statistics come from a fixed
+/// sample of at most kSampleCount boxes spread over the input (sap_grid.cpp): deterministic for any thread count.
 SapGrid choose_grid(const AabbSoa& boxes);
+
+/// Cell spans of the boxes [begin, begin + k) on both grid axes: box begin + j spans cells [u0[j], u1[j]] x
+/// [v0[j], v1[j]]. One branch-free loop (vectorised); the bucketing passes call it per block of kSpanBlock boxes.
+constexpr std::size_t kSpanBlock = 256;
+void cell_spans(const SapGrid& grid, const AabbSoa& boxes, std::size_t begin, std::size_t k, int* u0, int* u1,
+                int* v0, int* v1);
 
 /// The same grid with half as many cells per axis (rounded up); used when big boxes span too many cells.
 SapGrid coarser(const SapGrid& grid);

@@ -29,10 +29,10 @@
 namespace batchcol::broadphase {
 namespace {
 
-// Bucketing chunks: at least this many objects each (below, per-chunk cell counters cost more than they save) and at
-// most kMaxBucketChunks (the counters are chunks x cells words, kept between frames: 4 chunks x n/16 cells x 4 bytes
-// = 1 byte per object at most).
-constexpr std::size_t kBucketChunkMin = 16384;
+// Bucketing chunks: at least this many objects each (below, per-chunk cell counters cost more than they save; 4096
+// lets a 10k scene use both cores) and at most kMaxBucketChunks (the counters are chunks x cells words, kept between
+// frames: 4 chunks x n/16 cells x 4 bytes = 1 byte per object at most).
+constexpr std::size_t kBucketChunkMin = 4096;
 constexpr std::size_t kMaxBucketChunks = 4;
 // Groups of cells sorted and swept as parallel tasks, balanced by entry count; enough for load balance on a few cores.
 constexpr std::size_t kSweepGroups = 64;
@@ -152,17 +152,26 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
   const Chunks ch(n, kBucketChunkMin, kMaxBucketChunks);
   counts_.assign(ch.count * cells, 0);
   chunk_entries_.assign(ch.count, 0);
-  const float *lu = boxes.min(grid_.u), *hu = boxes.max(grid_.u), *lv = boxes.min(grid_.v), *hv = boxes.max(grid_.v);
   const SapGrid g = grid_;
   tbb::parallel_for(std::size_t{0}, ch.count, [&](std::size_t c) {
     std::uint32_t* count = counts_.data() + c * cells;
     std::size_t total = 0;
     const std::size_t end = ch.end(c, n);
-    for (std::size_t i = ch.begin(c, n); i < end; ++i) {
-      const int cu0 = g.cell_u(lu[i]), cu1 = g.cell_u(hu[i]), cv0 = g.cell_v(lv[i]), cv1 = g.cell_v(hv[i]);
-      for (int cv = cv0; cv <= cv1; ++cv)
-        for (int cu = cu0; cu <= cu1; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
-      total += static_cast<std::size_t>(cu1 - cu0 + 1) * static_cast<std::size_t>(cv1 - cv0 + 1);
+    int u0[kSpanBlock], u1[kSpanBlock], v0[kSpanBlock], v1[kSpanBlock];
+    for (std::size_t b = ch.begin(c, n); b < end; b += kSpanBlock) {
+      const std::size_t k = std::min(kSpanBlock, end - b);
+      cell_spans(g, boxes, b, k, u0, u1, v0, v1);
+      for (std::size_t j = 0; j < k; ++j) {
+        const std::size_t row = static_cast<std::size_t>(v0[j]) * g.cells_u;
+        if (u0[j] == u1[j] && v0[j] == v1[j]) {  // most boxes lie in one cell
+          ++count[row + u0[j]];
+          ++total;
+          continue;
+        }
+        for (int cv = v0[j]; cv <= v1[j]; ++cv)
+          for (int cu = u0[j]; cu <= u1[j]; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
+        total += static_cast<std::size_t>(u1[j] - u0[j] + 1) * static_cast<std::size_t>(v1[j] - v0[j] + 1);
+      }
     }
     chunk_entries_[c] = total;
   });
@@ -201,11 +210,20 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
   tbb::parallel_for(std::size_t{0}, ch.count, [&](std::size_t c) {
     std::uint32_t* offset = counts_.data() + c * cells;
     const std::size_t end = ch.end(c, n);
-    for (std::size_t i = ch.begin(c, n); i < end; ++i) {
-      const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i)};
-      const int cu0 = g.cell_u(e.u0), cu1 = g.cell_u(e.u1), cv0 = g.cell_v(e.v0), cv1 = g.cell_v(e.v1);
-      for (int cv = cv0; cv <= cv1; ++cv)
-        for (int cu = cu0; cu <= cu1; ++cu) out[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
+    int u0[kSpanBlock], u1[kSpanBlock], v0[kSpanBlock], v1[kSpanBlock];
+    for (std::size_t b = ch.begin(c, n); b < end; b += kSpanBlock) {
+      const std::size_t k = std::min(kSpanBlock, end - b);
+      cell_spans(g, boxes, b, k, u0, u1, v0, v1);
+      for (std::size_t j = 0; j < k; ++j) {
+        const std::size_t i = b + j;
+        const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i)};
+        if (u0[j] == u1[j] && v0[j] == v1[j]) {
+          out[offset[static_cast<std::size_t>(v0[j]) * g.cells_u + u0[j]]++] = e;
+          continue;
+        }
+        for (int cv = v0[j]; cv <= v1[j]; ++cv)
+          for (int cu = u0[j]; cu <= u1[j]; ++cu) out[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
+      }
     }
   });
 }
