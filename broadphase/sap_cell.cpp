@@ -8,19 +8,22 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 namespace batchcol::broadphase {
 namespace {
 
-// Cells up to kInsertionSortMax records are insertion-sorted from any order; up to kInPlaceSortMax, std::sort (in
-// place: no scratch, which kept per task would cost more memory than the cells); larger ones (degenerate scenes: the
-// grid could not split them) radix-sorted with per-task scratch. A nearly sorted cell (update()) tries insertion
-// sort first.
+// Cells up to kInsertionSortMax records are insertion-sorted from any order; up to kSlabSortMax, counting-sorted into
+// slabs of x0 and then insertion-sorted; larger ones (degenerate scenes: the grid could not split them) radix-sorted.
+// A nearly sorted cell (update()) tries insertion sort first.
 constexpr std::size_t kInsertionSortMax = 48;
-constexpr std::size_t kInPlaceSortMax = 4096;
+constexpr std::size_t kSlabSortMax = 4096;
+// Slabs per record: two records per slab on average, so the insertion sort after the counting sort moves about one
+// record per slab. The histogram (kSlabSortMax / 2 + 1 counters) lives on the stack.
+constexpr std::size_t kRecordsPerSlab = 2;
 // A nearly sorted cell (update()) is insertion-sorted while the records moved stay below this many per record plus
-// a constant; past that budget the order was not "nearly sorted" and the radix sort finishes the job.
+// a constant; past that budget the order was not "nearly sorted" and the next method finishes the job.
 constexpr std::size_t kMovesPerRecord = 4;
 constexpr std::size_t kMovesSlack = 64;
 // A cell with at most 1/kDescentFraction of its neighbours out of order is treated as nearly sorted.
@@ -44,9 +47,12 @@ bool insertion_sort(CellRecord* e, std::size_t k, std::size_t budget) {
   return true;
 }
 
-void radix_sort_cell(CellRecord* e, std::size_t k, std::vector<std::uint64_t>& w, std::vector<std::uint64_t>& tmp,
-                     std::vector<CellRecord>& buf) {
-  if (w.size() < k) w.resize(k), tmp.resize(k), buf.resize(k);
+void radix_sort_cell(CellRecord* e, std::size_t k, SortScratch& s) {
+  std::vector<std::uint64_t>& w = s.words;
+  std::vector<std::uint64_t>& tmp = s.tmp;
+  std::vector<CellRecord>& buf = s.entries;
+  if (w.size() < k) w.resize(k), tmp.resize(k);
+  if (buf.size() < k) buf.resize(k);
   std::array<std::array<std::uint32_t, 256>, 4> hist{};
   for (std::size_t i = 0; i < k; ++i) {
     const std::uint32_t key = sortable_key(e[i].x0);
@@ -73,10 +79,39 @@ void radix_sort_cell(CellRecord* e, std::size_t k, std::vector<std::uint64_t>& w
   std::memcpy(static_cast<void*>(e), buf.data(), k * sizeof(CellRecord));
 }
 
+// Counting sort of e[0, k) into slabs of equal width between the smallest and largest x0, then insertion sort inside
+// the slabs. The slab index floor((x0 - lo) * scale) is monotone in x0 (rounded subtraction and product, clamp,
+// truncation), so records of a lower slab never belong after a higher one. Returns false, records permuted and none
+// lost, when the x0 range overflows float or the slabs were too uneven for the move budget.
+bool slab_sort(CellRecord* e, std::size_t k, SortScratch& s) {
+  float lo = e[0].x0, hi = e[0].x0;
+  for (std::size_t i = 1; i < k; ++i) {
+    lo = e[i].x0 < lo ? e[i].x0 : lo;
+    hi = e[i].x0 > hi ? e[i].x0 : hi;
+  }
+  if (!(hi > lo)) return true;  // all keys equal: any order is sorted
+  const std::size_t slabs = k / kRecordsPerSlab;
+  const float scale = static_cast<float>(slabs) / (hi - lo);
+  if (!(scale > 0.0f) || !(scale < std::numeric_limits<float>::infinity())) return false;  // range overflowed
+  const float last = static_cast<float>(slabs - 1);
+  const auto slab = [&](float x) {
+    const float t = (x - lo) * scale;
+    return static_cast<std::uint32_t>(t < last ? t : last);
+  };
+  std::uint32_t start[kSlabSortMax / kRecordsPerSlab + 1];
+  std::fill(start, start + slabs + 1, 0u);
+  for (std::size_t i = 0; i < k; ++i) ++start[slab(e[i].x0) + 1];
+  for (std::size_t b = 0; b < slabs; ++b) start[b + 1] += start[b];
+  if (s.entries.size() < k) s.entries.resize(k);
+  CellRecord* buf = s.entries.data();
+  for (std::size_t i = 0; i < k; ++i) buf[start[slab(e[i].x0)]++] = e[i];
+  std::memcpy(static_cast<void*>(e), buf, k * sizeof(CellRecord));
+  return insertion_sort(e, k, kMovesPerRecord * k + kMovesSlack);
+}
+
 }  // namespace
 
-void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, std::vector<std::uint64_t>& words,
-               std::vector<std::uint64_t>& tmp, std::vector<CellRecord>& buf) {
+void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, SortScratch& scratch) {
   if (k < 2) return;
   if (k <= kInsertionSortMax) {
     insertion_sort(e, k, static_cast<std::size_t>(-1));
@@ -86,14 +121,12 @@ void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, std::vector<std
   // Few descents predict few insertion moves; the move budget bounds the cost when the prediction fails.
   std::size_t descents = 0;
   for (std::size_t i = 1; i < k; ++i) descents += e[i].x0 < e[i - 1].x0 ? 1 : 0;
+  if (descents == 0) return;
   if ((nearly_sorted || descents * kDescentFraction <= k) &&
       insertion_sort(e, k, kMovesPerRecord * k + kMovesSlack))
     return;
-  if (k <= kInPlaceSortMax) {
-    std::sort(e, e + k, [](const CellRecord& a, const CellRecord& b) { return a.x0 < b.x0; });
-    return;
-  }
-  radix_sort_cell(e, k, words, tmp, buf);
+  if (k <= kSlabSortMax && slab_sort(e, k, scratch)) return;
+  radix_sort_cell(e, k, scratch);
 }
 
 }  // namespace batchcol::broadphase

@@ -27,11 +27,21 @@ inline void make_tombstone(CellRecord& r) {
   r.x1 = -kInf, r.u0 = kInf, r.u1 = -kInf, r.v0 = kInf, r.v1 = -kInf;
 }
 
+/// Per-thread scratch of sort_cell(), grown to the largest cell it sorted and kept (a warm frame allocates nothing).
+struct SortScratch {
+  std::vector<std::uint64_t> words, tmp;
+  std::vector<CellRecord> entries;
+  std::size_t bytes() const {
+    return words.capacity() * sizeof(std::uint64_t) + tmp.capacity() * sizeof(std::uint64_t) +
+           entries.capacity() * sizeof(CellRecord);
+  }
+};
+
 /// Sorts e[0, k) by x0: insertion sort for small cells and for nearly sorted ones (update(): it gives up after about
-/// 4 moves per record), std::sort for mid-size cells, an LSD radix sort on the float keys for huge ones (degenerate
-/// scenes). The buffers are per-task scratch for the radix sort, grown only when it runs.
-void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, std::vector<std::uint64_t>& words,
-               std::vector<std::uint64_t>& tmp, std::vector<CellRecord>& buf);
+/// 4 moves per record); for mid-size cells a counting sort into slabs of x0 followed by insertion sort (rebuild():
+/// records arrive in input order); an LSD radix sort on the float keys for huge cells and when the slabs fail
+/// (degenerate scenes).
+void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, SortScratch& scratch);
 
 /// Where a cell's pairs go: the cell's grid coordinates, the filter and the output words (a << 32 | b).
 struct CellSweep {

@@ -83,9 +83,9 @@ std::size_t SweepAndPrune::memory_bytes() const {
   std::size_t b = pair_buffer_bytes() + bytes(counts_) + bytes(cell_start_) + held_bytes(entries_) +
                   bytes(overflow_ids_) + bytes(overflow_start_) + bytes(overflow_entries_);
   for (const auto& g : group_movers_) b += bytes(g);
-  for (const auto& g : group_scratch_) b += bytes(g.words) + bytes(g.tmp) + bytes(g.entries);
+  for (const SortScratch& s : sort_scratch_) b += s.bytes();
   return b + bytes(first_cell_) + bytes(group_start_) + bytes(chunk_entries_) + bytes(shifts_) +
-         bytes(radix_histograms_) + bytes(group_pairs_) + bytes(group_movers_) + bytes(group_scratch_);
+         bytes(radix_histograms_) + bytes(group_pairs_) + bytes(group_movers_);
 }
 
 void SweepAndPrune::run(const AabbSoa& boxes, const FilterSoa& filter, std::vector<CandidatePair>& pairs,
@@ -244,7 +244,6 @@ void SweepAndPrune::choose_groups() {
   first_cell_[0] = 0;
   group_pairs_.resize(groups);
   group_movers_.resize(groups);
-  if (group_scratch_.size() < groups) group_scratch_.resize(groups);
 }
 
 void SweepAndPrune::sort_and_sweep(const FilterSoa& filter, bool nearly_sorted) {
@@ -255,17 +254,17 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter, bool nearly_sorted) 
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::vector<std::uint64_t>& out = group_pairs_[g];
     out.clear();
-    CellScratch& scratch = group_scratch_[g];
+    SortScratch& scratch = sort_scratch_.local();
     for (std::size_t cell = first_cell_[g]; cell < first_cell_[g + 1]; ++cell) {
       const std::size_t s = cell_start_[cell], k = cell_start_[cell + 1] - s;
       Entry* e = all + s;
-      sort_cell(e, k, nearly_sorted, scratch.words, scratch.tmp, scratch.entries);
+      sort_cell(e, k, nearly_sorted, scratch);
       const CellSweep sweep{grid, static_cast<int>(cell % grid.cells_u), static_cast<int>(cell / grid.cells_u),
                             filter, out};
       sweep.within(e, k);
       const std::size_t os = overflow_start_[cell], ok = overflow_start_[cell + 1] - os;
       if (ok == 0) continue;
-      sort_cell(over + os, ok, false, scratch.words, scratch.tmp, scratch.entries);
+      sort_cell(over + os, ok, false, scratch);
       sweep.within(over + os, ok);
       sweep.between(e, k, over + os, ok);
     }
