@@ -5,8 +5,13 @@
 
 #include "broadphase/float_key.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <utility>
@@ -23,8 +28,11 @@ constexpr std::size_t kSlabSortMax = 4096;
 // record per slab. The histogram (kSlabSortMax / 2 + 1 counters) lives on the stack.
 constexpr std::size_t kRecordsPerSlab = 2;
 // A nearly sorted cell (update()) is insertion-sorted while the records moved stay below this many per record plus
-// a constant; past that budget the order was not "nearly sorted" and the next method finishes the job.
+// a constant; past that budget the order was not "nearly sorted" and the next method finishes the job. A cell only
+// predicted to be nearly sorted by its few descents gets one move per record: sorted runs of a renumbered scene
+// meeting in a cell of a new grid have few descents but need many moves, which the slab sort does cheaper.
 constexpr std::size_t kMovesPerRecord = 4;
+constexpr std::size_t kPredictedMovesPerRecord = 1;
 constexpr std::size_t kMovesSlack = 64;
 // A cell with at most 1/kDescentFraction of its neighbours out of order is treated as nearly sorted.
 constexpr std::size_t kDescentFraction = 8;
@@ -122,11 +130,42 @@ void sort_cell(CellRecord* e, std::size_t k, bool nearly_sorted, SortScratch& sc
   std::size_t descents = 0;
   for (std::size_t i = 1; i < k; ++i) descents += e[i].x0 < e[i - 1].x0 ? 1 : 0;
   if (descents == 0) return;
-  if ((nearly_sorted || descents * kDescentFraction <= k) &&
-      insertion_sort(e, k, kMovesPerRecord * k + kMovesSlack))
+  if (nearly_sorted && insertion_sort(e, k, kMovesPerRecord * k + kMovesSlack)) return;
+  if (!nearly_sorted && descents * kDescentFraction <= k &&
+      insertion_sort(e, k, kPredictedMovesPerRecord * k + kMovesSlack))
     return;
   if (k <= kSlabSortMax && slab_sort(e, k, scratch)) return;
   radix_sort_cell(e, k, scratch);
+}
+
+void CellSweep::within(const CellRecord* e, std::size_t k) const {
+#if defined(__SSE2__)
+  static_assert(offsetof(CellRecord, u1) == offsetof(CellRecord, u0) + 4 &&
+                    offsetof(CellRecord, v0) == offsetof(CellRecord, u0) + 8 &&
+                    offsetof(CellRecord, v1) == offsetof(CellRecord, u0) + 12,
+                "within() loads u0, u1, v0, v1 as one 4-float vector");
+  // The four grid-axis conditions q.u0 <= p.u1, -q.u1 <= -p.u0, q.v0 <= p.v1, -q.v1 <= -p.v0 as one comparison of
+  // q's (u0, -u1, v0, -v1) with p's (u1, -u0, v1, -v0): the fields u0, u1, v0, v1 are adjacent in a record. Sign
+  // flips are exact and keep the order (-0 and +0 compare equal); a tombstone (u0 = +inf, u1 = -inf) fails lane 0
+  // or 1 as q, and as p its x1 = -inf ends the scan before any test. Replaces four scalar compares and a mispredicted
+  // branch per candidate.
+  const __m128 flip = _mm_castsi128_ps(_mm_setr_epi32(0, INT32_MIN, 0, INT32_MIN));
+  for (std::size_t i = 0; i + 1 < k; ++i) {
+    const float hx = e[i].x1;
+    if (!(e[i + 1].x0 <= hx)) continue;
+    const __m128 pu = _mm_loadu_ps(&e[i].u0);  // (u0, u1, v0, v1)
+    const __m128 bound = _mm_xor_ps(_mm_shuffle_ps(pu, pu, _MM_SHUFFLE(2, 3, 0, 1)), flip);
+    for (std::size_t j = i + 1; j < k && e[j].x0 <= hx; ++j) {
+      const __m128 q = _mm_xor_ps(_mm_loadu_ps(&e[j].u0), flip);
+      if (_mm_movemask_ps(_mm_cmple_ps(q, bound)) == 0xF) report(e[i], e[j]);
+    }
+  }
+#else
+  for (std::size_t i = 0; i < k; ++i) {
+    const float hx = e[i].x1;
+    for (std::size_t j = i + 1; j < k && e[j].x0 <= hx; ++j) test(e[i], e[j]);
+  }
+#endif
 }
 
 }  // namespace batchcol::broadphase

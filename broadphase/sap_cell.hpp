@@ -54,7 +54,11 @@ struct CellSweep {
   /// of their overlap lies in this cell: a pair shared by several cells is reported by exactly one of them (cell_of
   /// is monotone, so that corner's cell is in both boxes' cell ranges).
   void test(const CellRecord& p, const CellRecord& q) const {
-    if (!((q.u0 <= p.u1) & (p.u0 <= q.u1) & (q.v0 <= p.v1) & (p.v0 <= q.v1))) return;
+    if ((q.u0 <= p.u1) & (p.u0 <= q.u1) & (q.v0 <= p.v1) & (p.v0 <= q.v1)) report(p, q);
+  }
+
+  /// The second half of test(), for boxes known to overlap on the grid axes.
+  void report(const CellRecord& p, const CellRecord& q) const {
     if (grid.cell_u(p.u0 < q.u0 ? q.u0 : p.u0) != cu || grid.cell_v(p.v0 < q.v0 ? q.v0 : p.v0) != cv) return;
     std::uint32_t a = p.id, b = q.id;
     if (a > b) std::swap(a, b);
@@ -62,12 +66,8 @@ struct CellSweep {
   }
 
   /// All pairs within e[0, k), sorted by x0: x0[i] <= x0[j] <= x1[j], so the x overlap reduces to x0[j] <= x1[i].
-  void within(const CellRecord* e, std::size_t k) const {
-    for (std::size_t i = 0; i < k; ++i) {
-      const float hx = e[i].x1;
-      for (std::size_t j = i + 1; j < k && e[j].x0 <= hx; ++j) test(e[i], e[j]);
-    }
-  }
+  /// The grid-axis test is one 4-wide comparison per candidate (sap_cell.cpp).
+  void within(const CellRecord* e, std::size_t k) const;
 
   /// All pairs (m in a, n in b) of two sorted lists: the record with the smaller x0 scans the other list (ties: a's
   /// record first, and b's later scan starts after it), so each pair overlapping on x is met exactly once.
