@@ -14,6 +14,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <string>
 
 namespace batchcol::broadphase {
@@ -21,6 +22,8 @@ namespace {
 
 // Records ahead whose boxes are prefetched: enough misses in flight to cover memory latency, few enough to stay in L1.
 constexpr std::ptrdiff_t kPrefetchDistance = 12;
+// Records refreshed per block: the local arrays (12 x 64 x 4 bytes) stay in L1.
+constexpr std::size_t kRefreshBlock = 64;
 
 }  // namespace
 
@@ -34,31 +37,51 @@ void SweepAndPrune::refresh(const AabbSoa& boxes) {
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t group) {
     std::vector<std::uint32_t>& movers = group_movers_[group];
     movers.clear();
+    // Per block of records: the new boxes gathered into local arrays (scalar loads by object index), then the stay
+    // test of every record in one branch-free loop (8 cell_of each, vectorised), then the records written.
+    float nx0[kRefreshBlock], nx1[kRefreshBlock], nu0[kRefreshBlock], nu1[kRefreshBlock], nv0[kRefreshBlock],
+        nv1[kRefreshBlock], ou0[kRefreshBlock], ou1[kRefreshBlock], ov0[kRefreshBlock], ov1[kRefreshBlock];
+    int stays[kRefreshBlock], lowest[kRefreshBlock];
     for (std::size_t cell = first_cell_[group]; cell < first_cell_[group + 1]; ++cell) {
       const int cu = static_cast<int>(cell % g.cells_u), cv = static_cast<int>(cell / g.cells_u);
-      for (Entry* r = all + cell_start_[cell]; r != all + cell_start_[cell + 1]; ++r) {
-        // The reads below hit six arrays at the object's index: in random object order, six cache misses per
-        // record. Asking for a record's boxes kPrefetchDistance records ahead overlaps those misses.
-        if (end_of_all - r > kPrefetchDistance) {
-          const std::uint32_t ahead = r[kPrefetchDistance].id;
-          if (ahead < object_count_) {
-            for (const float* a : {lx, hx, lu, hu, lv, hv}) __builtin_prefetch(a + ahead);
+      Entry* const cell_end = all + cell_start_[cell + 1];
+      for (Entry* b = all + cell_start_[cell]; b < cell_end; b += kRefreshBlock) {
+        const std::size_t m = std::min<std::size_t>(kRefreshBlock, static_cast<std::size_t>(cell_end - b));
+        for (std::size_t j = 0; j < m; ++j) {
+          // In random object order the six loads below miss the cache; asking kPrefetchDistance records ahead
+          // overlaps those misses.
+          if (end_of_all - (b + j) > kPrefetchDistance) {
+            const std::uint32_t ahead = b[j + kPrefetchDistance].id;
+            if (ahead < object_count_) {
+              for (const float* a : {lx, hx, lu, hu, lv, hv}) __builtin_prefetch(a + ahead);
+            }
           }
+          const std::uint32_t i = b[j].id;  // tombstones keep a valid id: their loads are harmless
+          nx0[j] = lx[i], nx1[j] = hx[i], nu0[j] = lu[i], nu1[j] = hu[i], nv0[j] = lv[i], nv1[j] = hv[i];
+          ou0[j] = b[j].u0, ou1[j] = b[j].u1, ov0[j] = b[j].v0, ov1[j] = b[j].v1;
         }
-        if (!(r->u0 <= r->u1)) continue;  // a tombstone
-        const std::uint32_t i = r->id;
-        const int old_u0 = g.cell_u(r->u0), old_u1 = g.cell_u(r->u1), old_v0 = g.cell_v(r->v0),
-                  old_v1 = g.cell_v(r->v1);
-        const Entry now{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], i};
-        if (g.cell_u(now.u0) >= old_u0 && g.cell_u(now.u1) <= old_u1 && g.cell_v(now.v0) >= old_v0 &&
-            g.cell_v(now.v1) <= old_v1) {
-          *r = now;
-          continue;
+        const float gou = g.origin_u, giu = g.inv_width_u, gov = g.origin_v, giv = g.inv_width_v;
+        const int gcu = g.cells_u, gcv = g.cells_v;
+        for (std::size_t j = 0; j < m; ++j) {
+          const auto cell_u = [&](float x) { return SapGrid::cell_of(x, gou, giu, gcu); };
+          const auto cell_v = [&](float x) { return SapGrid::cell_of(x, gov, giv, gcv); };
+          const int old_u0 = cell_u(ou0[j]), old_u1 = cell_u(ou1[j]), old_v0 = cell_v(ov0[j]), old_v1 = cell_v(ov1[j]);
+          stays[j] = (cell_u(nu0[j]) >= old_u0) & (cell_u(nu1[j]) <= old_u1) & (cell_v(nv0[j]) >= old_v0) &
+                     (cell_v(nv1[j]) <= old_v1);
+          lowest[j] = (old_u0 == cu) & (old_v0 == cv);
         }
-        // Every copy of the object takes this branch (they hold the same box); the one in the lowest cell of the
-        // old range reports the object once.
-        if (old_u0 == cu && old_v0 == cv) movers.push_back(i);
-        make_tombstone(*r);
+        for (std::size_t j = 0; j < m; ++j) {
+          Entry& r = b[j];
+          if (!(ou0[j] <= ou1[j])) continue;  // a tombstone
+          if (stays[j]) {
+            r = Entry{nx0[j], nx1[j], nu0[j], nu1[j], nv0[j], nv1[j], r.id};
+            continue;
+          }
+          // Every copy of the object takes this branch (they hold the same box); the one in the lowest cell of the
+          // old range reports the object once.
+          if (lowest[j]) movers.push_back(r.id);
+          make_tombstone(r);
+        }
       }
     }
   });
