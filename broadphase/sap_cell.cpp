@@ -21,8 +21,7 @@ namespace {
 
 // Cells up to kInsertionSortMax records are insertion-sorted from any order; up to kSlabSortMax, counting-sorted into
 // slabs of x0 and then insertion-sorted; larger ones (degenerate scenes: the grid could not split them) radix-sorted.
-// A nearly sorted cell (update()) tries insertion sort first.
-constexpr std::size_t kInsertionSortMax = 48;
+// A nearly sorted cell (update()) tries insertion sort first. (kInsertionSortMax: sap_cell.hpp.)
 constexpr std::size_t kSlabSortMax = 4096;
 // Slabs per record: two records per slab on average, so the insertion sort after the counting sort moves about one
 // record per slab. The histogram (kSlabSortMax / 2 + 1 counters) lives on the stack.
@@ -56,11 +55,10 @@ bool insertion_sort(CellRecord* e, std::size_t k, std::size_t budget) {
 }
 
 void radix_sort_cell(CellRecord* e, std::size_t k, SortScratch& s) {
+  s.reserve(k);  // a no-op after the caller's reserve()
   std::vector<std::uint64_t>& w = s.words;
   std::vector<std::uint64_t>& tmp = s.tmp;
   std::vector<CellRecord>& buf = s.entries;
-  if (w.size() < k) w.resize(k), tmp.resize(k);
-  if (buf.size() < k) buf.resize(k);
   std::array<std::array<std::uint32_t, 256>, 4> hist{};
   for (std::size_t i = 0; i < k; ++i) {
     const std::uint32_t key = sortable_key(e[i].x0);
@@ -110,7 +108,7 @@ bool slab_sort(CellRecord* e, std::size_t k, SortScratch& s) {
   std::fill(start, start + slabs + 1, 0u);
   for (std::size_t i = 0; i < k; ++i) ++start[slab(e[i].x0) + 1];
   for (std::size_t b = 0; b < slabs; ++b) start[b + 1] += start[b];
-  if (s.entries.size() < k) s.entries.resize(k);
+  s.reserve(k);  // a no-op after the caller's reserve()
   CellRecord* buf = s.entries.data();
   for (std::size_t i = 0; i < k; ++i) buf[start[slab(e[i].x0)]++] = e[i];
   std::memcpy(static_cast<void*>(e), buf, k * sizeof(CellRecord));

@@ -27,10 +27,21 @@ inline void make_tombstone(CellRecord& r) {
   r.x1 = -kInf, r.u0 = kInf, r.u1 = -kInf, r.v0 = kInf, r.v1 = -kInf;
 }
 
-/// Per-thread scratch of sort_cell(), grown to the largest cell it sorted and kept (a warm frame allocates nothing).
+/// Cells up to this many records are insertion-sorted and need no scratch.
+constexpr std::size_t kInsertionSortMax = 48;
+
+/// Scratch of sort_cell(), one per worker slot. The caller grows it with reserve() to the largest cell before a
+/// parallel sort (so what is allocated depends on the cells only, not on which thread sorted which cell); sort_cell()
+/// never grows it then, and a warm frame allocates nothing.
 struct SortScratch {
   std::vector<std::uint64_t> words, tmp;
   std::vector<CellRecord> entries;
+  /// Makes room for cells of up to k records (none needed up to kInsertionSortMax).
+  void reserve(std::size_t k) {
+    if (k <= kInsertionSortMax) return;
+    if (words.size() < k) words.resize(k), tmp.resize(k);
+    if (entries.size() < k) entries.resize(k);
+  }
   std::size_t bytes() const {
     return words.capacity() * sizeof(std::uint64_t) + tmp.capacity() * sizeof(std::uint64_t) +
            entries.capacity() * sizeof(CellRecord);

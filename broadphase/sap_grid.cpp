@@ -15,7 +15,7 @@ namespace {
 constexpr double kCellWidthInExtents = 8.0;
 // Fewer than this many objects per cell on average costs more in per-cell bookkeeping than it saves.
 constexpr std::size_t kMinObjectsPerCell = 16;
-// Bounds the cell index to 16 bits per axis (the bucketing packs cell ranges into 64 bits).
+// Bounds the grid (4096^2 cells at most) and keeps cell indices well inside int.
 constexpr int kMaxCellsPerAxis = 4096;
 // The statistics come from at most kSampleCount boxes spread evenly over the input (all of them in smaller scenes): the
 // axis and the cell width need the variance and the mean extent only roughly (the relative error of a variance from
@@ -23,6 +23,15 @@ constexpr int kMaxCellsPerAxis = 4096;
 // double cost ~80 instructions per object, a sixth of a 10k-object rebuild. A fixed sample: the same grid for any
 // thread count.
 constexpr std::size_t kSampleCount = 2048;
+
+// Sample k of `samples` from n boxes: one per stretch of n / samples boxes, at a position inside the stretch that
+// varies with k (a multiplicative hash), so that an input repeating with the stretch's period (every 64th box tiny,
+// say) is not sampled in phase with it. k * n < 2^43; the offset stays below the stretch, so i < n.
+std::size_t sample_index(std::size_t k, std::size_t n, std::size_t samples) {
+  const std::size_t stretch = n / samples;
+  const std::size_t offset = stretch > 1 ? (k * 2654435761u) % stretch : 0;
+  return k * n / samples + offset;
+}
 
 struct Stats {
   double sum[3] = {0, 0, 0}, sum_sq[3] = {0, 0, 0}, extent[3] = {0, 0, 0};
@@ -52,7 +61,7 @@ SapGrid choose_grid(const AabbSoa& b) {
     const float* lo = b.min(a);
     const float* hi = b.max(a);
     for (std::size_t k = 0; k < samples; ++k) {
-      const std::size_t i = k * n / samples;  // spread over the whole range (k * n < 2^43)
+      const std::size_t i = sample_index(k, n, samples);
       const double c = 0.5 * (static_cast<double>(lo[i]) + hi[i]);
       const double d = c - shift[a];
       t.sum[a] += d;

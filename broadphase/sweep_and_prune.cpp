@@ -20,6 +20,7 @@
 #include "broadphase/radix_sort.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -84,6 +85,7 @@ std::size_t SweepAndPrune::memory_bytes() const {
                   bytes(overflow_ids_) + bytes(overflow_start_) + bytes(overflow_entries_);
   for (const auto& g : group_movers_) b += bytes(g);
   for (const SortScratch& s : sort_scratch_) b += s.bytes();
+  b += bytes(sort_scratch_);
   return b + bytes(first_cell_) + bytes(group_start_) + bytes(chunk_entries_) + bytes(shifts_) +
          bytes(radix_histograms_) + bytes(group_pairs_) + bytes(group_movers_);
 }
@@ -251,10 +253,19 @@ void SweepAndPrune::sort_and_sweep(const FilterSoa& filter, bool nearly_sorted) 
   const SapGrid grid = grid_;
   Entry* all = entries_.data();
   Entry* over = overflow_entries_.data();
+  // Scratch for the largest cell in every worker slot, grown here (serially): what is allocated depends on the cells,
+  // never on which thread sorts which cell, so a warm frame allocates nothing.
+  std::size_t largest = 0;
+  for (std::size_t cell = 0; cell + 1 < cell_start_.size(); ++cell)
+    largest = std::max<std::size_t>({largest, cell_start_[cell + 1] - cell_start_[cell],
+                                     overflow_start_[cell + 1] - overflow_start_[cell]});
+  const auto slots = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  if (sort_scratch_.size() < slots) sort_scratch_.resize(slots);
+  for (SortScratch& s : sort_scratch_) s.reserve(largest);
   tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
     std::vector<std::uint64_t>& out = group_pairs_[g];
     out.clear();
-    SortScratch& scratch = sort_scratch_.local();
+    SortScratch& scratch = sort_scratch_[static_cast<std::size_t>(tbb::this_task_arena::current_thread_index())];
     for (std::size_t cell = first_cell_[g]; cell < first_cell_[g + 1]; ++cell) {
       const std::size_t s = cell_start_[cell], k = cell_start_[cell + 1] - s;
       Entry* e = all + s;

@@ -21,8 +21,6 @@
 #include "broadphase/sap_cell.hpp"
 #include "broadphase/sap_grid.hpp"
 
-#include <tbb/enumerable_thread_specific.h>
-
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -94,9 +92,10 @@ class SweepAndPrune {
   std::vector<Entry> overflow_entries_;        // by cell, sorted by x0
   std::vector<std::vector<std::uint64_t>> group_pairs_;  // per fixed group of cells: its pairs, written lock-free
   std::vector<std::vector<std::uint32_t>> group_movers_; // per group: objects leaving their cells this update
-  // Per-thread sort scratch, kept across calls so that a frame of a warm SAP allocates nothing. Per thread rather
-  // than per group of cells: 64 groups each holding its largest cell would cost ~30 bytes per object at 10k.
-  tbb::enumerable_thread_specific<SortScratch> sort_scratch_;
+  // Sort scratch per worker slot of the calling arena (this_task_arena::current_thread_index()), each grown to the
+  // largest cell before the parallel sort. Per slot rather than per group of cells: 64 groups each holding its
+  // largest cell would cost ~30 bytes per object at 10k.
+  std::vector<SortScratch> sort_scratch_;
   std::vector<std::size_t> first_cell_;         // per group: its first cell
   std::vector<std::size_t> group_start_;        // per group: offset of its pairs in words_
   std::vector<std::size_t> chunk_entries_;      // per bucketing chunk: cell copies

@@ -129,6 +129,20 @@ TEST(SweepAndPrune, DegenerateScenes) {
     expect_equals_brute_force(to_soa(b));
   }
   {
+    // Above 2048 objects the grid statistics come from a sample (sap_grid.cpp): degenerate inputs there too.
+    SCOPED_TRACE("over 2048 objects: all on a line, all at one point, every 4th box 200x larger (periodic input)");
+    std::vector<Aabb> line, point, periodic;
+    for (int i = 0; i < 5000; ++i) {
+      line.push_back(box_at({0.15 * i, 0, 0}, h));
+      point.push_back(box_at({1, 2, 3}, h));
+      const Eigen::Vector3d c(uniform(rng, 0, 100), uniform(rng, 0, 100), uniform(rng, 0, 100));
+      periodic.push_back(box_at(c, Eigen::Vector3d::Constant(i % 4 == 0 ? 2.0 : 0.01)));
+    }
+    expect_equals_brute_force(to_soa(line));
+    EXPECT_EQ(sap_pairs(to_soa(point)).size(), 5000u * 4999u / 2u);
+    expect_equals_brute_force(to_soa(periodic));
+  }
+  {
     SCOPED_TRACE("coordinates near the float range");
     std::vector<Aabb> b;
     for (int i = 0; i < 200; ++i) {
@@ -169,6 +183,37 @@ TEST(SweepAndPrune, FilterRules) {
   const std::vector<CandidatePair> want = {{0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 4}, {3, 4}};  // not 2-3, 0-4, 1-4, 0-1
   EXPECT_EQ(sap_pairs(s, f), want);
   EXPECT_EQ(brute_force_pairs(s, f), want);
+}
+
+// Scratch that grew with whichever thread happened to sort the largest cell made warm frames allocate at random
+// (review of the slab sort); the scratch is now sized from the cells before the parallel sort.
+TEST(SweepAndPrune, WarmRebuildsAndUpdatesAllocateNothing) {
+  Rng rng(9);
+  // Random order (slab sorts) plus a tight cluster that fills one cell past the slab sort's size (radix sort): which
+  // worker sorts the big cell varies from frame to frame.
+  std::vector<Aabb> a = uniform_boxes(rng, 20000, 1.0, half_size_for(20000, 0.4));
+  for (int i = 0; i < 6000; ++i)  // 1e-6 apart on a diagonal 6e-3 long (cells are ~0.03 wide), 2e-7 wide: no pairs
+    a.push_back(box_at(Eigen::Vector3d::Constant(0.5 + 1e-6 * ((i * 7919) % 6000)), Eigen::Vector3d::Constant(1e-7)));
+  std::vector<Aabb> b = a;
+  for (Aabb& box : b) box.min.x() += 1e-4, box.max.x() += 1e-4;
+  const AabbSoa sa = to_soa(a), sb = to_soa(b);
+  tbb::task_arena(2).execute([&] {
+    SweepAndPrune sap;
+    std::vector<CandidatePair> pairs;
+    for (int k = 0; k < 2; ++k) {  // warm-up: both frames seen by rebuild() and update()
+      sap.rebuild(k % 2 ? sb : sa, {}, pairs);
+      sap.update(k % 2 ? sa : sb, {}, pairs);
+    }
+    const std::size_t bytes = sap.memory_bytes();
+    for (int k = 0; k < 300; ++k) {  // the old per-thread scratch grew within ~70 frames in half the runs
+      sap.rebuild(k % 2 ? sb : sa, {}, pairs);
+      ASSERT_EQ(sap.memory_bytes(), bytes) << "rebuild " << k;
+      sap.update(k % 2 ? sa : sb, {}, pairs);
+      ASSERT_EQ(sap.memory_bytes(), bytes) << "update " << k;
+    }
+    EXPECT_GT(pairs.size(), 1000u);
+    EXPECT_GT(sap.stats().max_cell, 4096u);  // the cluster's cell is past the slab sort: radix
+  });
 }
 
 TEST(SweepAndPrune, IdenticalForOneAndTwoThreads) {
