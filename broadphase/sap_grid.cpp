@@ -95,17 +95,16 @@ SapGrid choose_grid(const AabbSoa& b) {
   return g;
 }
 
-void cell_spans(const SapGrid& g, const AabbSoa& boxes, std::size_t begin, std::size_t k, int* u0, int* u1, int* v0,
-                int* v1) {
+void cell_spans(const SapGrid& grid, const AabbSoa& boxes, std::size_t begin, std::size_t k, int* u0, int* u1,
+                int* v0, int* v1) {
+  const SapGrid g = grid;  // a local copy: the int stores below cannot alias it, so the loop vectorises
   const float *lu = boxes.min(g.u) + begin, *hu = boxes.max(g.u) + begin;
   const float *lv = boxes.min(g.v) + begin, *hv = boxes.max(g.v) + begin;
-  const float ou = g.origin_u, iu = g.inv_width_u, ov = g.origin_v, iv = g.inv_width_v;
-  const int cu = g.cells_u, cv = g.cells_v;
   for (std::size_t j = 0; j < k; ++j) {
-    u0[j] = SapGrid::cell_of(lu[j], ou, iu, cu);
-    u1[j] = SapGrid::cell_of(hu[j], ou, iu, cu);
-    v0[j] = SapGrid::cell_of(lv[j], ov, iv, cv);
-    v1[j] = SapGrid::cell_of(hv[j], ov, iv, cv);
+    u0[j] = g.cell_u(lu[j]);
+    u1[j] = g.cell_u(hu[j]);
+    v0[j] = g.cell_v(lv[j]);
+    v1[j] = g.cell_v(hv[j]);
   }
 }
 

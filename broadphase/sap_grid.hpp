@@ -36,6 +36,17 @@ struct SapGrid {
     t = t < last ? t : last;
     return static_cast<int>(t);
   }
+
+  /// Calls f(cell) for every cell of the span [u0, u1] x [v0, v1] (cell = v * cells_u + u); a one-cell span, the
+  /// common case, skips the loops.
+  template <class F> void for_each_cell(int u0, int u1, int v0, int v1, F&& f) const {
+    if (u0 == u1 && v0 == v1) {
+      f(static_cast<std::size_t>(v0) * cells_u + u0);
+      return;
+    }
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) f(static_cast<std::size_t>(v) * cells_u + u);
+  }
 };
 
 /// Sweep axis = the axis of largest variance of the box centres (ties: the lower axis); the grid over the two other

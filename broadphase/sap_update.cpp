@@ -60,14 +60,11 @@ void SweepAndPrune::refresh(const AabbSoa& boxes) {
           nx0[j] = lx[i], nx1[j] = hx[i], nu0[j] = lu[i], nu1[j] = hu[i], nv0[j] = lv[i], nv1[j] = hv[i];
           ou0[j] = b[j].u0, ou1[j] = b[j].u1, ov0[j] = b[j].v0, ov1[j] = b[j].v1;
         }
-        const float gou = g.origin_u, giu = g.inv_width_u, gov = g.origin_v, giv = g.inv_width_v;
-        const int gcu = g.cells_u, gcv = g.cells_v;
         for (std::size_t j = 0; j < m; ++j) {
-          const auto cell_u = [&](float x) { return SapGrid::cell_of(x, gou, giu, gcu); };
-          const auto cell_v = [&](float x) { return SapGrid::cell_of(x, gov, giv, gcv); };
-          const int old_u0 = cell_u(ou0[j]), old_u1 = cell_u(ou1[j]), old_v0 = cell_v(ov0[j]), old_v1 = cell_v(ov1[j]);
-          stays[j] = (cell_u(nu0[j]) >= old_u0) & (cell_u(nu1[j]) <= old_u1) & (cell_v(nv0[j]) >= old_v0) &
-                     (cell_v(nv1[j]) <= old_v1);
+          const int old_u0 = g.cell_u(ou0[j]), old_u1 = g.cell_u(ou1[j]), old_v0 = g.cell_v(ov0[j]),
+                    old_v1 = g.cell_v(ov1[j]);
+          stays[j] = (g.cell_u(nu0[j]) >= old_u0) & (g.cell_u(nu1[j]) <= old_u1) & (g.cell_v(nv0[j]) >= old_v0) &
+                     (g.cell_v(nv1[j]) <= old_v1);
           lowest[j] = (old_u0 == cu) & (old_v0 == cv);
         }
         for (std::size_t j = 0; j < m; ++j) {
@@ -98,9 +95,8 @@ void SweepAndPrune::bucket_overflow(const AabbSoa& boxes) {
   // Counting sort by cell, serial: the overflow is at most n / kOverflowFraction objects and usually a few percent.
   std::uint32_t* count = overflow_start_.data() + 1;
   for (const std::uint32_t i : overflow_ids_) {
-    const int cu0 = g.cell_u(lu[i]), cu1 = g.cell_u(hu[i]), cv0 = g.cell_v(lv[i]), cv1 = g.cell_v(hv[i]);
-    for (int cv = cv0; cv <= cv1; ++cv)
-      for (int cu = cu0; cu <= cu1; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
+    g.for_each_cell(g.cell_u(lu[i]), g.cell_u(hu[i]), g.cell_v(lv[i]), g.cell_v(hv[i]),
+                    [&](std::size_t cell) { ++count[cell]; });
   }
   for (std::size_t c = 0; c < cells; ++c) overflow_start_[c + 1] += overflow_start_[c];
   overflow_entries_.resize(overflow_start_[cells]);
@@ -108,10 +104,8 @@ void SweepAndPrune::bucket_overflow(const AabbSoa& boxes) {
   std::uint32_t* offset = overflow_start_.data();
   for (const std::uint32_t i : overflow_ids_) {
     const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], i};
-    const int cu0 = g.cell_u(e.u0), cu1 = g.cell_u(e.u1), cv0 = g.cell_v(e.v0), cv1 = g.cell_v(e.v1);
-    for (int cv = cv0; cv <= cv1; ++cv)
-      for (int cu = cu0; cu <= cu1; ++cu)
-        overflow_entries_[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
+    g.for_each_cell(g.cell_u(e.u0), g.cell_u(e.u1), g.cell_v(e.v0), g.cell_v(e.v1),
+                    [&](std::size_t cell) { overflow_entries_[offset[cell]++] = e; });
   }
   // offset[c] now equals the old start of cell c + 1: shift right by one to get the starts back.
   for (std::size_t c = cells; c > 0; --c) overflow_start_[c] = overflow_start_[c - 1];

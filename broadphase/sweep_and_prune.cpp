@@ -164,15 +164,7 @@ std::size_t SweepAndPrune::count_entries(const AabbSoa& boxes) {
       const std::size_t k = std::min(kSpanBlock, end - b);
       cell_spans(g, boxes, b, k, u0, u1, v0, v1);
       for (std::size_t j = 0; j < k; ++j) {
-        const std::size_t row = static_cast<std::size_t>(v0[j]) * g.cells_u;
-        if (u0[j] == u1[j] && v0[j] == v1[j]) {  // most boxes lie in one cell
-          ++count[row + u0[j]];
-          ++total;
-          continue;
-        }
-        for (int cv = v0[j]; cv <= v1[j]; ++cv)
-          for (int cu = u0[j]; cu <= u1[j]; ++cu) ++count[static_cast<std::size_t>(cv) * g.cells_u + cu];
-        total += static_cast<std::size_t>(u1[j] - u0[j] + 1) * static_cast<std::size_t>(v1[j] - v0[j] + 1);
+        g.for_each_cell(u0[j], u1[j], v0[j], v1[j], [&](std::size_t cell) { ++count[cell], ++total; });
       }
     }
     chunk_entries_[c] = total;
@@ -219,12 +211,7 @@ void SweepAndPrune::bucket(const AabbSoa& boxes) {
       for (std::size_t j = 0; j < k; ++j) {
         const std::size_t i = b + j;
         const Entry e{lx[i], hx[i], lu[i], hu[i], lv[i], hv[i], static_cast<std::uint32_t>(i)};
-        if (u0[j] == u1[j] && v0[j] == v1[j]) {
-          out[offset[static_cast<std::size_t>(v0[j]) * g.cells_u + u0[j]]++] = e;
-          continue;
-        }
-        for (int cv = v0[j]; cv <= v1[j]; ++cv)
-          for (int cu = u0[j]; cu <= u1[j]; ++cu) out[offset[static_cast<std::size_t>(cv) * g.cells_u + cu]++] = e;
+        g.for_each_cell(u0[j], u1[j], v0[j], v1[j], [&](std::size_t cell) { out[offset[cell]++] = e; });
       }
     }
   });
