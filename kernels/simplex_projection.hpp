@@ -4,6 +4,9 @@
 // are ratios of signed sub-volumes (sub-areas projected on the best-conditioned plane), so whenever the origin is
 // classified inside, the weights are non-negative and sum to one: the result is a convex combination even on
 // nearly degenerate simplices, and exactly degenerate ones (zero volume / area / length) fall back to their faces.
+// As in GJK's classic Voronoi-region form, only sub-simplices that keep the newest vertex are candidates, and every
+// case evaluates a fixed set of them (2 edges per triangle, up to 3 faces per tetrahedron): the SIMD kernel
+// (kernels/simd/wide_gjk.inl) runs the same sequence on all lanes at once without per-lane rounds.
 #pragma once
 
 #include "kernels/math.hpp"
@@ -53,11 +56,14 @@ template <class T> const SimplexProjection<T>& closer(const SimplexProjection<T>
 
 template <class T> bool opposite_sign(T a, T b) { return (a > T(0) && b < T(0)) || (a < T(0) && b > T(0)); }
 
+/// Triangle p[i], p[j], p[k] with p[k] the newest vertex: the closest point over the face and the two edges that
+/// keep k. (Edge i-j and the old vertices belong to the previous simplex, whose closest point x GJK already has:
+/// they cannot bring |x| down, so GJK never needs them.) Edges are oriented old -> new and visited i-k, then j-k.
 template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j, int k) {
   const Vec3<T> n = cross3<T>(p[j] - p[i], p[k] - p[i]);
   const T nn = norm2(n);
-  const auto edges = [&] { return closer(closer(segment(p, i, j), segment(p, i, k)), segment(p, j, k)); };
-  if (nn == T(0)) return edges();  // collinear: the closest point lies on one of the edges
+  const auto edges = [&] { return closer(segment(p, i, k), segment(p, j, k)); };
+  if (nn == T(0)) return edges();  // collinear: the closest point lies on an edge
   // Origin projected on the triangle's plane, then 2D signed areas on the coordinate plane where the triangle's
   // projection is largest (drop the axis of the largest |n| component: best conditioned).
   const Vec3<T> p0 = n * (dot3(p[i], n) / nn);
@@ -71,37 +77,34 @@ template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j,
   const std::array<T, 3> C = {area(p0, p[j], p[k]), area(p[i], p0, p[k]), area(p[i], p[j], p0)};
   const T total = area(p[i], p[j], p[k]);
   if (total == T(0)) return edges();
-  const std::array<int, 3> id = {i, j, k};
   bool inside = true;
   for (T c : C) inside = inside && !opposite_sign(c, total);
   const T sum = C[0] + C[1] + C[2];
   if (inside && sum != T(0)) {
     SimplexProjection<T> r;
     r.count = 3;
+    const std::array<int, 3> id = {i, j, k};
     for (int m = 0; m < 3; ++m) { r.index[m] = id[m]; r.lambda[m] = C[m] / sum; }
     r.x = r.lambda[0] * p[i] + r.lambda[1] * p[j] + r.lambda[2] * p[k];
     return r;
   }
-  // Outside: the closest point is on an edge whose opposite vertex has a weight of the wrong sign.
-  SimplexProjection<T> best;
-  bool have = false;
-  for (int m = 0; m < 3; ++m) {
-    if (inside || !opposite_sign(C[m], total)) continue;
-    const SimplexProjection<T> e = segment(p, id[(m + 1) % 3], id[(m + 2) % 3]);
-    best = have ? closer(best, e) : e;
-    have = true;
-  }
-  return have ? best : edges();
+  // Outside: the closest point is on an edge whose opposite vertex has a weight of the wrong sign (edge i-k is
+  // opposite j, edge j-k opposite i). When neither has (the origin lies beyond edge i-j), both are candidates.
+  const bool via_i = !inside && opposite_sign(C[1], total), via_j = !inside && opposite_sign(C[0], total);
+  if (via_i == via_j) return edges();
+  return via_i ? segment(p, i, k) : segment(p, j, k);
 }
 
 template <class T> T det3(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) { return dot3(a, cross3(b, c)); }
 
+/// Tetrahedron p[0..3] with p[3] the newest vertex: the origin inside, or the closest point over the faces that
+/// keep vertex 3 and that the origin sees. When the origin sees only the old face 0-1-2, nothing keeping vertex 3
+/// is closer than GJK's current x: the result is "no candidate" (x infinite, count 0).
 template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   // V[m] = signed volume of the tetrahedron with vertex m replaced by the origin; their sum is the full volume.
   const std::array<T, 4> V = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]),
                               -det3(p[0], p[1], p[2])};
   const T total = V[0] + V[1] + V[2] + V[3];
-  const std::array<std::array<int, 3>, 4> face = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
   bool inside = total != T(0);
   for (T vm : V) inside = inside && !opposite_sign(vm, total);
   if (inside) {
@@ -112,13 +115,15 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
     r.x = Vec3<T>::Zero();
     return r;
   }
-  // Outside (or flat): the closest point lies on a face the origin sees, i.e. whose opposite weight is negative;
-  // a flat tetrahedron (total == 0) has no orientation, so all four faces are candidates.
+  // Outside (or flat): faces m = 0, 1, 2 (face m omits vertex m) that the origin sees, i.e. whose opposite weight
+  // has the wrong sign; a flat tetrahedron (total == 0) has no orientation, so all three are candidates.
+  const std::array<std::array<int, 2>, 3> old = {{{1, 2}, {0, 2}, {0, 1}}};
   SimplexProjection<T> best;
+  best.x = Vec3<T>::Constant(std::numeric_limits<T>::infinity());
   bool have = false;
-  for (int m = 0; m < 4; ++m) {
+  for (int m = 0; m < 3; ++m) {
     if (total != T(0) && !opposite_sign(V[m], total)) continue;
-    const SimplexProjection<T> f = triangle(p, face[m][0], face[m][1], face[m][2]);
+    const SimplexProjection<T> f = triangle(p, old[m][0], old[m][1], 3);
     best = have ? closer(best, f) : f;
     have = true;
   }
@@ -127,7 +132,9 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
 
 }  // namespace detail
 
-/// Projects the origin onto conv(p[0..n-1]), 1 <= n <= 4.
+/// GJK's projection step: the closest point to the origin of conv(p[0..n-1]), 1 <= n <= 4, over the sub-simplices
+/// that keep the newest vertex p[n-1] (the others are faces of the previous simplex, which cannot be closer than
+/// GJK's current x), plus the old vertex p[0] for a segment. count == 0 (x infinite): no such candidate is visible.
 template <class T> SimplexProjection<T> project_origin(const Vec3<T>* p, int n) {
   switch (n) {
     case 1: return detail::vertex(p, 0);

@@ -195,15 +195,6 @@ template <class T> struct WideGjk {
     r.contains = splat_mask(0);
     return r;
   }
-  /// The vertex q (input index `id` in each lane).
-  static Proj vertex(const V3& q, mask id) {
-    Proj r = empty();
-    r.x = q;
-    r.count = splat_mask(1);
-    r.index[0] = id;
-    r.lambda[0] = splat(T(1));
-    return r;
-  }
   /// Closest point of a segment, kept small while candidates are compared (7 registers instead of a Proj's 13):
   /// kind 0 = vertex i, 1 = vertex j, 2 = interior point (1 - u) qi + u qj.
   struct Edge {
@@ -238,18 +229,79 @@ template <class T> struct WideGjk {
     return r;
   }
   static Proj segment(const V3& qi, const V3& qj, mask i, mask j) { return to_proj(edge(qi, qj, i, j)); }
-  static Proj closer(const Proj& a, const Proj& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
-
   static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
     // which 0: the first kept axis (drop + 1) % 3; which 1: the second (drop + 2) % 3.
     if (which == 0) return select(drop0, p.y, select(drop1, p.z, p.x));
     return select(drop0, p.z, select(drop1, p.x, p.y));
   }
 
+  static real area(real au, real av, real bu, real bv, real cu, real cv) {
+    return (bu - au) * (cv - av) - (bv - av) * (cu - au);
+  }
+
+  /// Triangle qi, qj, qk (qk newest), the reference's triangle() up to the choice of edge: the interior point and
+  /// its weights, whether it is the answer (`use`), else which of the edges i-k, j-k are candidates.
+  struct Face {
+    V3 x;
+    real lambda[3];
+    mask use, via_i, via_j;
+  };
+  static Face face(const V3& qi, const V3& qj, const V3& qk) {
+    const real zero = splat(T(0));
+    const V3 n = cross(sub(qj, qi), sub(qk, qi));
+    const real nn = norm2(n);
+    const V3 p0 = scale(dot(qi, n) / nn, n);
+    const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
+    const mask d1 = ay > ax;
+    const mask d2 = az > select(d1, ay, ax);
+    const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
+    // The four points in the kept coordinates (u, v), selected once.
+    const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
+    const real ui = coordinate(qi, drop0, drop1, 0), vi = coordinate(qi, drop0, drop1, 1);
+    const real uj = coordinate(qj, drop0, drop1, 0), vj = coordinate(qj, drop0, drop1, 1);
+    const real uk = coordinate(qk, drop0, drop1, 0), vk = coordinate(qk, drop0, drop1, 1);
+    const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
+    const real total = area(ui, vi, uj, vj, uk, vk);
+    const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
+    const real sum = (C[0] + C[1]) + C[2];
+    Face f;
+    for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] / sum;
+    f.x = add(add(scale(f.lambda[0], qi), scale(f.lambda[1], qj)), scale(f.lambda[2], qk));
+    const mask degenerate = (nn == zero) | (total == zero);
+    f.use = ~degenerate & inside & (sum != zero);
+    // Edge i-k is opposite j (weight C[1]), edge j-k opposite i (C[0]); neither or both: both are candidates.
+    const mask wrong_i = ~degenerate & ~inside & opposite_sign(C[1], total);
+    const mask wrong_j = ~degenerate & ~inside & opposite_sign(C[0], total);
+    f.via_i = wrong_i | ~wrong_j;
+    f.via_j = wrong_j | ~wrong_i;
+    return f;
+  }
+  /// Lanes where the face's answer is edge j-k rather than edge i-k (the reference's closer(i-k, j-k) when both
+  /// are candidates: j-k only if strictly closer), given the two edges' squared norms.
+  static mask takes_j(const Face& f, real ni, real nj) { return f.via_j & (~f.via_i | (nj < ni)); }
+
+  AI static Proj face_proj(const Face& f, mask i, mask j, mask k) {
+    Proj r = empty();
+    r.x = f.x;
+    r.count = splat_mask(3);
+    r.index[0] = i, r.index[1] = j, r.index[2] = k;
+    for (int m = 0; m < 3; ++m) r.lambda[m] = f.lambda[m];
+    return r;
+  }
+
+  /// Triangle q[0], q[1], q[2] (q[2] newest): the reference's triangle(p, 0, 1, 2).
+  static Proj triangle(const V3 (&q)[3]) {
+    const Face f = face(q[0], q[1], q[2]);
+    const Edge ei = edge(q[0], q[2], splat_mask(0), splat_mask(2)), ej = edge(q[1], q[2], splat_mask(1), splat_mask(2));
+    const Proj e = to_proj(pick(takes_j(f, norm2(ei.x), norm2(ej.x)), ej, ei));
+    return pick(f.use, face_proj(f, splat_mask(0), splat_mask(1), splat_mask(2)), e);
+  }
+
+  static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
+
   /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
-  /// remaining candidate (`taken[m]` says which), so a round costs one sub-projection for all lanes, and the
-  /// number of rounds is the largest candidate count of one lane (usually 1-2), not the number of distinct
-  /// candidates over the lanes (up to 3 edges or 4 faces).
+  /// remaining candidate (`taken[m]` says which), so the number of rounds is the largest candidate count of one
+  /// lane (usually 1), not the number of distinct candidates over the lanes.
   template <int M> static mask next_round(mask (&remaining)[M], mask (&taken)[M]) {
     mask round = splat_mask(0);  // lanes that took a candidate this round
     for (int m = 0; m < M; ++m) {
@@ -260,67 +312,9 @@ template <class T> struct WideGjk {
     return round;
   }
 
-  /// Triangle q[0], q[1], q[2] (input indices id[]) per lane. `want`: the lanes whose result is used; the edge
-  /// cases are computed only when one of them needs them.
-  static Proj triangle(const V3 (&q)[3], const mask (&id)[3], mask want) {
-    const real zero = splat(T(0));
-    const V3 n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
-    const real nn = norm2(n);
-    const V3 p0 = scale(dot(q[0], n) / nn, n);
-    const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
-    const mask d1 = ay > ax;
-    const mask d2 = az > select(d1, ay, ax);
-    const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
-    // The four points in the kept coordinates (u, v), selected once.
-    const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
-    const real ui = coordinate(q[0], drop0, drop1, 0), vi = coordinate(q[0], drop0, drop1, 1);
-    const real uj = coordinate(q[1], drop0, drop1, 0), vj = coordinate(q[1], drop0, drop1, 1);
-    const real uk = coordinate(q[2], drop0, drop1, 0), vk = coordinate(q[2], drop0, drop1, 1);
-    const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
-    const real total = area(ui, vi, uj, vj, uk, vk);
-    const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
-    const real sum = (C[0] + C[1]) + C[2];
-    Proj face = empty();
-    face.count = splat_mask(3);
-    for (int m = 0; m < 3; ++m) face.index[m] = id[m];
-    for (int m = 0; m < 3; ++m) face.lambda[m] = C[m] / sum;
-    face.x = add(add(scale(face.lambda[0], q[0]), scale(face.lambda[1], q[1])), scale(face.lambda[2], q[2]));
-    const mask degenerate = (nn == zero) | (total == zero);
-    const mask use_face = ~degenerate & inside & (sum != zero);
-    if (!any(want & ~use_face)) return face;
-    // Outside: edges opposite a vertex with a weight of the wrong sign, m = 0, 1, 2 in the reference's order
-    // (edge m joins vertices m + 1 and m + 2).
-    mask remaining[3], taken[3];
-    for (int m = 0; m < 3; ++m) remaining[m] = want & ~degenerate & ~inside & opposite_sign(C[m], total);
-    Edge best{};
-    mask have = splat_mask(0);
-    for (;;) {
-      const mask round = next_round(remaining, taken);
-      if (!any(round)) break;
-      V3 from = q[1], to = q[2];
-      mask from_id = id[1], to_id = id[2];
-      for (int m = 1; m < 3; ++m) {
-        from = pick(taken[m], q[(m + 1) % 3], from), to = pick(taken[m], q[(m + 2) % 3], to);
-        from_id = select(taken[m], id[(m + 1) % 3], from_id), to_id = select(taken[m], id[(m + 2) % 3], to_id);
-      }
-      const Edge e = edge(from, to, from_id, to_id);
-      best = pick(round & have, closer(best, e), pick(round, e, best));
-      have |= round;
-    }
-    // All three edges: degenerate triangles, and the rare lanes where no weight has the wrong sign.
-    Edge edges = best;
-    if (any(want & ~use_face & (degenerate | ~have)))
-      edges = closer(closer(edge(q[0], q[1], id[0], id[1]), edge(q[0], q[2], id[0], id[2])), edge(q[1], q[2], id[1], id[2]));
-    if (!any(want & use_face)) return to_proj(pick(degenerate, edges, pick(have, best, edges)));
-    return pick(use_face, face, to_proj(pick(degenerate, edges, pick(have, best, edges))));
-  }
-
-  static real area(real au, real av, real bu, real bv, real cu, real cv) {
-    return (bu - au) * (cv - av) - (bv - av) * (cu - au);
-  }
-
-  static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
-
+  /// Tetrahedron p[0..3] (p[3] newest): the reference's tetrahedron(). The three edges to vertex 3 are computed
+  /// once; each round, every lane evaluates the next face keeping vertex 3 that it sees (face m omits vertex m),
+  /// and keeps the closest answer. `want`: lanes whose result is used.
   static Proj tetrahedron(const V3* p, mask want) {
     const real zero = splat(T(0));
     const real V[4] = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]), -det3(p[0], p[1], p[2])};
@@ -332,26 +326,47 @@ template <class T> struct WideGjk {
     in.contains = splat_mask(-1);
     for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
     if (!any(want & ~inside)) return in;
-    // Outside (or flat): the faces the origin sees, m = 0..3 in the reference's order (face m omits vertex m).
-    static constexpr int face[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-    mask remaining[4], taken[4];
-    for (int m = 0; m < 4; ++m) remaining[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
-    Proj best = empty();
+    // Edge e joins old vertex e to vertex 3.
+    const Edge E[3] = {edge(p[0], p[3], splat_mask(0), splat_mask(3)), edge(p[1], p[3], splat_mask(1), splat_mask(3)),
+                       edge(p[2], p[3], splat_mask(2), splat_mask(3))};
+    const real En[3] = {norm2(E[0].x), norm2(E[1].x), norm2(E[2].x)};
+    mask remaining[3], taken[3];
+    for (int m = 0; m < 3; ++m) remaining[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
+    // The best answer so far: a face interior (x, weights, old vertices i, j) or an edge (best_edge).
+    const real inf = splat(std::numeric_limits<T>::infinity());
+    V3 bx{inf, inf, inf};
+    real bl[3] = {zero, zero, zero}, best_n2 = inf;
+    mask bi = splat_mask(0), bj = splat_mask(0), best_edge = splat_mask(0), best_use = splat_mask(0);
     mask have = splat_mask(0);
     for (;;) {
       const mask round = next_round(remaining, taken);
       if (!any(round)) break;
-      V3 q[3] = {p[face[0][0]], p[face[0][1]], p[face[0][2]]};
-      mask id[3] = {splat_mask(face[0][0]), splat_mask(face[0][1]), splat_mask(face[0][2])};
-      for (int m = 1; m < 4; ++m)
-        for (int c = 0; c < 3; ++c) {
-          q[c] = pick(taken[m], p[face[m][c]], q[c]);
-          id[c] = select(taken[m], splat_mask(face[m][c]), id[c]);
-        }
-      const Proj f = triangle(q, id, round);
-      best = pick(round & have, closer(best, f), pick(round, f, best));
+      // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
+      const mask i = select(taken[0], splat_mask(1), splat_mask(0)), j = select(taken[2], splat_mask(1), splat_mask(2));
+      const Face f = face(pick(taken[0], p[1], p[0]), pick(taken[2], p[1], p[2]), p[3]);
+      const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
+      const mask to_j = takes_j(f, ni, nj);
+      const real n2 = select(f.use, norm2(f.x), select(to_j, nj, ni));
+      const mask take = round & (~have | (n2 < best_n2));
+      best_n2 = select(take, n2, best_n2);
+      best_use = select(take, f.use, best_use);
+      best_edge = select(take, select(to_j, j, i), best_edge);
+      bx = pick(take, f.x, bx);
+      for (int m = 0; m < 3; ++m) bl[m] = select(take, f.lambda[m], bl[m]);
+      bi = select(take, i, bi), bj = select(take, j, bj);
       have |= round;
     }
+    Edge e = E[0];
+    for (int k = 1; k < 3; ++k) e = pick(best_edge == splat_mask(k), E[k], e);
+    Proj best = to_proj(e);
+    Proj f = empty();
+    f.x = bx;
+    f.count = splat_mask(3);
+    f.index[0] = bi, f.index[1] = bj, f.index[2] = splat_mask(3);
+    for (int m = 0; m < 3; ++m) f.lambda[m] = bl[m];
+    best = pick(best_use, f, best);
+    best.x = pick(have, best.x, V3{inf, inf, inf});  // sees only the old face: no candidate
+    best.count = select(have, best.count, splat_mask(0));
     return pick(inside, in, best);
   }
 
@@ -609,8 +624,7 @@ template <class T> struct WideGjk {
         const mask four = n_after == splat_mask(4);
         if (any(live & three)) {
           const V3 q[3] = {pw[0], pw[1], pw[2]};
-          const mask id[3] = {splat_mask(0), splat_mask(1), splat_mask(2)};
-          proj = pick(three, triangle(q, id, live & three), proj);
+          proj = pick(three, triangle(q), proj);
         }
         if (any(live & four)) proj = pick(four, tetrahedron(pw, live & four), proj);
         const real next_xx = norm2(proj.x);

@@ -1,5 +1,7 @@
-// The signed-volume projection against a brute-force reference: every subset of the simplex, its affine
-// minimum-norm point solved in long double, kept when its weights are non-negative.
+// GJK's signed-volume projection step against a brute-force reference: every subset of the simplex, its affine
+// minimum-norm point solved in long double, kept when its weights are non-negative. The step only considers
+// sub-simplices that keep the newest vertex p[n-1]: it must find the true closest point whenever that point's
+// support set contains p[n-1], and otherwise return a point of the simplex (or no candidate for a tetrahedron).
 #include "kernels/simplex_projection.hpp"
 #include "support/generators.hpp"
 
@@ -12,9 +14,15 @@ namespace {
 
 using LVec = Eigen::Matrix<long double, 3, 1>;
 
-double brute_force_distance(const std::vector<Eigen::Vector3d>& p) {
+struct BruteForce {
+  double distance;
+  int support;  // bit mask of the closest point's support set
+};
+
+BruteForce brute_force(const std::vector<Eigen::Vector3d>& p) {
   const int n = static_cast<int>(p.size());
   long double best = 1e300L;
+  int support = 0;
   for (int mask = 1; mask < (1 << n); ++mask) {
     std::vector<LVec> s;
     for (int i = 0; i < n; ++i)
@@ -34,20 +42,37 @@ double brute_force_distance(const std::vector<Eigen::Vector3d>& p) {
     for (int k = 0; k < m - 1; ++k) { feasible = feasible && mu[k] >= 0; l0 -= mu[k]; }
     if (!feasible || l0 < 0) continue;
     const LVec x = s[0] + (m > 1 ? LVec(E * mu) : LVec::Zero());
-    best = std::min(best, x.norm());
+    if (x.norm() < best) best = x.norm(), support = mask;
   }
-  return static_cast<double>(best);
+  return {static_cast<double>(best), support};
+}
+
+/// Checks r against the brute force; returns whether the true closest point keeps the newest vertex.
+bool check_step(const std::vector<Eigen::Vector3d>& p, const SimplexProjection<double>& r, double tol, int trial) {
+  const int n = static_cast<int>(p.size());
+  const BruteForce ref = brute_force(p);
+  const bool keeps_newest = (ref.support >> (n - 1)) & 1;
+  if (keeps_newest) EXPECT_NEAR(r.x.norm(), ref.distance, tol) << "trial " << trial;
+  if (r.count == 0) {  // no candidate: only a tetrahedron whose closest point lies on the old face
+    EXPECT_EQ(n, 4) << "trial " << trial;
+    EXPECT_FALSE(keeps_newest) << "trial " << trial;
+    EXPECT_TRUE(std::isinf(r.x.norm())) << "trial " << trial;
+    return keeps_newest;
+  }
+  EXPECT_GE(r.x.norm(), ref.distance - tol) << "trial " << trial;
+  return keeps_newest;
 }
 
 TEST(SimplexProjection, MatchesBruteForceOnRandomSimplices) {
   testing::Rng rng(7);
+  int exact = 0, skipped = 0;
   for (int trial = 0; trial < 4000; ++trial) {
     const int n = 1 + trial % 4;
     std::vector<Eigen::Vector3d> p;
     for (int i = 0; i < n; ++i) p.push_back(Eigen::Vector3d::Random() + Eigen::Vector3d::Constant(trial % 3 == 0 ? 0.0 : 0.7));
     const SimplexProjection<double> r = project_origin(p.data(), n);
-    const double ref = brute_force_distance(p);
-    ASSERT_NEAR(r.x.norm(), ref, 1e-12) << "trial " << trial;
+    (check_step(p, r, 1e-12, trial) ? exact : skipped) += 1;
+    if (r.count == 0) continue;
     double sum = 0;
     Eigen::Vector3d x = Eigen::Vector3d::Zero();
     for (int k = 0; k < r.count; ++k) {
@@ -58,6 +83,22 @@ TEST(SimplexProjection, MatchesBruteForceOnRandomSimplices) {
     EXPECT_NEAR(sum, 1.0, 1e-12);
     if (!r.contains_origin) EXPECT_LT((x - r.x).norm(), 1e-12);
   }
+  EXPECT_GT(exact, 2000);  // most random simplices have their closest point on the newest vertex's side
+  EXPECT_GT(skipped, 100);
+}
+
+TEST(SimplexProjection, OldFaceClosestGivesNoCandidate) {
+  // The origin sees only face 0-1-2 (below it); vertex 3 is on the far side: nothing keeping vertex 3 is closer.
+  const std::vector<Eigen::Vector3d> p = {{-1, -1, 1}, {1, -1, 1}, {0, 1, 1}, {0, 0, 3}};
+  const auto r = project_origin(p.data(), 4);
+  EXPECT_EQ(r.count, 0);
+  EXPECT_FALSE(r.contains_origin);
+  EXPECT_TRUE(std::isinf(r.x.norm()));
+  // Same points with the roles swapped (vertex 0 newest on the near face): the closest point keeps it.
+  const std::vector<Eigen::Vector3d> q = {{0, 0, 3}, {-1, -1, 1}, {1, -1, 1}, {0, 1, 1}};
+  const auto s = project_origin(q.data(), 4);
+  EXPECT_EQ(s.count, 3);
+  EXPECT_NEAR(s.x.norm(), 1.0, 1e-15);
 }
 
 TEST(SimplexProjection, DegenerateSimplicesGiveFiniteConvexCombinations) {
@@ -67,7 +108,7 @@ TEST(SimplexProjection, DegenerateSimplicesGiveFiniteConvexCombinations) {
   for (const auto& p : cases) {
     const auto r = project_origin(p.data(), static_cast<int>(p.size()));
     ASSERT_TRUE(r.x.allFinite());
-    EXPECT_NEAR(r.x.norm(), brute_force_distance(p), 1e-12);
+    check_step(p, r, 1e-12, 0);
   }
 }
 
@@ -90,7 +131,9 @@ TEST(SimplexProjection, FloatVersionStaysWithinFloatRounding) {
       pf.push_back(p.back().cast<float>());
     }
     const auto r = project_origin(pf.data(), n);
-    EXPECT_NEAR(r.x.norm(), brute_force_distance(p), 2e-6) << trial;
+    const BruteForce ref = brute_force(p);
+    if ((ref.support >> (n - 1)) & 1) EXPECT_NEAR(r.x.norm(), ref.distance, 2e-6) << trial;
+    else if (r.count > 0) EXPECT_GE(r.x.norm(), ref.distance - 2e-6) << trial;
   }
 }
 
