@@ -205,7 +205,6 @@ template <class T> struct WideGjk {
   AI static Edge pick(mask m, const Edge& a, const Edge& b) {
     return {pick(m, a.x, b.x), select(m, a.u, b.u), select(m, a.kind, b.kind), select(m, a.i, b.i), select(m, a.j, b.j)};
   }
-  AI static Edge closer(const Edge& a, const Edge& b) { return pick(norm2(b.x) < norm2(a.x), b, a); }
   /// The segment from qi to qj (input indices i, j in each lane): the reference's segment(), same operations.
   AI static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
     const V3 t = sub(qj, qi);
@@ -334,8 +333,10 @@ template <class T> struct WideGjk {
     for (int m = 0; m < 3; ++m) remaining[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
     // The best answer so far: a face interior (x, weights, old vertices i, j) or an edge (best_edge).
     const real inf = splat(std::numeric_limits<T>::infinity());
-    V3 bx{inf, inf, inf};
-    real bl[3] = {zero, zero, zero}, best_n2 = inf;
+    Face bf;  // its x and weights
+    bf.x = {inf, inf, inf};
+    for (int m = 0; m < 3; ++m) bf.lambda[m] = zero;
+    real best_n2 = inf;
     mask bi = splat_mask(0), bj = splat_mask(0), best_edge = splat_mask(0), best_use = splat_mask(0);
     mask have = splat_mask(0);
     for (;;) {
@@ -351,20 +352,14 @@ template <class T> struct WideGjk {
       best_n2 = select(take, n2, best_n2);
       best_use = select(take, f.use, best_use);
       best_edge = select(take, select(to_j, j, i), best_edge);
-      bx = pick(take, f.x, bx);
-      for (int m = 0; m < 3; ++m) bl[m] = select(take, f.lambda[m], bl[m]);
+      bf.x = pick(take, f.x, bf.x);
+      for (int m = 0; m < 3; ++m) bf.lambda[m] = select(take, f.lambda[m], bf.lambda[m]);
       bi = select(take, i, bi), bj = select(take, j, bj);
       have |= round;
     }
     Edge e = E[0];
     for (int k = 1; k < 3; ++k) e = pick(best_edge == splat_mask(k), E[k], e);
-    Proj best = to_proj(e);
-    Proj f = empty();
-    f.x = bx;
-    f.count = splat_mask(3);
-    f.index[0] = bi, f.index[1] = bj, f.index[2] = splat_mask(3);
-    for (int m = 0; m < 3; ++m) f.lambda[m] = bl[m];
-    best = pick(best_use, f, best);
+    Proj best = pick(best_use, face_proj(bf, bi, bj, splat_mask(3)), to_proj(e));
     best.x = pick(have, best.x, V3{inf, inf, inf});  // sees only the old face: no candidate
     best.count = select(have, best.count, splat_mask(0));
     return pick(inside, in, best);
