@@ -4,9 +4,10 @@
 // are ratios of signed sub-volumes (sub-areas projected on the best-conditioned plane), so whenever the origin is
 // classified inside, the weights are non-negative and sum to one: the result is a convex combination even on
 // nearly degenerate simplices, and exactly degenerate ones (zero volume / area / length) fall back to their faces.
-// As in GJK's classic Voronoi-region form, only sub-simplices that keep the newest vertex are candidates, and every
-// case evaluates a fixed set of them (2 edges per triangle, up to 3 faces per tetrahedron): the SIMD kernel
-// (kernels/simd/wide_gjk.inl) runs the same sequence on all lanes at once without per-lane rounds.
+// As in GJK's classic Voronoi-region form, only sub-simplices that keep the newest vertex are candidates: 2 edges per
+// triangle, and per tetrahedron the faces through the newest vertex that the origin sees (at most 3), visited in a
+// fixed order. The SIMD kernel (kernels/simd/wide_gjk.inl) runs the triangle on all lanes at once and the
+// tetrahedron in one round per visible face, with the same arithmetic.
 #pragma once
 
 #include "kernels/math.hpp"

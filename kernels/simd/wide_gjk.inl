@@ -288,12 +288,14 @@ template <class T> struct WideGjk {
     return r;
   }
 
-  /// Triangle q[0], q[1], q[2] (q[2] newest): the reference's triangle(p, 0, 1, 2).
-  static Proj triangle(const V3 (&q)[3]) {
-    const Face f = face(q[0], q[1], q[2]);
-    const Edge ei = edge(q[0], q[2], splat_mask(0), splat_mask(2)), ej = edge(q[1], q[2], splat_mask(1), splat_mask(2));
-    const Proj e = to_proj(pick(takes_j(f, norm2(ei.x), norm2(ej.x)), ej, ei));
-    return pick(f.use, face_proj(f, splat_mask(0), splat_mask(1), splat_mask(2)), e);
+  /// Triangle p[0], p[1], p[2] (p[2] newest): the reference's triangle(p, 0, 1, 2). `want`: lanes whose result is
+  /// used; the edges are computed only when one of them is outside the face.
+  static Proj triangle(const V3* p, mask want) {
+    const Face f = face(p[0], p[1], p[2]);
+    const Proj in = face_proj(f, splat_mask(0), splat_mask(1), splat_mask(2));
+    if (!any(want & ~f.use)) return in;
+    const Edge ei = edge(p[0], p[2], splat_mask(0), splat_mask(2)), ej = edge(p[1], p[2], splat_mask(1), splat_mask(2));
+    return pick(f.use, in, to_proj(pick(takes_j(f, norm2(ei.x), norm2(ej.x)), ej, ei)));
   }
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
@@ -617,10 +619,7 @@ template <class T> struct WideGjk {
         Proj proj = empty();
         if (any(live & two)) proj = pick(two, segment(pw[0], pw[1], splat_mask(0), splat_mask(1)), proj);
         const mask four = n_after == splat_mask(4);
-        if (any(live & three)) {
-          const V3 q[3] = {pw[0], pw[1], pw[2]};
-          proj = pick(three, triangle(q), proj);
-        }
+        if (any(live & three)) proj = pick(three, triangle(pw, live & three), proj);
         if (any(live & four)) proj = pick(four, tetrahedron(pw, live & four), proj);
         const real next_xx = norm2(proj.x);
 
