@@ -22,7 +22,7 @@ struct PairView {
   // Shape fields as base pointers into the ShapeTable plus its stride in bytes (no Eigen code in the kernels).
   const double* shape_size = nullptr;       // Shape::size[0] of shape 0; [1], [2] follow
   const double* shape_inflation = nullptr;  // Shape::inflation of shape 0
-  std::size_t shape_stride = 0;
+  std::uint32_t shape_stride = 0;  // sizeof(Shape)
   std::uint32_t shape_count = 0;
   const Shape* shapes = nullptr;  // the table itself, for the per-lane setup of the batch-array GJK
 

@@ -14,6 +14,9 @@ struct PairLanes {
   struct V3 {
     real x, y, z;
   };
+  /// `real` at any double-aligned address: a plain vector load / store, which keeps the value in a register
+  /// (a memcpy into a local made GCC 12 round-trip the lanes through the stack: +50 instructions per block).
+  typedef double unaligned_real __attribute__((vector_size(sizeof(double) * W), aligned(alignof(double))));
   static real splat(double v) { return real{} + v; }
   static V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
   static V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -25,11 +28,13 @@ struct PairLanes {
   /// |v|: the sign bit cleared (vector casts between same-size types reinterpret the bits).
   static real abs(real v) { return real(mask(v) & (mask{} + Int(0x7fffffffffffffffLL))); }
 
-  /// Lane l = a[idx[l]]: one vector load when the indices are consecutive.
-  static real load(const double* a, const std::uint32_t* idx, bool consecutive) {
+  /// Lane l = a[idx[l]]: one vector load when the indices are consecutive. The closed forms pass `Consecutive`
+  /// as a template argument so that their consecutive blocks compile to straight vector loads, without a branch
+  /// per load and with the pointers free to stay in registers.
+  template <bool Consecutive> static real load(const double* a, const std::uint32_t* idx) {
     real r;
-    if (consecutive) {
-      __builtin_memcpy(&r, a + idx[0], sizeof r);
+    if constexpr (Consecutive) {
+      r = *reinterpret_cast<const unaligned_real*>(a + idx[0]);
     } else {
       for (int l = 0; l < W; ++l) r[l] = a[idx[l]];
     }
@@ -38,7 +43,7 @@ struct PairLanes {
   /// a[idx[l]] = lane l for the lanes set in `lanes` (all of them when `whole`: one vector store).
   static void store(double* a, const std::uint32_t* idx, bool whole, real v, std::uint32_t lanes) {
     if (whole) {
-      __builtin_memcpy(a + idx[0], &v, sizeof v);
+      *reinterpret_cast<unaligned_real*>(a + idx[0]) = v;
     } else {
       for (int l = 0; l < W; ++l)
         if ((lanes >> l) & 1u) a[idx[l]] = v[l];
@@ -56,19 +61,22 @@ struct PairLanes {
   };
   // Always inlined: with several kernels calling them, GCC stops inlining these on its own (measured: sphere-sphere
   // 127 -> 175 instructions per pair when the batch-array GJK became a third caller).
-  __attribute__((always_inline)) static Pose load_pose(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
-                        const double* const q[4], const std::uint32_t* idx, bool consecutive) {
+  template <bool Consecutive>
+  __attribute__((always_inline)) static Pose load_pose(const PairView& in, const std::uint32_t* shape_index,
+                                                       const double* const t[3], const double* const q[4],
+                                                       const std::uint32_t* idx) {
     Pose p;
-    p.t = {load(t[0], idx, consecutive), load(t[1], idx, consecutive), load(t[2], idx, consecutive)};
-    p.w = load(q[0], idx, consecutive), p.x = load(q[1], idx, consecutive), p.y = load(q[2], idx, consecutive),
-    p.z = load(q[3], idx, consecutive);
+    p.t = {load<Consecutive>(t[0], idx), load<Consecutive>(t[1], idx), load<Consecutive>(t[2], idx)};
+    p.w = load<Consecutive>(q[0], idx), p.x = load<Consecutive>(q[1], idx), p.y = load<Consecutive>(q[2], idx),
+    p.z = load<Consecutive>(q[3], idx);
     p.norm = wsqrt<double>(((p.w * p.w + p.x * p.x) + p.y * p.y) + p.z * p.z);
     const real deviation = p.norm - splat(1.0), zero = splat(0.0);
+    // t - t is 0 for finite t and NaN otherwise, and a NaN makes the sum NaN: one comparison for three.
     p.valid = (deviation <= splat(kUnitTolerance)) & (deviation >= splat(-kUnitTolerance)) &
-              (p.t.x - p.t.x == zero) & (p.t.y - p.t.y == zero) & (p.t.z - p.t.z == zero);
+              (((p.t.x - p.t.x) + (p.t.y - p.t.y)) + (p.t.z - p.t.z) == zero);
     typedef std::uint32_t lanes32 __attribute__((vector_size(sizeof(std::uint32_t) * W)));
     lanes32 raw;
-    if (consecutive) {
+    if constexpr (Consecutive) {
       __builtin_memcpy(&raw, shape_index + idx[0], sizeof raw);
     } else {
       for (int l = 0; l < W; ++l) raw[l] = shape_index[idx[l]];
@@ -76,8 +84,12 @@ struct PairLanes {
     const mask shape = __builtin_convertvector(raw, mask);  // zero-extended to 64-bit lanes
     const mask in_range = shape < (mask{} + Int(in.shape_count));
     p.valid &= in_range;
-    p.shape = select(in_range, shape, mask{}) * Int(in.shape_stride);
+    p.shape = mul_u32(select(in_range, shape, mask{}), in.shape_stride);
     return p;
+  }
+  static Pose load_pose(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
+                        const double* const q[4], const std::uint32_t* idx, bool consecutive) {
+    return consecutive ? load_pose<true>(in, shape_index, t, q, idx) : load_pose<false>(in, shape_index, t, q, idx);
   }
   /// Shape field at `base` (a field of shape 0, e.g. in.shape_size + 1) for each lane's shape.
   static real field(const double* base, const Pose& p) { return gather_bytes<double>(base, p.shape); }
@@ -105,10 +117,16 @@ struct PairLanes {
   };
   static Block block(const std::uint32_t* pairs, std::size_t n, std::size_t k) {
     Block b;
-    b.lanes = n - k < std::size_t(W) ? int(n - k) : W;
+    if (n - k >= std::size_t(W)) {  // full block: a straight copy (one vector move), no per-lane clamp
+      __builtin_memcpy(b.idx, pairs + k, sizeof b.idx);
+      b.lanes = W;
+      b.live = (1u << W) - 1u;
+      b.consecutive = b.idx[W - 1] - b.idx[0] == std::uint32_t(W - 1);
+      return b;
+    }
+    b.lanes = int(n - k);
     for (int l = 0; l < W; ++l) b.idx[l] = pairs[k + std::size_t(l < b.lanes ? l : b.lanes - 1)];
     b.live = (1u << b.lanes) - 1u;  // W <= 16
-    b.consecutive = b.lanes == W && b.idx[W - 1] - b.idx[0] == std::uint32_t(W - 1);
     return b;
   }
 
@@ -130,16 +148,23 @@ struct PairLanes {
     }
   }
 
+  /// Byte l = bit l of `bits` (0 or 1), for up to 8 lanes. Each nibble spreads by one multiply: bit i of the
+  /// nibble, shifted by 7 i, lands on bit 8 i, and the four shifted copies do not overlap (no carries).
+  static std::uint64_t bits_to_bytes(std::uint32_t bits) {
+    const auto spread = [](std::uint32_t nibble) { return std::uint64_t((nibble * 0x204081u) & 0x01010101u); };
+    return spread(bits & 15u) | (spread((bits >> 4) & 15u) << 32);
+  }
+  static_assert(W <= 8, "bits_to_bytes covers 8 lanes");
+
   /// Writes status converged and collide for the answered lanes (`mine`), appends the others to `fallback`.
   /// Returns whether the block was answered whole with consecutive indices (vector stores allowed).
   static bool write_collide(const Block& b, std::uint32_t mine, mask collide, const ResultView& out,
                             std::uint32_t* fallback, std::size_t& fallbacks) {
     const std::uint32_t hits = lane_bits(collide);
     if (b.consecutive && mine == b.live) {
-      std::uint8_t bytes[W];
-      for (int l = 0; l < W; ++l) bytes[l] = std::uint8_t((hits >> l) & 1u);
-      __builtin_memcpy(out.collide + b.idx[0], bytes, W);
-      for (int l = 0; l < W; ++l) out.status[b.idx[0] + std::uint32_t(l)] = Status::converged;
+      const std::uint64_t bytes = bits_to_bytes(hits);  // little-endian: byte l = bit l
+      __builtin_memcpy(out.collide + b.idx[0], &bytes, W);
+      __builtin_memset(out.status + b.idx[0], int(Status::converged), W);
       return true;
     }
     for (int l = 0; l < b.lanes; ++l) {

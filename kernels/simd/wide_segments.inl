@@ -25,11 +25,11 @@ struct WideSegments : PairLanes {
     mask valid;
   };
 
-  template <bool Capsule>
+  template <bool Capsule, bool Consecutive>
   __attribute__((always_inline)) static Side load_side(const PairView& in, const std::uint32_t* shape_index,
                                                        const double* const t[3], const double* const q[4],
                                                        const Block& b) {
-    Pose p = load_pose(in, shape_index, t, q, b.idx, b.consecutive);
+    Pose p = load_pose<Consecutive>(in, shape_index, t, q, b.idx);
     Side s;
     s.valid = p.valid;
     s.radius = field(in.shape_size, p) + field(in.shape_inflation, p);
@@ -47,7 +47,7 @@ struct WideSegments : PairLanes {
 
   /// Closest points ca on A's segment and cb on B's (closest_points_segments in closed_forms.hpp, as selects).
   template <bool CapsuleA, bool CapsuleB>
-  static void closest_points(const Side& A, const Side& B, V3& ca, V3& cb) {
+  __attribute__((always_inline)) static void closest_points(const Side& A, const Side& B, V3& ca, V3& cb) {
     if (!CapsuleA && !CapsuleB) {
       ca = A.p0, cb = B.p0;
       return;
@@ -81,8 +81,12 @@ struct WideSegments : PairLanes {
   /// Answers pairs[0 .. n) (all of types A-B, each a sphere or a capsule); indices of the pairs it leaves to the
   /// scalar path go to fallback[0 .. returned count).
   template <bool CapsuleA, bool CapsuleB>
-  static std::size_t run(const PairView& in, const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
-                         const ResultView& out, std::uint32_t* fallback) {
+  static std::size_t run(const PairView& in_arg, const std::uint32_t* pairs, std::size_t n,
+                         const ClosedFormQuery& query, const ResultView& out_arg, std::uint32_t* fallback) {
+    // Local copies: the collide and status stores are bytes, which may alias anything, so with the caller's
+    // structs the compiler would reload every array pointer after them.
+    const PairView in = in_arg;
+    const ResultView out = out_arg;
     std::size_t fallbacks = 0;
     if (in.shape_count == 0) {
       for (std::size_t k = 0; k < n; ++k) fallback[fallbacks++] = pairs[k];
@@ -90,37 +94,45 @@ struct WideSegments : PairLanes {
     }
     for (std::size_t k = 0; k < n; k += W) {
       const Block b = block(pairs, n, k);
-      const Side A = load_side<CapsuleA>(in, in.shape_a, in.translation_a, in.rotation_a, b);
-      const Side B = load_side<CapsuleB>(in, in.shape_b, in.translation_b, in.rotation_b, b);
-      V3 ca, cb;
-      closest_points<CapsuleA, CapsuleB>(A, B, ca, cb);
-      const V3 v = sub(cb, ca);
-      const real core = wsqrt<double>(dot(v, v));
-      const real signed_distance = (core - A.radius) - B.radius;
-      // Touching cores (the scalar rule in segments_with_radii: within kSegmentTouchUlps of the coordinates)
-      // need the scalar path's normal.
-      const real coordinates = wmax(wmax(max_abs(A.p0), max_abs(A.p1)), wmax(max_abs(B.p0), max_abs(B.p1)));
-      const real touch = splat(kSegmentTouchUlps * std::numeric_limits<double>::epsilon()) * coordinates;
-      const mask answered = A.valid & B.valid & (core > touch);
-      const std::uint32_t mine = lane_bits(answered) & b.live;
-      const bool whole =
-          write_collide(b, mine, signed_distance <= splat(query.margin), out, fallback, fallbacks);
-      const bool has_distance = query.level >= QueryLevel::distance, has_points = query.level >= QueryLevel::witness;
-      write_defaults(b, whole, mine, has_distance, has_points, out);
-      if (has_distance) store(out.distance, b.idx, whole, signed_distance, mine);
-      if (has_points) {
-        const real safe_core = select(answered, core, splat(1.0));
-        const V3 normal{v.x / safe_core, v.y / safe_core, v.z / safe_core};
-        const V3 wa = add(ca, scale(A.radius, normal)), wb = sub(cb, scale(B.radius, normal));
-        const V3* vecs[3] = {&wa, &wb, &normal};
-        double* const* dst[3] = {out.witness_a, out.witness_b, out.normal};
-        for (int j = 0; j < 3; ++j) {
-          store(dst[j][0], b.idx, whole, vecs[j]->x, mine);
-          store(dst[j][1], b.idx, whole, vecs[j]->y, mine);
-          store(dst[j][2], b.idx, whole, vecs[j]->z, mine);
-        }
-      }
+      if (b.consecutive) answer<CapsuleA, CapsuleB, true>(in, b, query, out, fallback, fallbacks);
+      else answer<CapsuleA, CapsuleB, false>(in, b, query, out, fallback, fallbacks);
     }
     return fallbacks;
+  }
+
+  /// One block of W pairs.
+  template <bool CapsuleA, bool CapsuleB, bool Consecutive>
+  __attribute__((always_inline)) static void answer(const PairView& in, const Block& b, const ClosedFormQuery& query,
+                                                    const ResultView& out, std::uint32_t* fallback,
+                                                    std::size_t& fallbacks) {
+    const Side A = load_side<CapsuleA, Consecutive>(in, in.shape_a, in.translation_a, in.rotation_a, b);
+    const Side B = load_side<CapsuleB, Consecutive>(in, in.shape_b, in.translation_b, in.rotation_b, b);
+    V3 ca, cb;
+    closest_points<CapsuleA, CapsuleB>(A, B, ca, cb);
+    const V3 v = sub(cb, ca);
+    const real core = wsqrt<double>(dot(v, v));
+    const real signed_distance = (core - A.radius) - B.radius;
+    // Touching cores (the scalar rule in segments_with_radii: within kSegmentTouchUlps of the coordinates)
+    // need the scalar path's normal.
+    const real coordinates = wmax(wmax(max_abs(A.p0), max_abs(A.p1)), wmax(max_abs(B.p0), max_abs(B.p1)));
+    const real touch = splat(kSegmentTouchUlps * std::numeric_limits<double>::epsilon()) * coordinates;
+    const mask answered = A.valid & B.valid & (core > touch);
+    const std::uint32_t mine = lane_bits(answered) & b.live;
+    const bool whole = write_collide(b, mine, signed_distance <= splat(query.margin), out, fallback, fallbacks);
+    const bool has_distance = query.level >= QueryLevel::distance, has_points = query.level >= QueryLevel::witness;
+    write_defaults(b, whole, mine, has_distance, has_points, out);
+    if (has_distance) store(out.distance, b.idx, whole, signed_distance, mine);
+    if (has_points) {
+      const real safe_core = select(answered, core, splat(1.0));
+      const V3 normal{v.x / safe_core, v.y / safe_core, v.z / safe_core};
+      const V3 wa = add(ca, scale(A.radius, normal)), wb = sub(cb, scale(B.radius, normal));
+      const V3* vecs[3] = {&wa, &wb, &normal};
+      double* const* dst[3] = {out.witness_a, out.witness_b, out.normal};
+      for (int j = 0; j < 3; ++j) {
+        store(dst[j][0], b.idx, whole, vecs[j]->x, mine);
+        store(dst[j][1], b.idx, whole, vecs[j]->y, mine);
+        store(dst[j][2], b.idx, whole, vecs[j]->z, mine);
+      }
+    }
   }
 };
