@@ -130,7 +130,17 @@ double Shape::bounding_radius() const {
 
 std::uint32_t ShapeTable::add(Shape shape) {
   if (shapes_.size() >= std::numeric_limits<std::uint32_t>::max()) throw InputError("shape table is full");
+  const ShapeType type = shape.type;
+  const double radius = shape.bounding_radius();
   shapes_.push_back(std::move(shape));
+  try {  // the three arrays grow together: a failed allocation leaves the table as it was
+    types_.push_back(type);
+    bounding_radii_.push_back(radius);
+  } catch (...) {
+    shapes_.pop_back();
+    if (types_.size() > shapes_.size()) types_.pop_back();
+    throw;
+  }
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

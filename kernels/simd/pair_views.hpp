@@ -25,6 +25,7 @@ struct PairView {
   std::uint32_t shape_stride = 0;  // sizeof(Shape)
   std::uint32_t shape_count = 0;
   const Shape* shapes = nullptr;  // the table itself, for the per-lane setup of the batch-array GJK
+  const double* bounding_radii = nullptr;  // ShapeTable::bounding_radii()
 
   static PairView of(const ShapeTable& shapes, const PairBatch& batch) {
     PairView v;
@@ -41,6 +42,7 @@ struct PairView {
     v.shape_count = static_cast<std::uint32_t>(shapes.size());
     v.shape_stride = sizeof(Shape);
     v.shapes = shapes.shapes().data();
+    v.bounding_radii = shapes.bounding_radii().data();
     if (shapes.size() > 0) {
       v.shape_size = shapes[0].size.data();
       v.shape_inflation = &shapes[0].inflation;

@@ -111,7 +111,8 @@ template <class T> struct WideGjkPairs {
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) q.X.R(i, j) = T(chunk.R[3 * i + j][s]);
       q.X.t = t.template cast<T>();
-      set_gjk_parameters(q, a.bounding_radius(), b.bounding_radius(), norm3(t), no_warm, options);
+      set_gjk_parameters(q, in.bounding_radii[chunk.shape_a[s]], in.bounding_radii[chunk.shape_b[s]], norm3(t),
+                         no_warm, options);
       G::refill(L, l, q, std::int64_t(s), options.solver);
 
       LanePair& lp = lane[l];

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 #include <limits>
 
@@ -81,6 +82,21 @@ TEST(Shapes, TableStoresEachShapeOnceAndHullsAreShared) {
   const auto a = table.add(hull), b = table.add(hull.inflated(0.1));
   EXPECT_EQ(table.size(), 2u);
   EXPECT_EQ(table[a].hull.get(), table[b].hull.get());
+}
+
+TEST(Shapes, TableKeepsTypesAndBoundingRadiiInStep) {
+  ShapeTable table;
+  const Shape shapes[] = {Shape::sphere(0.5), Shape::box(0.1, 0.2, 0.3).inflated(0.05), Shape::cylinder(0.2, 0.4),
+                          Shape::halfspace({0, 0, 1}, 0.0)};
+  for (const Shape& s : shapes) table.add(s);
+  ASSERT_EQ(table.types().size(), table.size());
+  ASSERT_EQ(table.bounding_radii().size(), table.size());
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    EXPECT_EQ(table.types()[i], shapes[i].type) << i;
+    EXPECT_EQ(table.bounding_radii()[i], shapes[i].bounding_radius()) << i;  // the same function: the same bits
+  }
+  EXPECT_DOUBLE_EQ(table.bounding_radii()[1], std::sqrt(0.01 + 0.04 + 0.09) + 0.05);
+  EXPECT_EQ(table.bounding_radii()[3], std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

@@ -87,9 +87,15 @@ class ShapeTable {
   std::size_t size() const { return shapes_.size(); }
   const Shape& operator[](std::size_t i) const { return shapes_[i]; }
   const std::vector<Shape>& shapes() const { return shapes_; }
+  /// Per shape, kept at add() (shapes never change afterwards): its type, and its bounding_radius(). The executor
+  /// reads these contiguous arrays per pair instead of the Shape records.
+  const std::vector<ShapeType>& types() const { return types_; }
+  const std::vector<double>& bounding_radii() const { return bounding_radii_; }
 
  private:
   std::vector<Shape> shapes_;
+  std::vector<ShapeType> types_;
+  std::vector<double> bounding_radii_;
 };
 
 }  // namespace batchcol
