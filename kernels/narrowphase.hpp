@@ -78,7 +78,7 @@ void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, d
   s.scale = T(bounding_a + bounding_b + t_norm);
   s.floor = tolerance_floor(s.scale);
   GjkParams<T>& params = s.params;
-  params.solver = opt.solver;
+  params.solver = resolve_solver(opt.solver, opt.level);
   params.tolerance = std::max(T(opt.tolerance), s.floor);
   params.relative_tolerance = T(opt.relative_tolerance);
   params.max_iterations = opt.max_iterations;

@@ -267,8 +267,10 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
 
 }  // namespace
 
-void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results) {
-  validate(options);
+void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& requested, PairResults& results) {
+  validate(requested);
+  QueryOptions options = requested;  // the kernels see the solver that runs, never `automatic`
+  options.solver = resolve_solver(requested.solver, requested.level);
   detail::validate_batch_layout(batch);
   detail::size_results(results, batch.size());  // every pair's fields are written once, by its kernel
   const std::size_t n = batch.size();

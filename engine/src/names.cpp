@@ -29,7 +29,7 @@ const char* name_of(Enum value, const char* const (&names)[N]) {
 constexpr const char* kShapeTypeNames[] = {"sphere", "capsule", "box",    "cylinder", "cone",
                                            "ellipsoid", "convex", "triangle", "halfspace"};
 constexpr const char* kQueryLevelNames[] = {"boolean", "distance", "witness", "penetration"};
-constexpr const char* kSolverNames[] = {"gjk", "nesterov", "polyak"};
+constexpr const char* kSolverNames[] = {"gjk", "nesterov", "polyak", "automatic"};
 constexpr const char* kPrecisionNames[] = {"double", "float"};
 constexpr const char* kStatusNames[] = {"converged", "max_iterations", "degenerate", "invalid_input"};
 constexpr const char* kInstructionSetNames[] = {"automatic", "scalar", "avx2", "avx512"};

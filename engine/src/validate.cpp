@@ -48,7 +48,7 @@ void validate(const QueryOptions& o) {
   if (o.epa_max_iterations < 1) fail("epa_max_iterations must be >= 1");
   if (o.threads < 0) fail("threads must be >= 0 (0 = all cores)");
   if (static_cast<int>(o.level) > static_cast<int>(QueryLevel::penetration)) fail("level is not a QueryLevel");
-  if (static_cast<int>(o.solver) > static_cast<int>(Solver::polyak)) fail("solver is not a Solver");
+  if (static_cast<int>(o.solver) > static_cast<int>(Solver::automatic)) fail("solver is not a Solver");
   if (static_cast<int>(o.precision) > static_cast<int>(Precision::float32)) fail("precision is not a Precision");
 }
 

@@ -4,6 +4,7 @@
 #include "kernels/simd/wide_gjk.hpp"
 
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 
 namespace batchcol::kernels::simd {
@@ -53,6 +54,7 @@ int lane_count(InstructionSet isa, Precision precision) {
 template <>
 void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size_t n, GjkResult<double>* out,
                        Solver solver, bool points) {
+  if (solver == Solver::automatic) throw std::invalid_argument("gjk_lanes: resolve the solver first (resolve_solver)");
   switch (isa) {
     case InstructionSet::avx512: return avx512::gjk_lanes_double(s, n, out, solver, points);
     case InstructionSet::avx2: return avx2::gjk_lanes_double(s, n, out, solver, points);
@@ -63,6 +65,7 @@ void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size
 template <>
 void gjk_lanes<float>(InstructionSet isa, const PairSetup<float>* s, std::size_t n, GjkResult<float>* out,
                       Solver solver, bool points) {
+  if (solver == Solver::automatic) throw std::invalid_argument("gjk_lanes: resolve the solver first (resolve_solver)");
   switch (isa) {
     case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver, points);
     case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver, points);
@@ -93,10 +96,12 @@ template <>
 std::size_t gjk_pairs<double>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                               const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                               const ResultView& out, std::uint32_t* fallback) {
+  QueryOptions o = options;  // the lanes run the resolved solver
+  o.solver = resolve_solver(options.solver, options.level);
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
-    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
+    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
   }
 }
 
@@ -104,10 +109,12 @@ template <>
 std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                              const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                              const ResultView& out, std::uint32_t* fallback) {
+  QueryOptions o = options;  // the lanes run the resolved solver
+  o.solver = resolve_solver(options.solver, options.level);
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
-    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
+    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
   }
 }
 

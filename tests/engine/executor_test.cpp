@@ -208,6 +208,36 @@ TEST(Executor, MarginMakesNearPairsCollide) {
     }
 }
 
+// The default solver is `automatic`: polyak for boolean queries, gjk for the other levels. Its results are the
+// named solver's, bit for bit, and not those of the other solvers (iteration counts differ on some pair).
+TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
+  EXPECT_EQ(QueryOptions{}.solver, Solver::automatic);
+  EXPECT_EQ(resolve_solver(Solver::automatic, QueryLevel::boolean), Solver::polyak);
+  for (QueryLevel level : {QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration})
+    EXPECT_EQ(resolve_solver(Solver::automatic, level), Solver::gjk);
+  for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak})
+    EXPECT_EQ(resolve_solver(named, QueryLevel::boolean), named);
+
+  const Scene s = mixed_scene(3000, 5);
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::witness, QueryLevel::penetration}) {
+    QueryOptions automatic;
+    automatic.level = level;
+    PairResults got;
+    collide(s.shapes, s.batch, automatic, got);
+    for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
+      QueryOptions o = automatic;
+      o.solver = named;
+      PairResults want;
+      collide(s.shapes, s.batch, o, want);
+      if (named == resolve_solver(Solver::automatic, level)) {
+        testing::expect_same_results(want, got, std::string("automatic = ") + to_string(named) + " at " + to_string(level));
+      } else {
+        EXPECT_NE(want.iterations, got.iterations) << to_string(named) << " at " << to_string(level);
+      }
+    }
+  }
+}
+
 TEST(Executor, EmptyBatchIsFine) {
   ShapeTable shapes;
   PairBatch batch;

@@ -151,7 +151,7 @@ TEST(Names, RoundTripAndListValidNames) {
   for (const char* name : {"boolean", "distance", "witness", "penetration"}) {
     EXPECT_STREQ(to_string(parse_query_level(name)), name);
   }
-  for (const char* name : {"gjk", "nesterov", "polyak"}) EXPECT_STREQ(to_string(parse_solver(name)), name);
+  for (const char* name : {"gjk", "nesterov", "polyak", "automatic"}) EXPECT_STREQ(to_string(parse_solver(name)), name);
   EXPECT_EQ(parse_precision("double"), Precision::float64);
   EXPECT_EQ(parse_precision("float"), Precision::float32);
   EXPECT_STREQ(to_string(Precision::float32), "float");

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 namespace batchcol {
@@ -121,6 +122,21 @@ TEST(WideGjk, EqualsReferenceBitwiseFloat) {
     check_all_types<float>(solver, QueryLevel::witness);
     check_all_types<float>(solver, QueryLevel::boolean);
   }
+}
+
+// The lanes take the solver the setups were made with; `automatic` must have been resolved before.
+TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
+  Rng rng(77);
+  QueryOptions options;  // solver automatic: setup_pair resolves it into the parameters
+  std::vector<Shape> keep;
+  keep.reserve(400);  // make_setups keeps references into it: no reallocation
+  const auto setups = make_setups<double>(rng, ShapeType::cylinder, ShapeType::box, 8, options, keep);
+  ASSERT_FALSE(setups.empty());
+  for (const auto& s : setups) EXPECT_EQ(s.params.solver, Solver::gjk);  // witness level: gjk
+  std::vector<kernels::GjkResult<double>> got(setups.size());
+  EXPECT_THROW(kernels::simd::gjk_lanes<double>(InstructionSet::scalar, setups.data(), setups.size(), got.data(),
+                                                Solver::automatic),
+               std::invalid_argument);
 }
 
 TEST(WideGjk, RunsEverySetThisCpuHas) {

@@ -28,7 +28,7 @@ namespace batchcol::cli {
 namespace {
 
 struct BenchSettings {
-  std::string cases = "all", regime = "close", query = "witness", precision = "double", solver = "nesterov";
+  std::string cases = "all", regime = "close", query = "witness", precision = "double", solver = "automatic";
   std::string isa = "auto", save_pairs;
   int threads = 0, runs = 5;
   std::size_t pairs = 100000;
@@ -139,7 +139,8 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
                      {"pairs_answered", t.handled}, {"collide_disagreements", t.disagreements}});
   }
   nlohmann::json j = {{"case", r.bench_case.name()}, {"regime", to_string(regime)}, {"query", to_string(o.level)},
-                      {"precision", s.precision}, {"solver", to_string(o.solver)}, {"threads", threads},
+                      {"precision", s.precision}, {"solver", to_string(resolve_solver(o.solver, o.level))},
+                      {"solver_requested", to_string(o.solver)}, {"threads", threads},
                       {"pairs", s.pairs}, {"isa", to_string(o.isa)}, {"kernel", r.kernel}, {"pairs_per_second", r.pairs_per_second},
                       {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
                       {"error_pairs", r.error_pairs}, {"collide_disagreements", r.disagreements},
@@ -154,8 +155,10 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
   std::printf("instruction set: %s (closed forms: SIMD lanes for sphere/capsule pairs and box-box boolean, per pair "
               "otherwise)\n",
               to_string(o.isa));
-  std::printf("regime %s, query %s, precision %s, solver %s, threads %d, pairs %zu, median of %d runs after 1 warm-up\n",
-              to_string(regime), to_string(o.level), s.precision.c_str(), to_string(o.solver), threads, s.pairs, s.runs);
+  std::printf("regime %s, query %s, precision %s, solver %s%s, threads %d, pairs %zu, median of %d runs after 1 "
+              "warm-up\n",
+              to_string(regime), to_string(o.level), s.precision.c_str(), to_string(resolve_solver(o.solver, o.level)),
+              o.solver == Solver::automatic ? " (automatic)" : "", threads, s.pairs, s.runs);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
   std::printf("%-22s %-11s %6s %10s %11s %10s %10s", "case", "kernel", "iters", "ns/pair", "pairs/s",
@@ -229,7 +232,7 @@ Command add_bench_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--query", s->query, "boolean, distance, witness or penetration")->capture_default_str();
   app->add_option("--precision", s->precision, "double or float")->capture_default_str();
-  app->add_option("--solver", s->solver, "gjk, nesterov or polyak")->capture_default_str();
+  app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean, else gjk)")->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, std::numeric_limits<int>::max()))
       ->capture_default_str();

@@ -32,7 +32,6 @@ int run_demo(const DemoSettings& settings) {
   QueryOptions options;
   options.level = parse_query_level(settings.query);
   options.precision = parse_precision(settings.precision);
-  options.solver = Solver::nesterov;
   options.threads = settings.threads;
   validate(options);
 
@@ -59,7 +58,7 @@ int run_demo(const DemoSettings& settings) {
   std::printf("scene: %zu pairs over %zu shapes (%zu overlapping by construction)\n", scene.pairs.size(),
               scene.shapes.size(), scene.overlapping);
   std::printf("query: %s, solver %s, precision %s, threads %d\n", to_string(options.level),
-              to_string(options.solver), to_string(options.precision), threads);
+              to_string(resolve_solver(options.solver, options.level)), to_string(options.precision), threads);
   std::printf("colliding: %zu\n", colliding);
   std::printf("status:");
   for (std::size_t s = 0; s < status_counts.size(); ++s) {
