@@ -24,18 +24,21 @@ std::size_t PairBatch::add(std::uint32_t a, const Pose& pose_a, std::uint32_t b,
   return shape_a.size() - 1;
 }
 
-void PairResults::resize(std::size_t n) {
-  detail::size_results(*this, n);
+void PairResults::resize(std::size_t n, QueryLevel level) {
+  detail::size_results(*this, n, level);
   for (std::size_t i = 0; i < n; ++i) detail::fill_pair_defaults(*this, i);
 }
 
 namespace detail {
 
-void size_results(PairResults& r, std::size_t n) {
+void size_results(PairResults& r, std::size_t n, QueryLevel level) {
+  const std::size_t with_distance = level >= QueryLevel::distance ? n : 0;
+  const std::size_t with_points = level >= QueryLevel::witness ? n : 0;
   r.status.resize(n);
   r.collide.resize(n);
-  r.distance.resize(n);
-  for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal, &r.direction}) v->resize(n);
+  r.distance.resize(with_distance);
+  for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal}) v->resize(with_points);
+  r.direction.resize(n);
   r.iterations.resize(n);
 }
 

@@ -272,7 +272,8 @@ void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOption
   QueryOptions options = requested;  // the kernels see the solver that runs, never `automatic`
   options.solver = resolve_solver(requested.solver, requested.level);
   detail::validate_batch_layout(batch);
-  detail::size_results(results, batch.size());  // every pair's fields are written once, by its kernel
+  // Every computed array's entries are written once, by the pair's kernel; the others stay empty.
+  detail::size_results(results, batch.size(), options.level);
   const std::size_t n = batch.size();
   const std::size_t tiles = (n + kTilePairs - 1) / kTilePairs;
   const InstructionSet isa = resolve_instruction_set(options.isa);

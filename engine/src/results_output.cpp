@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <ostream>
 #include <string>
 
@@ -13,13 +14,22 @@ namespace {
 constexpr const char* kColumns[] = {"pair", "status", "collide", "distance", "pa_x", "pa_y", "pa_z",
                                     "pb_x", "pb_y", "pb_z", "n_x", "n_y", "n_z", "iterations"};
 
+// The value arrays a query level did not compute are empty (PairResults); the others have one entry per pair.
 void check_sizes(const PairResults& r) {
   const std::size_t n = r.size();
-  const bool ok = r.collide.size() == n && r.distance.size() == n && r.iterations.size() == n &&
-                  r.witness_a.size() == n && r.witness_a.y.size() == n && r.witness_a.z.size() == n &&
-                  r.witness_b.size() == n && r.witness_b.y.size() == n && r.witness_b.z.size() == n &&
-                  r.normal.size() == n && r.normal.y.size() == n && r.normal.z.size() == n;
-  if (!ok) throw InputError("results: the per-pair arrays have different sizes (expected " + std::to_string(n) + ")");
+  const auto n_or_empty = [n](std::size_t size) { return size == n || size == 0; };
+  const auto vec3 = [&](const Vec3Array& v) {
+    return n_or_empty(v.x.size()) && v.y.size() == v.x.size() && v.z.size() == v.x.size();
+  };
+  const bool ok = r.collide.size() == n && r.iterations.size() == n && n_or_empty(r.distance.size()) &&
+                  vec3(r.witness_a) && vec3(r.witness_b) && vec3(r.normal);
+  if (!ok)
+    throw InputError("results: the per-pair arrays have different sizes (expected " + std::to_string(n) +
+                     ", or 0 for values not computed)");
+}
+
+double value_or_nan(const std::vector<double>& values, std::size_t i) {
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN() : values[i];
 }
 
 // Appends `x`; NaN (a value the query level did not compute) becomes `missing`. Infinities are written as
@@ -51,8 +61,10 @@ void append_row_values(std::string& line, const PairResults& r, std::size_t i, b
   if (json) line += '"';
   key(2);
   line += r.collide[i] ? '1' : '0';
-  const double values[] = {r.distance[i],    r.witness_a.x[i], r.witness_a.y[i], r.witness_a.z[i], r.witness_b.x[i],
-                           r.witness_b.y[i], r.witness_b.z[i], r.normal.x[i],    r.normal.y[i],    r.normal.z[i]};
+  const auto at = [i](const std::vector<double>& v) { return value_or_nan(v, i); };
+  const double values[] = {at(r.distance),    at(r.witness_a.x), at(r.witness_a.y), at(r.witness_a.z),
+                           at(r.witness_b.x), at(r.witness_b.y), at(r.witness_b.z), at(r.normal.x),
+                           at(r.normal.y),    at(r.normal.z)};
   for (std::size_t k = 0; k < 10; ++k) {
     key(3 + k);
     append_number(line, values[k], missing, json);

@@ -76,13 +76,14 @@ struct ResultView {
 
 /// Writes pair i's answer, computed in A's frame, to the result arrays in the world frame (A's rotation Ra and
 /// translation ta): the executor's per-pair path and the batch-array GJK both write through this.
-/// Witness points and normal are NaN below QueryLevel::witness.
+/// The distance is written from QueryLevel::distance on, witness points and normal from QueryLevel::witness on (the
+/// arrays below are empty: see PairResults).
 template <class T>
 void write_pair_output(const PairOutput<T>& r, const Eigen::Matrix3d& Ra, const Eigen::Vector3d& ta, std::size_t i,
                        QueryLevel level, const ResultView& out) {
   out.status[i] = r.status;
   out.collide[i] = r.collide ? 1 : 0;
-  out.distance[i] = static_cast<double>(r.distance);
+  if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(r.distance);
   const auto put = [&](double* const* dst, const Eigen::Vector3d& v) {
     for (int c = 0; c < 3; ++c) dst[c][i] = v[c];
   };
@@ -90,9 +91,6 @@ void write_pair_output(const PairOutput<T>& r, const Eigen::Matrix3d& Ra, const 
     put(out.witness_a, mul<double>(Ra, r.witness_a.template cast<double>()) + ta);
     put(out.witness_b, mul<double>(Ra, r.witness_b.template cast<double>()) + ta);
     put(out.normal, mul<double>(Ra, r.normal.template cast<double>()));
-  } else {
-    const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-    put(out.witness_a, nan), put(out.witness_b, nan), put(out.normal, nan);
   }
   put(out.direction, mul<double>(Ra, r.direction.template cast<double>()));
   out.iterations[i] = r.iterations;

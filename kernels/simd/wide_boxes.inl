@@ -77,6 +77,6 @@ struct WideBoxes : PairLanes {
     }
     const std::uint32_t mine = lane_bits(answered) & b.live;
     const bool whole = write_collide(b, mine, ~separated, out, fallback, fallbacks);
-    write_defaults(b, whole, mine, false, false, out);
+    write_defaults(b, whole, mine, out);
   }
 };

@@ -130,16 +130,13 @@ struct PairLanes {
     return b;
   }
 
-  /// What the closed forms leave NaN / 0 (the executor does not pre-fill their pairs): the distance unless
-  /// `has_distance`, witness points and normal unless `has_points`, the search direction (closed forms have none),
-  /// and iterations 0, for the answered lanes `mine`.
-  __attribute__((always_inline)) static void write_defaults(const Block& b, bool whole, std::uint32_t mine, bool has_distance, bool has_points,
-                             const ResultView& out) {
+  /// What the closed forms leave NaN / 0 (the executor does not pre-fill their pairs): the search direction (closed
+  /// forms have none) and iterations 0, for the answered lanes `mine`. The arrays of values the query level does not
+  /// compute are empty (PairResults), so nothing is written for them.
+  __attribute__((always_inline)) static void write_defaults(const Block& b, bool whole, std::uint32_t mine,
+                                                            const ResultView& out) {
     const real nan = splat(std::numeric_limits<double>::quiet_NaN());
-    if (!has_distance) store(out.distance, b.idx, whole, nan, mine);
-    double* const* vectors[4] = {out.witness_a, out.witness_b, out.normal, out.direction};
-    for (int k = has_points ? 3 : 0; k < 4; ++k)
-      for (int c = 0; c < 3; ++c) store(vectors[k][c], b.idx, whole, nan, mine);
+    for (int c = 0; c < 3; ++c) store(out.direction[c], b.idx, whole, nan, mine);
     if (whole) {
       __builtin_memset(out.iterations + b.idx[0], 0, sizeof(std::int32_t) * W);
     } else {

@@ -120,7 +120,7 @@ struct WideSegments : PairLanes {
     const std::uint32_t mine = lane_bits(answered) & b.live;
     const bool whole = write_collide(b, mine, signed_distance <= splat(query.margin), out, fallback, fallbacks);
     const bool has_distance = query.level >= QueryLevel::distance, has_points = query.level >= QueryLevel::witness;
-    write_defaults(b, whole, mine, has_distance, has_points, out);
+    write_defaults(b, whole, mine, out);
     if (has_distance) store(out.distance, b.idx, whole, signed_distance, mine);
     if (has_points) {
       const real safe_core = select(answered, core, splat(1.0));

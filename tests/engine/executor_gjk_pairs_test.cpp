@@ -74,7 +74,11 @@ bool simd_closed_form(ShapeType a, ShapeType b, const QueryOptions& o) {
   return (segment(a) && segment(b)) || (a == ShapeType::box && b == ShapeType::box && o.level == QueryLevel::boolean);
 }
 
-/// The scalar reference of every pair; pairs answered by a SIMD closed form take `got`'s values (they are not what
+/// Entry i of a result array, NaN when the level left the array empty.
+double at(const std::vector<double>& v, std::size_t i) { return v.empty() ? kNan : v[i]; }
+Eigen::Vector3d at(const Vec3Array& v, std::size_t i) { return {at(v.x, i), at(v.y, i), at(v.z, i)}; }
+
+/// The scalar reference of every pair (every array full: NaN where the level computes nothing); pairs answered by a SIMD closed form take `got`'s values (they are not what
 /// this test is about, and every other pair, sphere-box closed forms included, must match).
 template <class T> PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& got) {
   PairResults r;
@@ -95,9 +99,9 @@ template <class T> PairResults reference(const Scene& s, const QueryOptions& o, 
       continue;
     if (simd_closed_form(s.shapes[b.shape_a[i]].type, s.shapes[b.shape_b[i]].type, o)) {
       r.status[i] = got.status[i], r.collide[i] = got.collide[i], r.iterations[i] = got.iterations[i];
-      r.distance[i] = got.distance[i];
+      r.distance[i] = at(got.distance, i);
       for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal, &PairResults::direction})
-        (r.*m).set(i, (got.*m)[i]);
+        (r.*m).set(i, at(got.*m, i));
       continue;
     }
     const Eigen::Matrix3d Ra = kernels::rotation_matrix(qa[0], qa[1], qa[2], qa[3]);
@@ -109,7 +113,7 @@ template <class T> PairResults reference(const Scene& s, const QueryOptions& o, 
     r.status[i] = p.status;
     r.collide[i] = p.collide ? 1 : 0;
     r.iterations[i] = p.iterations;
-    r.distance[i] = double(p.distance);
+    if (o.level >= QueryLevel::distance) r.distance[i] = double(p.distance);
     if (o.level >= QueryLevel::witness) {
       r.witness_a.set(i, kernels::mul<double>(Ra, p.witness_a.template cast<double>()) + ta);
       r.witness_b.set(i, kernels::mul<double>(Ra, p.witness_b.template cast<double>()) + ta);
@@ -117,6 +121,10 @@ template <class T> PairResults reference(const Scene& s, const QueryOptions& o, 
     }
     r.direction.set(i, kernels::mul<double>(Ra, p.direction.template cast<double>()));
   }
+  // As collide(): no arrays for the values the level does not compute.
+  if (o.level < QueryLevel::distance) r.distance.clear();
+  if (o.level < QueryLevel::witness)
+    for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal}) v->resize(0);
   return r;
 }
 
@@ -196,8 +204,9 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
     const double values[2][10] = {
         {want.distance[i], want.witness_a.x[i], want.witness_a.y[i], want.witness_a.z[i], want.normal.x[i],
          want.normal.y[i], want.normal.z[i], want.direction.x[i], want.direction.y[i], want.direction.z[i]},
-        {got.distance[i], got.witness_a.x[i], got.witness_a.y[i], got.witness_a.z[i], got.normal.x[i],
-         got.normal.y[i], got.normal.z[i], got.direction.x[i], got.direction.y[i], got.direction.z[i]}};
+        {at(got.distance, i), at(got.witness_a.x, i), at(got.witness_a.y, i), at(got.witness_a.z, i),
+         at(got.normal.x, i), at(got.normal.y, i), at(got.normal.z, i), got.direction.x[i], got.direction.y[i],
+         got.direction.z[i]}};
     EXPECT_EQ(std::memcmp(values[0], values[1], sizeof values[0]), 0) << i;
   }
   EXPECT_GE(compared, n - invalid.size() - n / 100);

@@ -87,6 +87,11 @@ void expect_matches_all_pairs(Scene& scene, const std::vector<ObjectHandle>& han
     ASSERT_NE(it, ref.index.end()) << "candidate pair not allowed by the filters";
     const std::size_t row = it->second;
     EXPECT_EQ(got.pairs.collide[k], ref.results.collide[row]);
+    ASSERT_EQ(got.pairs.distance.empty(), ref.results.distance.empty());
+    if (got.pairs.distance.empty()) {  // boolean: no distance array in either
+      EXPECT_LT(options.level, QueryLevel::distance);
+      continue;
+    }
     const double d = got.pairs.distance[k], e = ref.results.distance[row];
     if (got.object_a[k] == key.first) {
       EXPECT_TRUE(d == e || (std::isnan(d) && std::isnan(e))) << d << " vs " << e;

@@ -78,7 +78,7 @@ TEST(WideClosedForms, SphereCapsuleLanesEqualTheScalarClosedForm) {
       if (ia >= b.shapes.size() || ib >= b.shapes.size() || !is_unit_quaternion(qa) || !is_unit_quaternion(qb) ||
           !ta.allFinite() || !tb.allFinite()) {
         EXPECT_EQ(r.status[i], Status::invalid_input) << "pair " << i;
-        EXPECT_TRUE(std::isnan(r.distance[i]));
+        EXPECT_TRUE(r.distance.empty() || std::isnan(r.distance[i]));
         ++invalid;
         continue;
       }
@@ -89,8 +89,8 @@ TEST(WideClosedForms, SphereCapsuleLanesEqualTheScalarClosedForm) {
           kernels::segments_with_radii<double>(A.p0, A.p1, B.p0, B.p1, A.radius, B.radius, tb - ta);
       ASSERT_EQ(r.status[i], Status::converged) << "pair " << i;
       EXPECT_EQ(r.collide[i] != 0, ref.distance <= o.margin) << "pair " << i;
-      EXPECT_EQ(std::isnan(r.distance[i]), level < QueryLevel::distance);
-      EXPECT_EQ(std::isnan(r.witness_a.x[i]), level < QueryLevel::witness);
+      EXPECT_EQ(r.distance.empty(), level < QueryLevel::distance);  // not computed: no array at all
+      EXPECT_EQ(r.witness_a.x.empty(), level < QueryLevel::witness);
       EXPECT_TRUE(std::isnan(r.direction.x[i]));  // closed forms have no search direction
       if (level >= QueryLevel::distance) EXPECT_NEAR(r.distance[i], ref.distance, 1e-14) << "pair " << i;
       if (level >= QueryLevel::witness) {
@@ -181,9 +181,10 @@ TEST(WideClosedForms, BoxBoxLanesAgreeWithTheScalarSatAndGjkAndCountTouching) {
   EXPECT_GT(compared - colliding, 300u);
 }
 
-TEST(WideClosedForms, ReusedResultsGetNanInEveryFieldTheLevelDoesNotCompute) {
-  // Results are sized, not pre-filled: each kernel writes every field of its pairs. A first call at the
-  // penetration level fills the arrays with numbers; the next calls at lower levels must leave none behind.
+TEST(WideClosedForms, ReusedResultsKeepNothingOfTheLevelBefore) {
+  // Results are sized, not pre-filled: each kernel writes every computed field of its pairs. A first call at the
+  // penetration level fills the arrays with numbers; the next calls at lower levels must leave none behind: the
+  // arrays they do not compute are emptied, and the ones they keep are rewritten.
   for (const bool boxes : {false, true}) {
     const Batch b = boxes ? box_batch(17) : mixed_batch(19);
     PairResults r;
@@ -195,9 +196,11 @@ TEST(WideClosedForms, ReusedResultsGetNanInEveryFieldTheLevelDoesNotCompute) {
       collide(b.shapes, b.pairs, o, r);
       std::size_t closed = 0;
       for (std::size_t i = 0; i < b.pairs.size(); ++i) {
-        if (level == QueryLevel::boolean) EXPECT_TRUE(std::isnan(r.distance[i])) << i;
+        EXPECT_EQ(r.distance.size(), level == QueryLevel::boolean ? 0 : b.pairs.size());
         for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
-          EXPECT_TRUE(std::isnan((r.*m).x[i]) && std::isnan((r.*m).y[i]) && std::isnan((r.*m).z[i])) << i;
+          EXPECT_TRUE((r.*m).x.empty() && (r.*m).y.empty() && (r.*m).z.empty()) << i;
+        if (r.status[i] != Status::invalid_input && level == QueryLevel::distance && !r.collide[i])
+          EXPECT_FALSE(std::isnan(r.distance[i])) << i;  // separated: the distance is computed
         const std::uint32_t ia = b.pairs.shape_a[i], ib = b.pairs.shape_b[i];
         if (r.status[i] == Status::invalid_input) {
           EXPECT_EQ(r.collide[i], 0) << i;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace batchcol::testing {
 
@@ -93,8 +94,13 @@ SingleResult run_pair(const Shape& a, const Pose& pa, const Shape& b, const Pose
   batch.add(ia, pa, ib, pb);
   PairResults r;
   collide(table, batch, options, r);
-  return {r.status[0], r.collide[0] != 0, r.distance[0], r.witness_a[0], r.witness_b[0], r.normal[0],
-          r.iterations[0]};
+  // Arrays the level does not compute are empty: their values read as NaN here.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector3d none = Eigen::Vector3d::Constant(nan);
+  return {r.status[0], r.collide[0] != 0, r.distance.empty() ? nan : r.distance[0],
+          r.witness_a.x.empty() ? none : Eigen::Vector3d(r.witness_a[0]),
+          r.witness_b.x.empty() ? none : Eigen::Vector3d(r.witness_b[0]),
+          r.normal.x.empty() ? none : Eigen::Vector3d(r.normal[0]), r.iterations[0]};
 }
 
 }  // namespace batchcol::testing

@@ -3,7 +3,10 @@
 // Conventions (all results): witness points are in the world frame; the normal is a unit vector pointing from
 // shape a to shape b; the signed distance is negative when the shapes overlap (its magnitude is the penetration
 // depth, computed only at QueryLevel::penetration). Every pair satisfies witness_b - witness_a = distance * normal.
-// Values a query level does not compute are NaN (the CLI prints them as empty fields).
+// Arrays of values a query level does not compute are left empty by collide(): `distance` below
+// QueryLevel::distance, `witness_a`, `witness_b` and `normal` below QueryLevel::witness (a boolean query on a million
+// pairs writes 30 MB of results, not 110). Inside a computed array, pairs without a value (overlapping pairs'
+// distance below penetration, invalid input) hold NaN; the CLI prints NaN and missing arrays as empty fields.
 #pragma once
 
 #include "batchcol/errors.hpp"
@@ -109,13 +112,14 @@ struct PairBatch {
 struct PairResults {
   std::vector<Status> status;
   std::vector<std::uint8_t> collide;
-  std::vector<double> distance;
-  Vec3Array witness_a, witness_b, normal;
+  std::vector<double> distance;           // empty below QueryLevel::distance
+  Vec3Array witness_a, witness_b, normal;  // empty below QueryLevel::witness
   Vec3Array direction;  // final support direction (world frame); feed it back as PairBatch::warm_start
   std::vector<std::int32_t> iterations;  // GJK iterations plus EPA expansions
 
   std::size_t size() const { return status.size(); }
-  void resize(std::size_t n);
+  /// n pairs of defaults (invalid_input, NaN), with the arrays `level` computes (collide() sizes them so itself).
+  void resize(std::size_t n, QueryLevel level = QueryLevel::penetration);
 };
 
 /// Runs every pair of `batch` against `shapes`. Per-pair problems become Status::invalid_input; the function
