@@ -15,6 +15,7 @@
 #include "kernels/simplex_projection.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <array>
 
 namespace batchcol::kernels {
@@ -92,6 +93,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> x = S.v[0].w;
   Vec3<T> d_prev = initial_direction;
   Vec3<T> last_s = x;
+  assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound

@@ -61,14 +61,17 @@ struct ResultView {
   double* direction[3] = {};
   std::int32_t* iterations = nullptr;
 
+  /// Arrays the query level does not compute are empty: their pointers are null (an emptied vector's data() may
+  /// still point at its old storage, which a stray write would corrupt silently; a null pointer faults).
   static ResultView of(PairResults& r) {
+    const auto data = [](std::vector<double>& a) { return a.empty() ? nullptr : a.data(); };
     ResultView v;
     v.status = r.status.data();
     v.collide = r.collide.data();
-    v.distance = r.distance.data();
+    v.distance = data(r.distance);
     Vec3Array* a[4] = {&r.witness_a, &r.witness_b, &r.normal, &r.direction};
     double** d[4] = {v.witness_a, v.witness_b, v.normal, v.direction};
-    for (int k = 0; k < 4; ++k) d[k][0] = a[k]->x.data(), d[k][1] = a[k]->y.data(), d[k][2] = a[k]->z.data();
+    for (int k = 0; k < 4; ++k) d[k][0] = data(a[k]->x), d[k][1] = data(a[k]->y), d[k][2] = data(a[k]->z);
     v.iterations = r.iterations.data();
     return v;
   }

@@ -202,8 +202,9 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
     EXPECT_EQ(want.collide[i], got.collide[i]) << i;
     EXPECT_EQ(want.iterations[i], got.iterations[i]) << i;
     const double values[2][10] = {
-        {want.distance[i], want.witness_a.x[i], want.witness_a.y[i], want.witness_a.z[i], want.normal.x[i],
-         want.normal.y[i], want.normal.z[i], want.direction.x[i], want.direction.y[i], want.direction.z[i]},
+        {at(want.distance, i), at(want.witness_a.x, i), at(want.witness_a.y, i), at(want.witness_a.z, i),
+         at(want.normal.x, i), at(want.normal.y, i), at(want.normal.z, i), want.direction.x[i], want.direction.y[i],
+         want.direction.z[i]},
         {at(got.distance, i), at(got.witness_a.x, i), at(got.witness_a.y, i), at(got.witness_a.z, i),
          at(got.normal.x, i), at(got.normal.y, i), at(got.normal.z, i), got.direction.x[i], got.direction.y[i],
          got.direction.z[i]}};

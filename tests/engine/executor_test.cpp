@@ -225,7 +225,7 @@ TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
     EXPECT_EQ(resolve_solver(named, QueryLevel::boolean), named);
 
   const Scene s = mixed_scene(3000, 5);
-  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::witness, QueryLevel::penetration}) {
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
     QueryOptions automatic;
     automatic.level = level;
     PairResults got;

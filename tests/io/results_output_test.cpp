@@ -147,6 +147,32 @@ TEST(ResultsOutput, MismatchedArraySizesAreRejected) {
   EXPECT_TRUE(out.str().empty());  // nothing written before the check
 }
 
+// A boolean query leaves the distance, witness and normal arrays empty: their columns are empty / null. Empty is
+// allowed per array, but an array's x, y, z must agree.
+TEST(ResultsOutput, ArraysALevelDidNotComputeAreEmptyFields) {
+  PairResults r = sample_results();
+  r.distance.clear();
+  for (Vec3Array* v : {&r.witness_a, &r.witness_b, &r.normal}) v->resize(0);
+  std::ostringstream csv, json;
+  write_results_csv(r, csv);
+  const auto lines = lines_of(csv.str());
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[1], "0,converged,0,,,,,,,,,,,7");
+  EXPECT_EQ(lines[2], "1,max_iterations,1,,,,,,,,,,,128");
+  write_results_json(r, json);
+  const auto parsed = nlohmann::json::parse(json.str()).at("results");
+  ASSERT_EQ(parsed.size(), 3u);
+  EXPECT_TRUE(parsed[0]["distance"].is_null());
+  EXPECT_TRUE(parsed[0]["n_z"].is_null());
+  EXPECT_EQ(parsed[0]["iterations"], 7);
+
+  PairResults torn = sample_results();
+  torn.normal.x.clear();  // y and z still full
+  std::ostringstream out;
+  EXPECT_THROW(write_results_csv(torn, out), InputError);
+  EXPECT_TRUE(out.str().empty());
+}
+
 TEST(Names, RoundTripAndListValidNames) {
   for (const char* name : {"boolean", "distance", "witness", "penetration"}) {
     EXPECT_STREQ(to_string(parse_query_level(name)), name);

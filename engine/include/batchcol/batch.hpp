@@ -34,11 +34,12 @@ enum class Solver : std::uint8_t {
   polyak,     // heavy-ball (Polyak) momentum on the support direction, same fallback
   automatic,  // the default: polyak for QueryLevel::boolean, gjk for the other levels (see resolve_solver)
 };
-/// The solver `requested` runs as at `level` (never `automatic`). Measured on the bench's 26 GJK type pairs
+/// The solver `requested` runs as at `level` (never `automatic`). Measured on the bench's GJK type pairs (25, 26)
 /// (mean iterations, geometric mean over the pairs, relative to nesterov): boolean polyak 0.80 close / 0.98
 /// overlap / 0.99 distant (gjk 0.85 / 0.96 / 1.02); distance and witness gjk 0.89 / 0.89 / 0.66 (polyak 0.95 /
 /// 0.98 / 0.81), with the same worst-case error. Nesterov stays best on ellipsoid-ellipsoid witness in the close
-/// regime (20.7 iterations against gjk's 28.3): ask for it by name there.
+/// regime (20.7 iterations against gjk's 28.3): ask for it by name there. Penetration was not measured: it takes
+/// witness's choice for its GJK part.
 inline Solver resolve_solver(Solver requested, QueryLevel level) {
   if (requested != Solver::automatic) return requested;
   return level == QueryLevel::boolean ? Solver::polyak : Solver::gjk;

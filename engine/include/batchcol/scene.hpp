@@ -71,7 +71,7 @@ struct SceneTimings {
 };
 
 /// Everything Scene::collide() reports. Candidate k is the pair (object_a[k], object_b[k]); pairs.*[k] is its
-/// narrow-phase result at the requested level (values the level does not compute are NaN).
+/// narrow-phase result at the requested level (arrays of values the level does not compute are empty: PairResults).
 struct SceneResults {
   std::vector<ObjectHandle> object_a, object_b;
   PairResults pairs;
