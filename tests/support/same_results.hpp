@@ -13,7 +13,8 @@ namespace batchcol::testing {
 
 /// Same doubles bit for bit (NaN payloads included, unlike ==).
 inline bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+  // memcmp must not see the null data() of empty arrays (the levels that leave them empty), even for 0 bytes.
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 /// Expects every field of `got` bitwise equal to `want`'s; `label` names the comparison in failures.
