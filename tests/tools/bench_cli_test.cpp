@@ -58,6 +58,23 @@ TEST_F(BenchCli, JsonHasTheDocumentedFields) {
   }
 }
 
+// Each timed run repeats the call until it lasts --min-run-ms: 2000 sphere pairs take microseconds, so a 50 ms run
+// needs many calls; 0 times single calls. Peers are timed the same way.
+TEST_F(BenchCli, TimedRunsRepeatCheapCallsUntilTheMinimumRunTime) {
+  const RunResult longer = run("bench --case sphere-sphere --query boolean --pairs 2000 --runs 5 --min-run-ms 50 --json");
+  ASSERT_EQ(longer.exit_code, 0) << longer.err;
+  const nlohmann::json j = nlohmann::json::parse(longer.out);
+  EXPECT_EQ(j["min_run_ms"], 50.0);
+  EXPECT_GT(j["calls_per_run"].get<int>(), 1);
+  for (const auto& peer : j["peers"]) EXPECT_GT(peer["calls_per_run"].get<int>(), 1) << peer["name"];
+
+  const RunResult single = run("bench --case sphere-sphere --query boolean --pairs 2000 --runs 5 --min-run-ms 0 --json");
+  ASSERT_EQ(single.exit_code, 0) << single.err;
+  const nlohmann::json k = nlohmann::json::parse(single.out);
+  EXPECT_EQ(k["calls_per_run"], 1);
+  for (const auto& peer : k["peers"]) EXPECT_EQ(peer["calls_per_run"], 1) << peer["name"];
+}
+
 TEST_F(BenchCli, TextOutputNamesTheKernelAndInstructionSet) {
   const RunResult r = run("bench --case box-cone --regime overlap --query penetration --pairs 200 --no-peers --isa scalar");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -112,7 +129,8 @@ TEST_F(BenchCli, EveryInstructionSetThisCpuRunsAgreesAndOthersExitWith2) {
 
 TEST_F(BenchCli, BadFlagsExitWith2) {
   for (const char* args : {"bench --case sphere-torus", "bench --case sphere", "bench --regime near",
-                           "bench --pairs 0", "bench --query everything", "bench --isa sse9"}) {
+                           "bench --pairs 0", "bench --query everything", "bench --isa sse9",
+                           "bench --min-run-ms -1", "bench --min-run-ms nan"}) {
     const RunResult r = run(args);
     EXPECT_EQ(r.exit_code, 2) << args;
     EXPECT_EQ(r.err.rfind("batchcol: error: ", 0), 0u) << args << ": " << r.err;

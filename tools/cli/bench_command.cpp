@@ -6,6 +6,7 @@
 #include "cli/atomic_output.hpp"
 #include "cli/bench_pairs.hpp"
 #include "cli/bench_peers.hpp"
+#include "cli/bench_timing.hpp"
 #include "cli/commands.hpp"
 
 #include <batchcol/batch.hpp>
@@ -15,7 +16,6 @@
 #include <tbb/info.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -31,6 +31,7 @@ struct BenchSettings {
   std::string cases = "all", regime = "close", query = "witness", precision = "double", solver = "automatic";
   std::string isa = "auto", save_pairs;
   int threads = 0, runs = 5;
+  double min_run_ms = 20;  // each timed run repeats collide() until it lasts this long (bench_timing.hpp)
   std::size_t pairs = 100000;
   std::uint64_t seed = 20240603;
   bool json = false, no_peers = false;
@@ -43,6 +44,7 @@ struct CaseResult {
   std::size_t error_pairs = 0, disagreements = 0;
   double reference_min = 0, reference_max = 0;
   double iterations_mean = 0;  // GJK iterations plus EPA expansions per pair (0 for closed forms)
+  int calls_per_run = 1;
   std::string note, kernel;
   PeerReport peers;
 };
@@ -96,14 +98,10 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
 
   out.kernel = kernel_for(p.shapes[p.pairs.shape_a[0]], p.shapes[p.pairs.shape_b[0]], options);
   PairResults results;
-  collide(p.shapes, p.pairs, options, results);  // warm-up: page faults, TBB thread start
-  std::vector<double> seconds;
-  for (int run = 0; run < s.runs; ++run) {
-    const auto start = std::chrono::steady_clock::now();
-    collide(p.shapes, p.pairs, options, results);
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  const double median = median_of(seconds);
+  const CallTiming timing =
+      time_calls([&] { collide(p.shapes, p.pairs, options, results); }, s.runs, s.min_run_ms * 1e-3);
+  out.calls_per_run = timing.calls_per_run;
+  const double median = timing.seconds_per_call;
   const double n = double(p.pairs.size());
   out.ns_per_pair = median * 1e9 / n;
   out.pairs_per_second = median > 0 ? n / median : 0.0;
@@ -127,7 +125,7 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
     out.note = "no pair has a distance at this query level (overlapping pairs need --query penetration): "
                "error fields are 0";
   }
-  if (!s.no_peers) out.peers = time_peers(bench_case, p, options.level, threads, s.runs);
+  if (!s.no_peers) out.peers = time_peers(bench_case, p, options.level, threads, s.runs, s.min_run_ms * 1e-3);
   return out;
 }
 
@@ -136,7 +134,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
   for (const PeerTiming& t : r.peers.timings) {
     peers.push_back({{"name", t.name}, {"query", t.query}, {"ns_per_pair", t.ns_per_pair},
                      {"error_max", t.error_max}, {"ratio", r.ns_per_pair > 0 ? t.ns_per_pair / r.ns_per_pair : 0.0},
-                     {"pairs_answered", t.handled}, {"collide_disagreements", t.disagreements}});
+                     {"pairs_answered", t.handled}, {"calls_per_run", t.calls_per_run}, {"collide_disagreements", t.disagreements}});
   }
   nlohmann::json j = {{"case", r.bench_case.name()}, {"regime", to_string(regime)}, {"query", to_string(o.level)},
                       {"precision", s.precision}, {"solver", to_string(resolve_solver(o.solver, o.level))},
@@ -145,7 +143,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
                       {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
                       {"error_pairs", r.error_pairs}, {"collide_disagreements", r.disagreements},
                       {"reference_min", r.reference_min}, {"reference_max", r.reference_max}, {"iterations_mean", r.iterations_mean},
-                      {"timed_runs", s.runs}, {"peers", peers}, {"peers_missing", r.peers.notes}};
+                      {"timed_runs", s.runs}, {"calls_per_run", r.calls_per_run}, {"min_run_ms", s.min_run_ms}, {"peers", peers}, {"peers_missing", r.peers.notes}};
   if (!r.note.empty()) j["note"] = r.note;
   return j;
 }
@@ -156,9 +154,9 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
               "otherwise)\n",
               to_string(o.isa));
   std::printf("regime %s, query %s, precision %s, solver %s%s, threads %d, pairs %zu, median of %d runs after 1 "
-              "warm-up\n",
+              "warm-up, each run >= %g ms (repeated calls)\n",
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(resolve_solver(o.solver, o.level)),
-              o.solver == Solver::automatic ? " (automatic)" : "", threads, s.pairs, s.runs);
+              o.solver == Solver::automatic ? " (automatic)" : "", threads, s.pairs, s.runs, s.min_run_ms);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
   std::printf("%-22s %-11s %6s %10s %11s %10s %10s", "case", "kernel", "iters", "ns/pair", "pairs/s",
@@ -189,6 +187,9 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
 int run_bench(const BenchSettings& s) {
   const std::vector<BenchCase> cases = parse_bench_cases(s.cases);
   const Regime regime = parse_regime(s.regime);
+  // CLI::Range lets NaN through (every comparison with it is false).
+  if (!(s.min_run_ms >= 0.0 && s.min_run_ms <= 10000.0))
+    throw InputError("--min-run-ms " + std::to_string(s.min_run_ms) + ": must be a number of milliseconds in [0, 10000]");
   if (!s.save_pairs.empty() && cases.size() != 1) throw InputError("--save-pairs needs a single --case");
   QueryOptions options;
   options.level = parse_query_level(s.query);
@@ -240,6 +241,11 @@ Command add_bench_command(CLI::App& parent) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))
       ->capture_default_str();
   app->add_option("--runs", s->runs, "Timed runs (the median is reported)")->check(CLI::Range(5, 1000))->capture_default_str();
+  app->add_option("--min-run-ms", s->min_run_ms,
+                  "Each timed run repeats the call until it lasts this long; the per-call median is reported (0: one "
+                  "call per run)")
+      ->check(CLI::Range(0.0, 10000.0))
+      ->capture_default_str();
   app->add_option("--isa", s->isa, "auto, scalar, avx2 or avx512 (auto: the best this CPU runs)")->capture_default_str();
   app->add_option("--seed", s->seed, "Seed of the pair generator")->capture_default_str();
   app->add_option("--save-pairs", s->save_pairs, "Write the generated pairs as a batch file (single --case)");

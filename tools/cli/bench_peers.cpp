@@ -1,4 +1,5 @@
 #include "cli/bench_peers.hpp"
+#include "cli/bench_timing.hpp"
 
 #ifdef BATCHCOL_HAVE_FCL
 #include <peers/fcl_adapter.hpp>
@@ -12,7 +13,6 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <functional>
 
@@ -22,7 +22,7 @@ namespace {
 using PeerQuery = std::function<peers::PeerAnswer(std::size_t pair)>;
 
 PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p, int threads, int timed_runs,
-                     const PeerQuery& query) {
+                     double min_run_seconds, const PeerQuery& query) {
   const std::size_t n = p.pairs.size();
   std::vector<peers::PeerAnswer> answers(n);
   tbb::task_arena arena(threads);
@@ -33,19 +33,13 @@ PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p,
       });
     });
   };
-  run();  // warm-up
-  std::vector<double> seconds;
-  for (int k = 0; k < timed_runs; ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    run();
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  std::sort(seconds.begin(), seconds.end());
+  const CallTiming timing = time_calls(run, timed_runs, min_run_seconds);
 
   PeerTiming t;
   t.name = name;
   t.query = boolean ? "collide" : "distance";
-  t.ns_per_pair = seconds[seconds.size() / 2] * 1e9 / double(n);
+  t.ns_per_pair = timing.seconds_per_call * 1e9 / double(n);
+  t.calls_per_run = timing.calls_per_run;
   for (std::size_t i = 0; i < n; ++i) {
     const peers::PeerAnswer& a = answers[i];
     if (!a.ok) continue;
@@ -62,7 +56,7 @@ PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p,
 }  // namespace
 
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLevel level, int threads,
-                      int timed_runs) {
+                      int timed_runs, double min_run_seconds) {
   PeerReport report;
   const bool boolean = level == QueryLevel::boolean;
   const PairBatch& b = p.pairs;
@@ -70,7 +64,7 @@ PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLev
   {
     const peers::FclShapeCache fcl(p.shapes);
     constexpr double kFclTolerance = 1e-8;  // batchcol's default tolerance (QueryOptions::tolerance)
-    report.timings.push_back(time_peer("FCL", boolean, p, threads, timed_runs, [&](std::size_t i) {
+    report.timings.push_back(time_peer("FCL", boolean, p, threads, timed_runs, min_run_seconds, [&](std::size_t i) {
       return boolean ? fcl.collide(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), peers::FclSolver::libccd)
                      : fcl.distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), peers::FclSolver::libccd,
                                     kFclTolerance);
@@ -84,7 +78,7 @@ PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLev
     report.notes.push_back("Bullet: no " + bench_case.name() + " pair (Bullet has no ellipsoid shape)");
   } else {
     const peers::BulletShapeCache bullet(p.shapes);
-    report.timings.push_back(time_peer("Bullet", boolean, p, threads, timed_runs, [&](std::size_t i) {
+    report.timings.push_back(time_peer("Bullet", boolean, p, threads, timed_runs, min_run_seconds, [&](std::size_t i) {
       return bullet.signed_distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i));
     }));
     if (boolean) report.timings.back().query = "signed distance (no boolean GJK in btGjkEpaSolver2)";

@@ -1,5 +1,5 @@
 // Peer timings of `batchcol bench`: FCL and Bullet (when found at configure time) on the same pairs, with
-// tbb::parallel_for in a task_arena of the same thread count, one warm-up and the median of the timed runs.
+// tbb::parallel_for in a task_arena of the same thread count, timed as batchcol is (bench_timing.hpp).
 #pragma once
 
 #include "cli/bench_pairs.hpp"
@@ -14,7 +14,8 @@ namespace batchcol::cli {
 struct PeerTiming {
   std::string name;              // "FCL" or "Bullet"
   std::string query;             // what the peer ran: "collide" or "distance"
-  double ns_per_pair = 0;        // median run time / pairs
+  double ns_per_pair = 0;        // median per-call time / pairs (bench_timing.hpp)
+  int calls_per_run = 1;
   std::size_t handled = 0;       // pairs the peer answered (ok)
   double error_max = 0;          // max |signed distance - reference| over handled pairs (distance queries)
   std::size_t disagreements = 0; // boolean queries: collide != (reference <= 0)
@@ -28,6 +29,6 @@ struct PeerReport {
 /// Boolean queries run the peers' collide, every other level their (signed) distance. Geometries are built once
 /// before timing (peers::FclShapeCache, peers::BulletShapeCache).
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& pairs, QueryLevel level, int threads,
-                      int timed_runs);
+                      int timed_runs, double min_run_seconds);
 
 }  // namespace batchcol::cli
