@@ -1,6 +1,6 @@
 #!/bin/bash
 # Instructions per pair of the timed collide() calls, per function, from callgrind: `batchcol bench` is run with
-# --runs 45 and --runs 5 on one thread and the difference is divided by 40 x pairs (pair generation, the reference
+# --runs 45 and --runs 5 on one thread (one call per run: --min-run-ms 0) and the difference is divided by 40 x pairs (pair generation, the reference
 # and the warm-up cancel out). Wall time on a shared 2-core VM is too noisy to compare kernels; this is not.
 # usage: tools/instructions_per_pair.sh BATCHCOL_BINARY CASE [QUERY=boolean] [PRECISION=double] [ISA=auto]
 set -euo pipefail
@@ -9,7 +9,7 @@ command -v valgrind >/dev/null || { echo "needs valgrind (apt-get install valgri
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 for runs in 5 45; do
   valgrind --tool=callgrind --callgrind-out-file="$work/cg$runs" "$bin" bench --case "$case_name" --regime close \
-    --query "$query" --precision "$precision" --pairs $pairs --threads 1 --no-peers --isa "$isa" --runs $runs \
+    --query "$query" --precision "$precision" --pairs $pairs --threads 1 --no-peers --isa "$isa" --runs $runs --min-run-ms 0 \
     >/dev/null 2>&1
   callgrind_annotate --inclusive=no "$work/cg$runs" 2>/dev/null | grep -E "^ *[0-9,]+ \(" |
     sed -E 's/,//g; s/^ *([0-9]+) +\( *[0-9.]+%\) +/\1\t/' > "$work/f$runs"
