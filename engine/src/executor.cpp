@@ -14,6 +14,7 @@
 #include <tbb/task_arena.h>
 
 #include <array>
+#include <cstring>
 #include <limits>
 
 namespace batchcol {
@@ -46,12 +47,30 @@ void group_by_type(const ShapeTable& shapes, const PairBatch& batch, std::size_t
   std::uint8_t* const key = keys.data();
   const auto key_of = [&](std::size_t k) {
     const std::uint32_t a = shape_a[k], b = shape_b[k];
-    // Invalid pairs go to group 0; whatever kernel runs them rejects them per pair.
+    // Invalid pairs go to group 0; whatever kernel runs them rejects them per pair. (Branches: a branch-free
+    // version that read shape 0's types for them measured 2 instructions per pair more.)
     return a < count && b < count
                ? static_cast<std::uint8_t>(static_cast<std::size_t>(type[a]) * kShapeTypeCount +
                                            static_cast<std::size_t>(type[b]))
                : std::uint8_t{0};
   };
+  if (shapes.one_type()) {
+    // Every valid pair has the table's one type pair: only the indices are checked (measured: 6.5 instead of
+    // 13.5 instructions per pair in this function). A pair with an invalid index takes the general path below.
+    // Unsigned i >= count is a signed compare of both shifted by 2^31 (the table holds < 2^32 shapes): SSE2 has
+    // only signed 32-bit compares, and with them this loop is vectorised.
+    const auto shifted = [](std::uint32_t v) { return static_cast<std::int32_t>(v ^ 0x80000000u); };
+    const std::int32_t limit = shifted(static_cast<std::uint32_t>(count));
+    int invalid = 0;
+    for (std::size_t k = 0; k < n; ++k) invalid |= int(shifted(shape_a[k]) >= limit) | int(shifted(shape_b[k]) >= limit);
+    if (invalid == 0) {
+      const std::size_t group = static_cast<std::size_t>(type[0]) * kShapeTypeCount + static_cast<std::size_t>(type[0]);
+      std::memset(key, static_cast<int>(group), n);  // run_generic() reads the keys of the pairs it gets back
+      for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(k);
+      for (std::size_t g = group + 1; g < groups.size(); ++g) groups[g] = static_cast<std::uint32_t>(n);
+      return;
+    }
+  }
   const std::uint8_t first = key_of(0);
   unsigned differ = 0;
   for (std::size_t k = 0; k < n; ++k) {

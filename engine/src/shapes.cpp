@@ -141,6 +141,7 @@ std::uint32_t ShapeTable::add(Shape shape) {
     if (types_.size() > shapes_.size()) types_.pop_back();
     throw;
   }
+  mixed_ = mixed_ || type != types_.front();
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

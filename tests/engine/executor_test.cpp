@@ -244,6 +244,56 @@ TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
   }
 }
 
+// A table of one shape type takes the executor's shortcut (ShapeTable::one_type(): the types are not read per
+// pair); the same pairs in a table that also holds another type go through the per-pair grouping. Both must give
+// the same bits, also in tiles where an invalid index (here 999, 2^31 and 2^32 - 1, which a signed compare would
+// take for negative) sends the tile back to the general path.
+TEST(Executor, OneTypeTableGivesTheResultsOfTheGeneralGrouping) {
+  Rng rng(77);
+  for (const ShapeType type : {ShapeType::sphere, ShapeType::capsule, ShapeType::box, ShapeType::cylinder,
+                               ShapeType::convex}) {
+    ShapeTable one, mixed;
+    for (int k = 0; k < 5; ++k) {
+      const Shape shape = testing::random_shape(rng, type);
+      one.add(shape);
+      mixed.add(shape);
+    }
+    mixed.add(type == ShapeType::sphere ? Shape::box(0.1, 0.1, 0.1) : Shape::sphere(0.1));  // index 5: never used
+    ASSERT_TRUE(one.one_type()) << to_string(type);
+    ASSERT_FALSE(mixed.one_type()) << to_string(type);
+    PairBatch batch;
+    const std::uint32_t invalid[] = {999, 0x80000000u, 0xffffffffu};
+    for (std::size_t i = 0; i < 3000; ++i) {
+      const auto a = static_cast<std::uint32_t>(rng() % 5), b = static_cast<std::uint32_t>(rng() % 5);
+      const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+      const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
+                    testing::random_rotation(rng)};
+      // Pairs 2500.. (the third tile) hold invalid indices; the first two tiles are all valid.
+      const bool bad = i >= 2500 && i % 97 == 0;
+      batch.add(bad && i % 2 ? invalid[i % 3] : a, pa, bad && !(i % 2) ? invalid[i % 3] : b, pb);
+    }
+    for (const QueryLevel level : {QueryLevel::boolean, QueryLevel::witness}) {
+      QueryOptions options;
+      options.level = level;
+      PairResults want, got;
+      collide(mixed, batch, options, want);
+      collide(one, batch, options, got);
+      testing::expect_same_results(want, got, std::string(to_string(type)) + " " + to_string(level));
+      std::size_t rejected = 0;
+      for (std::size_t i = 0; i < batch.size(); ++i) rejected += got.status[i] == Status::invalid_input ? 1 : 0;
+      EXPECT_EQ(rejected, 5u) << to_string(type);  // pairs 2522, 2619, 2716, 2813, 2910
+    }
+    // Index 5 == size(): the first invalid index of the one-type table.
+    PairBatch edge;
+    for (std::uint32_t k = 0; k < 4; ++k) edge.add(k, Pose{}, k + 1, Pose{Eigen::Vector3d(1, 0, 0), Eigen::Quaterniond::Identity()});
+    edge.add(0, Pose{}, 5, Pose{});
+    PairResults r;
+    collide(one, edge, QueryOptions{}, r);
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_NE(r.status[i], Status::invalid_input) << to_string(type) << " " << i;
+    EXPECT_EQ(r.status[4], Status::invalid_input) << to_string(type);
+  }
+}
+
 TEST(Executor, EmptyBatchIsFine) {
   ShapeTable shapes;
   PairBatch batch;

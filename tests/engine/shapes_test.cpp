@@ -99,6 +99,19 @@ TEST(Shapes, TableKeepsTypesAndBoundingRadiiInStep) {
   EXPECT_EQ(table.bounding_radii()[3], std::numeric_limits<double>::infinity());
 }
 
+TEST(Shapes, TableKnowsWhenItHoldsOneType) {
+  ShapeTable table;
+  EXPECT_FALSE(table.one_type());  // empty: no type at all
+  table.add(Shape::capsule(0.1, 0.2));
+  EXPECT_TRUE(table.one_type());
+  table.add(Shape::capsule(0.3, 0.1).inflated(0.01));  // inflation does not change the type
+  EXPECT_TRUE(table.one_type());
+  table.add(Shape::sphere(0.1));
+  EXPECT_FALSE(table.one_type());
+  table.add(Shape::capsule(0.1, 0.2));
+  EXPECT_FALSE(table.one_type());  // once mixed, always mixed: shapes are never removed
+}
+
 }  // namespace
 }  // namespace batchcol
 

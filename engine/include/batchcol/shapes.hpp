@@ -91,11 +91,15 @@ class ShapeTable {
   /// reads these contiguous arrays per pair instead of the Shape records.
   const std::vector<ShapeType>& types() const { return types_; }
   const std::vector<double>& bounding_radii() const { return bounding_radii_; }
+  /// True when the table is not empty and all its shapes have one type: every valid pair is then of one type pair,
+  /// and the executor skips reading the two types of each pair.
+  bool one_type() const { return !shapes_.empty() && !mixed_; }
 
  private:
   std::vector<Shape> shapes_;
   std::vector<ShapeType> types_;
   std::vector<double> bounding_radii_;
+  bool mixed_ = false;
 };
 
 }  // namespace batchcol
