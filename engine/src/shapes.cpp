@@ -141,7 +141,7 @@ std::uint32_t ShapeTable::add(Shape shape) {
     if (types_.size() > shapes_.size()) types_.pop_back();
     throw;
   }
-  mixed_ = mixed_ || type != types_.front();
+  mixed_ = shapes_.size() > 1 && (mixed_ || type != types_.front());  // a moved-from table starts afresh
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

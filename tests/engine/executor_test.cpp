@@ -246,8 +246,9 @@ TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
 
 // A table of one shape type takes the executor's shortcut (ShapeTable::one_type(): the types are not read per
 // pair); the same pairs in a table that also holds another type go through the per-pair grouping. Both must give
-// the same bits, also in tiles where an invalid index (here 999, 2^31 and 2^32 - 1, which a signed compare would
-// take for negative) sends the tile back to the general path.
+// the same bits. Pairs with an invalid index (999, 2^31, 2^32 - 1) go to group 0 (sphere-sphere) in the mixed
+// table and to the table's own type pair in the one-type table, whose kernels (box SAT, batch-array GJK,
+// per-pair path) must reject them as group 0's do.
 TEST(Executor, OneTypeTableGivesTheResultsOfTheGeneralGrouping) {
   Rng rng(77);
   for (const ShapeType type : {ShapeType::sphere, ShapeType::capsule, ShapeType::box, ShapeType::cylinder,
