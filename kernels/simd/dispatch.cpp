@@ -96,12 +96,11 @@ template <>
 std::size_t gjk_pairs<double>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                               const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                               const ResultView& out, std::uint32_t* fallback) {
-  QueryOptions o = options;  // the lanes run the resolved solver
-  o.solver = resolve_solver(options.solver, options.level);
+  if (options.solver == Solver::automatic) throw std::invalid_argument("gjk_pairs: resolve the solver first (resolve_solver)");
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
-    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, o, out, fallback);
+    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
   }
 }
 
@@ -109,12 +108,11 @@ template <>
 std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                              const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                              const ResultView& out, std::uint32_t* fallback) {
-  QueryOptions o = options;  // the lanes run the resolved solver
-  o.solver = resolve_solver(options.solver, options.level);
+  if (options.solver == Solver::automatic) throw std::invalid_argument("gjk_pairs: resolve the solver first (resolve_solver)");
   switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
-    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, o, out, fallback);
+    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
   }
 }
 

@@ -36,7 +36,8 @@ void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkR
 /// executor's scalar path's bits. Preconditions: neither type is triangle or halfspace, no closed form applies to
 /// the type pair under `options`, options.level < penetration, no warm start; pairs[0 .. n) ascending. Returns how
 /// many pairs it left to the scalar path (invalid input, a float stall redone in double), listed in
-/// fallback[0 .. count) (room for n); every field of the others is written.
+/// fallback[0 .. count) (room for n); every field of the others is written. options.solver must be resolved
+/// (collide() does it; `automatic` throws, as for gjk_lanes).
 template <class T>
 std::size_t gjk_pairs(InstructionSet isa, const PairView& in, ShapeType type_a, ShapeType type_b,
                       const std::uint32_t* pairs, std::size_t n, const QueryOptions& options, const ResultView& out,

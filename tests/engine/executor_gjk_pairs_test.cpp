@@ -180,6 +180,7 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
   QueryOptions o;
   o.level = level;
   o.precision = std::is_same_v<T, float> ? Precision::float32 : Precision::float64;
+  o.solver = resolve_solver(o.solver, o.level);  // as collide() does before calling the kernels
   PairResults got;
   got.resize(n);
   std::vector<std::uint32_t> pairs(n), fallback(n);

@@ -137,6 +137,19 @@ TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   EXPECT_THROW(kernels::simd::gjk_lanes<double>(InstructionSet::scalar, setups.data(), setups.size(), got.data(),
                                                 Solver::automatic),
                std::invalid_argument);
+  // The batch-array entry point too: collide() resolves the solver once for every kernel.
+  ShapeTable table;
+  table.add(Shape::cylinder(0.1, 0.2));
+  PairBatch batch;
+  batch.add(0, Pose{}, 0, Pose{Eigen::Vector3d(1, 0, 0), Eigen::Quaterniond::Identity()});
+  PairResults results;
+  results.resize(1);
+  const std::uint32_t pair = 0;
+  std::uint32_t fallback = 0;
+  EXPECT_THROW(kernels::simd::gjk_pairs<double>(InstructionSet::scalar, kernels::simd::PairView::of(table, batch),
+                                                ShapeType::cylinder, ShapeType::cylinder, &pair, 1, options,
+                                                kernels::simd::ResultView::of(results), &fallback),
+               std::invalid_argument);
 }
 
 TEST(WideGjk, RunsEverySetThisCpuHas) {
