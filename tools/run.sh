@@ -4,7 +4,8 @@
 #   tools/run.sh test             build everything and run the whole test suite (ctest)
 #   tools/run.sh asan-test        same, built with AddressSanitizer + UBSan in build-asan/
 # Missing Debian packages are installed with apt-get when running as root; otherwise the script prints the
-# exact install command and stops. BATCHCOL_BUILD_DIR overrides the build folder (default: build/).
+# exact install command and stops. BATCHCOL_BUILD_DIR overrides the build folder (default: build/);
+# BATCHCOL_CMAKE_ARGS adds CMake options (CI builds the demo with the optional peers switched off through it).
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -61,7 +62,9 @@ configure_and_build() {
   local build_dir="$1" target="$2"
   shift 2
   echo "run.sh: configuring $build_dir ($*)"
-  cmake -S . -B "$build_dir" "$@"
+  local extra=()
+  read -r -a extra <<<"${BATCHCOL_CMAKE_ARGS:-}"
+  cmake -S . -B "$build_dir" "$@" "${extra[@]}"
   echo "run.sh: building $target with $(nproc) jobs"
   cmake --build "$build_dir" --target "$target" -j"$(nproc)"
 }

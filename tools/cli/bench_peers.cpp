@@ -1,6 +1,8 @@
 #include "cli/bench_peers.hpp"
 #include "cli/bench_timing.hpp"
 
+#include <peers/peer_answer.hpp>  // PeerAnswer, also when no peer library was found
+
 #ifdef BATCHCOL_HAVE_FCL
 #include <peers/fcl_adapter.hpp>
 #endif
@@ -19,6 +21,7 @@
 namespace batchcol::cli {
 namespace {
 
+#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET)
 using PeerQuery = std::function<peers::PeerAnswer(std::size_t pair)>;
 
 PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p, int threads, int timed_runs,
@@ -52,14 +55,19 @@ PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p,
   }
   return t;
 }
+#endif
 
 }  // namespace
 
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLevel level, int threads,
                       int timed_runs, double min_run_seconds) {
   PeerReport report;
+#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET)
   const bool boolean = level == QueryLevel::boolean;
   const PairBatch& b = p.pairs;
+#else
+  (void)p, (void)level, (void)threads, (void)timed_runs, (void)min_run_seconds;
+#endif
 #ifdef BATCHCOL_HAVE_FCL
   {
     const peers::FclShapeCache fcl(p.shapes);
