@@ -43,6 +43,46 @@ std::string first_line(const std::string& s) {
   return s.substr(start, s.find('\n', start) - start);
 }
 
+/// ConvexHull::start_vertices: for each cube-map cell (kernels/support.hpp, start_cell), the first vertex with the
+/// largest dot product with the cell's centre direction (a linear scan: built once per hull).
+void build_start_vertices(ConvexHull& hull) {
+  hull.start_vertices.assign(kHullStartCells, 0);
+  const double step = 2.0 / kHullStartGrid;
+  for (std::uint32_t face = 0; face < 6; ++face) {
+    const int axis = static_cast<int>(face / 2);
+    for (std::uint32_t cu = 0; cu < kHullStartGrid; ++cu)
+      for (std::uint32_t cv = 0; cv < kHullStartGrid; ++cv) {
+        Eigen::Vector3d d;
+        d[axis] = face % 2 == 0 ? 1.0 : -1.0;
+        d[(axis + 1) % 3] = -1.0 + (cu + 0.5) * step;
+        d[(axis + 2) % 3] = -1.0 + (cv + 0.5) * step;
+        std::uint32_t best = 0;
+        for (std::uint32_t i = 1; i < hull.vertices.size(); ++i)
+          if (hull.vertices[i].dot(d) > hull.vertices[best].dot(d)) best = i;
+        hull.start_vertices[(face * kHullStartGrid + cu) * kHullStartGrid + cv] = best;
+      }
+  }
+}
+
+/// ConvexHull::neighbor_block_*: the compressed adjacency rows cut into padded blocks with their coordinates.
+void build_neighbor_blocks(ConvexHull& hull) {
+  constexpr std::uint32_t B = ConvexHull::kNeighborBlock;
+  hull.neighbor_block_offsets.assign(1, 0);
+  hull.neighbor_block_index.clear();
+  hull.neighbor_block_xyz.clear();
+  for (std::size_t v = 0; v + 1 < hull.neighbor_offsets.size(); ++v) {
+    const std::uint32_t first = hull.neighbor_offsets[v], last = hull.neighbor_offsets[v + 1];
+    for (std::uint32_t k = first; k < last; k += B) {
+      std::uint32_t index[B];
+      for (std::uint32_t j = 0; j < B; ++j) index[j] = hull.neighbors[k + j < last ? k + j : first];
+      for (std::uint32_t j = 0; j < B; ++j) hull.neighbor_block_index.push_back(index[j]);
+      for (int c = 0; c < 3; ++c)
+        for (std::uint32_t j = 0; j < B; ++j) hull.neighbor_block_xyz.push_back(hull.vertices[index[j]][c]);
+    }
+    hull.neighbor_block_offsets.push_back(static_cast<std::uint32_t>(hull.neighbor_block_index.size() / B));
+  }
+}
+
 void build_adjacency(ConvexHull& hull) {
   std::vector<std::vector<std::uint32_t>> adj(hull.vertices.size());
   for (const auto& f : hull.faces)
@@ -142,6 +182,8 @@ std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::V
   hull->centroid /= static_cast<double>(hull->vertices.size());
   for (const auto& v : hull->vertices) hull->radius = std::max(hull->radius, v.norm());
   build_adjacency(*hull);
+  build_neighbor_blocks(*hull);
+  build_start_vertices(*hull);
   return hull;
 }
 

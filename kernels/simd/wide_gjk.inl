@@ -105,6 +105,28 @@ template <class T> struct WideGjk {
     return gather_bytes(origin, start + i * Int(sizeof(Eigen::Vector3d)) + Int(c * sizeof(double)));
   }
 
+  // Float lanes in halves of Wide<double>::W lanes (one double register each): the offsets of a double gather and
+  // the converted values. Sized from the double width so that every type is a valid vector in every build.
+  static constexpr int Wd = Wide<double>::W;
+  using HalfIndex = wmask<double>;
+  typedef std::int32_t Half32 __attribute__((vector_size(4 * Wd)));
+  typedef float HalfReal __attribute__((vector_size(4 * Wd)));
+  /// Vertex i[l] of lane l's hull (vertices start start[l] bytes after `origin`; lanes 0 .. W/2 in `lo`), float lanes.
+  static V3 vertex_f(const double* origin, HalfIndex lo, HalfIndex hi, mask i) {
+    Half32 i_lo{}, i_hi{};
+    for (int l = 0; l < W / 2; ++l) i_lo[l] = std::int32_t(i[l]), i_hi[l] = std::int32_t(i[W / 2 + l]);
+    const HalfIndex at_lo = lo + __builtin_convertvector(i_lo, HalfIndex) * std::int64_t(sizeof(Eigen::Vector3d));
+    const HalfIndex at_hi = hi + __builtin_convertvector(i_hi, HalfIndex) * std::int64_t(sizeof(Eigen::Vector3d));
+    real c[3] = {};
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t component = std::int64_t(k * sizeof(double));
+      const HalfReal a = __builtin_convertvector(gather_bytes<double>(origin, at_lo + component), HalfReal);
+      const HalfReal b = __builtin_convertvector(gather_bytes<double>(origin, at_hi + component), HalfReal);
+      for (int l = 0; l < W / 2; ++l) c[k][l] = a[l], c[k][W / 2 + l] = b[l];
+    }
+    return {c[0], c[1], c[2]};
+  }
+
   /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
   /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
   /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
@@ -153,6 +175,32 @@ template <class T> struct WideGjk {
         best_index = select(better, i_vec, best_index);
       }
       return {vertex_component(base[0], start, best_index, 0), vertex_component(base[0], start, best_index, 1), vertex_component(base[0], start, best_index, 2)};
+    } else if constexpr (sizeof(T) == 4 && W > 1) {
+      // Float lanes: each half of the lanes is one gather of doubles with 64-bit byte offsets (the vertices are
+      // stored in double), converted to float as gather<T>() converts (round to nearest): 6 gathers per vertex
+      // instead of 3 W scalar loads, conversions and lane inserts.
+      HalfIndex start_lo{}, start_hi{};
+      mask final_index{};
+      const auto origin = reinterpret_cast<std::uintptr_t>(base[0]);
+      for (int l = 0; l < W; ++l) {
+        const auto offset = std::int64_t(reinterpret_cast<std::uintptr_t>(base[l]) - origin);
+        if (l < W / 2) start_lo[l] = offset;
+        else start_hi[l - W / 2] = offset;
+        final_index[l] = Int(last[l]);
+      }
+      mask i_vec = splat_mask(0);
+      V3 v = vertex_f(base[0], start_lo, start_hi, i_vec);
+      real best = (v.x * d.x + v.y * d.y) + v.z * d.z;
+      mask best_index = i_vec;
+      for (std::uint32_t i = 1; i < most; ++i) {
+        i_vec = wmin(splat_mask(Int(i)), final_index);  // a repeated vertex never wins a strict '>'
+        v = vertex_f(base[0], start_lo, start_hi, i_vec);
+        const real di = (v.x * d.x + v.y * d.y) + v.z * d.z;
+        const mask better = di > best;
+        best = select(better, di, best);
+        best_index = select(better, i_vec, best_index);
+      }
+      return vertex_f(base[0], start_lo, start_hi, best_index);
     } else {
       real best = dot_at(base, index, d);
       mask best_index = splat_mask(0);
@@ -398,16 +446,26 @@ template <class T> struct WideGjk {
     L.fresh = 0;
   }
 
-  static void load_side(Side& s, const ShapeCore<T>& c, int l) {
-    s.s0[l] = c.size.x();
-    s.s1[l] = c.size.y();
-    s.s2[l] = c.size.z();
+  /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
+  struct SideStart {
+    T size[3];
+    const std::array<Vec3<T>, 3>* triangle;  // triangle cores only
+    const ConvexHull* hull;                  // convex cores only
+  };
+  static SideStart side_start(const ShapeCore<T>& c) {
+    return {{c.size.x(), c.size.y(), c.size.z()}, &c.triangle, c.hull};
+  }
+
+  static void load_side(Side& s, const SideStart& c, int l) {
+    s.s0[l] = c.size[0];
+    s.s1[l] = c.size[1];
+    s.s2[l] = c.size[2];
     if (s.type == ShapeType::triangle)
       for (int v = 0; v < 3; ++v)
-        for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = c.triangle[v][i];
-    s.hull[l] = c.hull;
-    s.hint[l] = SupportHint{};
+        for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = (*c.triangle)[v][i];
     if (s.type == ShapeType::convex) {
+      s.hull[l] = c.hull;
+      s.hint[l] = SupportHint{};
       s.first_vertex[l] = c.hull->vertices.front().data();
       s.vertex_count[l] = std::uint32_t(c.hull->vertices.size());
       const std::uint32_t bit = 1u << l;
@@ -422,13 +480,23 @@ template <class T> struct WideGjk {
   }
   static Vec3<T> get_lane(const V3& v, int l) { return Vec3<T>(v.x[l], v.y[l], v.z[l]); }
 
+  /// Everything a lane reads of its pair's setup. PairSetup's refill() and the batch-array GJK's lean setup
+  /// (wide_gjk_pairs.inl, no PairSetup per pair) both start lanes through start_lane().
+  struct LaneStart {
+    T R[9], t[3];  // B's pose in A's frame, row-major
+    SideStart A, B;
+    Vec3<T> initial_direction;
+    int max_iterations;
+    bool momentum, normalize, boolean_only;
+    T tolerance, relative, touch, core_margin;
+  };
+
   /// Starts pair `p` in lane l: the reference's initialisation up to the first support point, which start()
   /// computes for all freshly refilled lanes at once.
-  static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
+  static void start_lane(Lanes& L, int l, const LaneStart& s, std::int64_t p) {
     L.pair[l] = p;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) L.R[3 * i + j][l] = s.X.R(i, j);
-    for (int i = 0; i < 3; ++i) L.t[i][l] = s.X.t[i];
+    for (int e = 0; e < 9; ++e) L.R[e][l] = s.R[e];
+    for (int i = 0; i < 3; ++i) L.t[i][l] = s.t[i];
     load_side(L.A, s.A, l);
     load_side(L.B, s.B, l);
     Vec3<T> init = s.initial_direction;
@@ -441,14 +509,34 @@ template <class T> struct WideGjk {
     L.lower[l] = -std::numeric_limits<T>::infinity();
     L.k[l] = 0;
     L.stale[l] = 0;
-    L.max_iterations[l] = s.params.max_iterations;
-    L.momentum[l] = solver != Solver::gjk ? -1 : 0;
-    L.normalize[l] = s.params.normalize_momentum ? -1 : 0;
-    L.boolean_only[l] = s.params.boolean_only ? -1 : 0;
-    L.tolerance[l] = s.params.tolerance;
-    L.relative[l] = s.params.relative_tolerance;
-    L.touch[l] = s.params.touch_tolerance;
-    L.core_margin[l] = s.params.core_margin;
+    L.max_iterations[l] = s.max_iterations;
+    L.momentum[l] = s.momentum ? -1 : 0;
+    L.normalize[l] = s.normalize ? -1 : 0;
+    L.boolean_only[l] = s.boolean_only ? -1 : 0;
+    L.tolerance[l] = s.tolerance;
+    L.relative[l] = s.relative;
+    L.touch[l] = s.touch;
+    L.core_margin[l] = s.core_margin;
+  }
+
+  static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
+    LaneStart q;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) q.R[3 * i + j] = s.X.R(i, j);
+      q.t[i] = s.X.t[i];
+    }
+    q.A = side_start(s.A);
+    q.B = side_start(s.B);
+    q.initial_direction = s.initial_direction;
+    q.max_iterations = s.params.max_iterations;
+    q.momentum = solver != Solver::gjk;
+    q.normalize = s.params.normalize_momentum;
+    q.boolean_only = s.params.boolean_only;
+    q.tolerance = s.params.tolerance;
+    q.relative = s.params.relative_tolerance;
+    q.touch = s.params.touch_tolerance;
+    q.core_margin = s.params.core_margin;
+    start_lane(L, l, q, p);
   }
 
   /// Writes lane l's result as the reference's GjkResult.

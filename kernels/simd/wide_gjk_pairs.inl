@@ -46,8 +46,8 @@ template <class T> struct WideGjkPairs {
     std::size_t next = 0;  // chunk slot the next load takes
     Chunk chunk;
     LanePair lane[W];
-    PairSetup<T> setup;  // refill()'s input, rebuilt per load
-    const Vec3<T> no_warm = Vec3<T>::Constant(std::numeric_limits<T>::quiet_NaN());
+    /// Normalised momentum directions unless both cores are strictly convex (ShapeCore::strictly_convex()).
+    bool normalize = !(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid);
 
     /// Validates the next kChunk pairs and computes their poses, W per register (prepare_pair's rule and
     /// arithmetic); invalid ones go to the fallback.
@@ -95,25 +95,65 @@ template <class T> struct WideGjkPairs {
                           side_a ? in.rotation_a : in.rotation_b, b.idx, b.consecutive);
     }
 
-    /// setup_pair_into() for a pair without closed form or warm start, then WideGjk's refill.
+    /// One side's core as make_core() builds it, read straight from the Shape record (no ShapeCore, no PairSetup:
+    /// building those per pair cost ~450 of the ~2050 instructions of an ellipsoid pair). `radius` gets the swept
+    /// radius with make_core's roundings: T(inflation), plus T(radius) for spheres and capsules.
+    static typename G::SideStart side(const Shape& shape, T& radius) {
+      typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
+      radius = T(shape.inflation);
+      switch (shape.type) {
+        case ShapeType::sphere: radius += T(shape.size.x()); break;
+        case ShapeType::capsule:
+          radius += T(shape.size.x());
+          c.size[1] = T(shape.size.y());
+          break;
+        case ShapeType::convex: c.hull = shape.hull.get(); break;
+        default:
+          for (int i = 0; i < 3; ++i) c.size[i] = T(shape.size[i]);
+          break;
+      }
+      return c;
+    }
+    /// ShapeCore::center() of a core (the hull's centroid, the origin for the other types in this path).
+    static Vec3<T> center(const typename G::SideStart& c) {
+      return c.hull ? Vec3<T>(c.hull->centroid.template cast<T>()) : Vec3<T>::Zero();
+    }
+
+    /// setup_pair_into() and set_gjk_parameters() for a pair without closed form or warm start, with their
+    /// arithmetic in their order, then WideGjk's start_lane().
     bool load(Lanes& L, int l) {
       while (next == chunk.count) {
         if (read == n) return false;
         fill_chunk();
       }
       const std::size_t s = next++;
-      PairSetup<T>& q = setup;
-      const Shape& a = in.shapes[chunk.shape_a[s]];
-      const Shape& b = in.shapes[chunk.shape_b[s]];
-      q.A = make_core<T>(a);
-      q.B = make_core<T>(b);
-      const Vec3<double> t(chunk.t[0][s], chunk.t[1][s], chunk.t[2][s]);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) q.X.R(i, j) = T(chunk.R[3 * i + j][s]);
-      q.X.t = t.template cast<T>();
-      set_gjk_parameters(q, in.bounding_radii[chunk.shape_a[s]], in.bounding_radii[chunk.shape_b[s]], norm3(t),
-                         no_warm, options);
-      G::refill(L, l, q, std::int64_t(s), options.solver);
+      const std::uint32_t ia = chunk.shape_a[s], ib = chunk.shape_b[s];
+      typename G::LaneStart q;
+      T radius_a, radius_b;
+      q.A = side(in.shapes[ia], radius_a);
+      q.B = side(in.shapes[ib], radius_b);
+      for (int e = 0; e < 9; ++e) q.R[e] = T(chunk.R[e][s]);
+      const double tx = chunk.t[0][s], ty = chunk.t[1][s], tz = chunk.t[2][s];
+      q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
+      const T radii = radius_a + radius_b;
+      const T scale = T(in.bounding_radii[ia] + in.bounding_radii[ib] + std::sqrt((tx * tx + ty * ty) + tz * tz));
+      const T floor = tolerance_floor(scale);
+      q.tolerance = std::max(T(options.tolerance), floor);
+      q.relative = T(options.relative_tolerance);
+      q.max_iterations = options.max_iterations;
+      q.momentum = options.solver != Solver::gjk;
+      q.normalize = normalize;
+      q.boolean_only = options.level == QueryLevel::boolean;
+      q.core_margin = T(options.margin) + radii;
+      q.touch = floor;
+      // MinkowskiDifference::center(): A's centre minus B's centre mapped into A's frame (mul()'s association).
+      const Vec3<T> cb = center(q.B);
+      const T* R = q.R;
+      const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + q.t[0],
+                             (R[3] * cb.x() + R[4] * cb.y()) + R[5] * cb.z() + q.t[1],
+                             (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + q.t[2]);
+      q.initial_direction = center(q.A) - b_center;
+      G::start_lane(L, l, q, std::int64_t(s));
 
       LanePair& lp = lane[l];
       lp.pair = chunk.pair[s];
@@ -121,7 +161,7 @@ template <class T> struct WideGjkPairs {
         for (int j = 0; j < 3; ++j) lp.Ra(i, j) = chunk.Ra[3 * i + j][s];
         lp.ta[i] = chunk.ta[i][s];
       }
-      lp.completion = {q.A.radius, q.B.radius, q.radii, q.scale, q.floor, q.params.tolerance, q.params.core_margin};
+      lp.completion = {radius_a, radius_b, radii, scale, floor, q.tolerance, q.core_margin};
       return true;
     }
 

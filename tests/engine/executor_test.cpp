@@ -36,19 +36,28 @@ Scene mixed_scene(std::size_t pairs, std::uint64_t seed) {
 }
 
 TEST(Executor, BitwiseIdenticalForOneAndTwoThreadsAtEveryLevelAndPrecision) {
-  const Scene s = mixed_scene(5000, 1);
-  for (Precision p : {Precision::float64, Precision::float32})
-    for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
-      QueryOptions o;
-      o.level = level;
-      o.precision = p;
-      o.threads = 1;
-      PairResults one, two;
-      collide(s.shapes, s.batch, o, one);
-      o.threads = 2;
-      collide(s.shapes, s.batch, o, two);
-      testing::expect_same_results(one, two, std::string("1 vs 2 threads, ") + to_string(level));
-    }
+  // Tiles are sized from the batch and the thread count (executor.cpp, tile_pairs): 5000 pairs make tiles of 625
+  // pairs on 1 thread, 313 on 2 and 209 on 3; 1000 pairs make 128-pair tiles on 2 and 3 threads.
+  for (std::size_t pairs : {std::size_t(5000), std::size_t(1000)}) {
+    const Scene s = mixed_scene(pairs, 1);
+    for (Precision p : {Precision::float64, Precision::float32})
+      for (QueryLevel level :
+           {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
+        QueryOptions o;
+        o.level = level;
+        o.precision = p;
+        o.threads = 1;
+        PairResults one;
+        collide(s.shapes, s.batch, o, one);
+        for (int threads : {2, 3}) {
+          o.threads = threads;
+          PairResults more;
+          collide(s.shapes, s.batch, o, more);
+          testing::expect_same_results(one, more, "1 vs " + std::to_string(threads) + " threads, " +
+                                                      std::to_string(pairs) + " pairs, " + to_string(level));
+        }
+      }
+  }
 }
 
 // Every instruction set this CPU runs gives bitwise the same results as the scalar build (and so as the

@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <set>
+
 namespace batchcol::kernels {
 namespace {
 
@@ -37,6 +41,46 @@ TEST(Support, HillClimbingOnLargeHullsEqualsALinearScan) {
       EXPECT_EQ(support(core, d, hint).dot(d), best) << n << " vertices, query " << q;
     }
   }
+}
+
+TEST(Support, ClimbsFromTheDirectionTableEqualALinearScan) {
+  // A fresh hint starts each climb from the hull's direction table (start_cell), as every pair's first support
+  // does; directions on cube-face and cell boundaries, axes and zero components included.
+  batchcol::testing::Rng rng(34);
+  for (int n : {40, 250, 940}) {
+    const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
+    ASSERT_EQ(s.hull->start_vertices.size(), kHullStartCells);
+    const ShapeCore<double> core = make_core<double>(s);
+    for (int q = 0; q < 3000; ++q) {
+      Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+      if (q % 7 == 0) d = Eigen::Vector3d::Unit(q % 3) * (q % 2 ? -1.0 : 1.0);
+      if (q % 11 == 0) d[q % 3] = 0.0;
+      if (q % 13 == 0) d = Eigen::Vector3d(1.0, 1.0, q % 2 ? -1.0 : 1.0);  // three-way tie of the face choice
+      double best = -1e300;
+      for (const auto& v : s.hull->vertices) best = std::max(best, v.dot(d));
+      SupportHint hint;  // fresh
+      EXPECT_EQ(support(core, d, hint).dot(d), best) << n << " vertices, query " << q;
+      EXPECT_NE(hint.vertex, kNoHullVertex);
+    }
+  }
+}
+
+TEST(Support, StartCellIsDefinedForEveryDirectionAndRefusesNone) {
+  EXPECT_EQ(start_cell(Eigen::Vector3d(0, 0, 0)), kNoHullVertex);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(start_cell(Eigen::Vector3d(nan, nan, nan)), kNoHullVertex);
+  batchcol::testing::Rng rng(35);
+  for (int q = 0; q < 10000; ++q) {
+    const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng) * std::pow(10.0, (q % 40) - 20);
+    EXPECT_LT(start_cell(d), kHullStartCells);
+    EXPECT_LT(start_cell(Eigen::Vector3f(d.cast<float>())), kHullStartCells);
+  }
+  // The six axis directions land on six different faces.
+  std::set<std::uint32_t> faces;
+  for (int a = 0; a < 3; ++a)
+    for (double sign : {1.0, -1.0}) faces.insert(start_cell(Eigen::Vector3d(Eigen::Vector3d::Unit(a) * sign)) /
+                                                 (kHullStartGrid * kHullStartGrid));
+  EXPECT_EQ(faces.size(), 6u);
 }
 
 TEST(Support, FloatCoresStayWithinFloatRounding) {

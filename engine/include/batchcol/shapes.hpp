@@ -24,6 +24,11 @@ constexpr int kShapeTypeCount = 9;
 
 const char* to_string(ShapeType type);
 
+/// Cells per cube-face side of ConvexHull::start_vertices (kernels/support.hpp, start_cell).
+constexpr std::uint32_t kHullStartGrid = 8;
+constexpr std::uint32_t kHullStartCells = 6 * kHullStartGrid * kHullStartGrid;
+constexpr std::uint32_t kNoHullVertex = 0xffffffffu;
+
 /// A convex polytope computed by qhull: only the hull vertices are kept, with triangulated faces (outward normals)
 /// and vertex adjacency (compressed rows) for hill-climbing support queries on large hulls.
 struct ConvexHull {
@@ -34,6 +39,18 @@ struct ConvexHull {
   std::vector<std::uint32_t> neighbors;             // vertex indices adjacent through a hull edge
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mean of the hull vertices (inside the hull)
   double radius = 0.0;  // largest vertex norm: the hull's bounding radius about the local origin
+  /// Where a support query without a previous vertex starts climbing: per cube-map cell of directions, the support
+  /// vertex of the cell's centre direction (kHullStartCells entries; empty: start at vertex 0).
+  std::vector<std::uint32_t> start_vertices;
+  /// The adjacency again, in blocks of kNeighborBlock neighbours with their coordinates in structure-of-arrays
+  /// order, so that one climbing step computes a block's dot products together (kernels/support.hpp). Vertex v's
+  /// blocks are [neighbor_block_offsets[v], neighbor_block_offsets[v + 1]); block b's indices are
+  /// neighbor_block_index[kNeighborBlock b ...] and its coordinates neighbor_block_xyz[3 kNeighborBlock b ...]
+  /// (x of each, then y, then z). A short last block repeats the vertex's first neighbour.
+  static constexpr std::uint32_t kNeighborBlock = 4;
+  std::vector<std::uint32_t> neighbor_block_offsets;
+  std::vector<std::uint32_t> neighbor_block_index;
+  std::vector<double> neighbor_block_xyz;
 };
 
 /// Computes the convex hull of `points` with qhull. Throws InputError (naming `what`) when a point is not finite or
