@@ -15,3 +15,4 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
+#include <utility>

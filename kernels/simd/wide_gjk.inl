@@ -109,20 +109,24 @@ template <class T> struct WideGjk {
   // the converted values. Sized from the double width so that every type is a valid vector in every build.
   static constexpr int Wd = Wide<double>::W;
   using HalfIndex = wmask<double>;
-  typedef std::int32_t Half32 __attribute__((vector_size(4 * Wd)));
   typedef float HalfReal __attribute__((vector_size(4 * Wd)));
   /// Vertex i[l] of lane l's hull (vertices start start[l] bytes after `origin`; lanes 0 .. W/2 in `lo`), float lanes.
   static V3 vertex_f(const double* origin, HalfIndex lo, HalfIndex hi, mask i) {
-    Half32 i_lo{}, i_hi{};
-    for (int l = 0; l < W / 2; ++l) i_lo[l] = std::int32_t(i[l]), i_hi[l] = std::int32_t(i[W / 2 + l]);
-    const HalfIndex at_lo = lo + __builtin_convertvector(i_lo, HalfIndex) * std::int64_t(sizeof(Eigen::Vector3d));
-    const HalfIndex at_hi = hi + __builtin_convertvector(i_hi, HalfIndex) * std::int64_t(sizeof(Eigen::Vector3d));
-    real c[3] = {};
+    return vertex_f(origin, lo, hi, i, std::make_index_sequence<std::size_t(W / 2)>{});
+  }
+  template <std::size_t... I>
+  static V3 vertex_f(const double* origin, HalfIndex lo, HalfIndex hi, mask i, std::index_sequence<I...>) {
+    constexpr std::size_t H = sizeof...(I);
+    const HalfIndex at_lo = lo + __builtin_convertvector(__builtin_shufflevector(i, i, I...), HalfIndex) *
+                                     std::int64_t(sizeof(Eigen::Vector3d));
+    const HalfIndex at_hi = hi + __builtin_convertvector(__builtin_shufflevector(i, i, (H + I)...), HalfIndex) *
+                                     std::int64_t(sizeof(Eigen::Vector3d));
+    real c[3];
     for (int k = 0; k < 3; ++k) {
       const std::int64_t component = std::int64_t(k * sizeof(double));
       const HalfReal a = __builtin_convertvector(gather_bytes<double>(origin, at_lo + component), HalfReal);
       const HalfReal b = __builtin_convertvector(gather_bytes<double>(origin, at_hi + component), HalfReal);
-      for (int l = 0; l < W / 2; ++l) c[k][l] = a[l], c[k][W / 2 + l] = b[l];
+      c[k] = __builtin_shufflevector(a, b, I..., (H + I)...);
     }
     return {c[0], c[1], c[2]};
   }
