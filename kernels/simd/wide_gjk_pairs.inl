@@ -168,6 +168,19 @@ template <class T> struct WideGjkPairs {
     /// complete_pair() and write_pair_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
     /// the fallback (computed again on the scalar path).
     void done(const Lanes& L, int l, GjkStatus status) {
+      if (status == GjkStatus::separated_proven || status == GjkStatus::collision_proven) {
+        // A boolean query's usual ending: complete_from_gjk() and write_pair_output() reduce to a converged pair
+        // whose collide is decided, its world direction and its iterations (the same arithmetic), without a
+        // GjkResult (the simplex, 40 values) and a PairOutput per pair.
+        const LanePair& lp = lane[l];
+        const std::uint32_t i = lp.pair;
+        out.status[i] = Status::converged;
+        out.collide[i] = status == GjkStatus::collision_proven ? 1 : 0;
+        const Eigen::Vector3d d = mul<double>(lp.Ra, G::get_lane(L.direction, l).template cast<double>());
+        for (int c = 0; c < 3; ++c) out.direction[c][i] = d[c];
+        out.iterations[i] = int(L.k[l]);
+        return;
+      }
       GjkResult<T> g;
       G::finish(L, l, status, g, options.level >= QueryLevel::witness);
       const LanePair& lp = lane[l];
