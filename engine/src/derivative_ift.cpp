@@ -31,7 +31,8 @@ PairJacobians implicit_jacobians(const PairGeometry& g) {
   C.rightCols(kb) = g.scale * g.flat_b.leftCols(kb);
   if (k > 0) {
     const Eigen::JacobiSVD<Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 4>> svd(C);
-    // Unit flats are independent when their smallest singular value is O(1); 1e-6 matches kTieTolerance's margin.
+    // Unit flats are independent when their smallest singular value is O(1); below 1e-6 two flats are parallel
+    // to within a micro-radian, as close to a face-face contact as the witness points' accuracy can tell.
     if (k > 3 || !(svd.singularValues()(k - 1) > 1e-6 * g.scale)) {
       J.dependent = true;
       set_nan(J);

@@ -29,62 +29,88 @@ void add_rim(Eigen::Matrix3d& H, double r, const Eigen::Vector3d& u, double rho)
 void add_flat(SupportJacobian& J, const Eigen::Vector3d& u, Eigen::Vector3d d, double length) {
   d -= u.dot(d) * u;
   for (int k = 0; k < J.flats; ++k) d -= J.flat.col(k).dot(d) * J.flat.col(k);
-  if (J.flats < 2 && d.norm() > 1e-9 * length) J.flat.col(J.flats++) = d.normalized();
+  if (J.flats < 2 && d.norm() > 1e-6 * length) J.flat.col(J.flats++) = d.normalized();
 }
 
-// A polytope given by its vertices: the vertices whose dot product is within the tolerance of the best (scaled by
-// the vertices' extent, so the test is independent of units) span the flat directions.
-template <class Points> void vertex_ties(SupportJacobian& J, const Points& vertices, const Eigen::Vector3d& u,
-                                         double radius) {
-  double best = -INFINITY;
-  Eigen::Vector3d top = Eigen::Vector3d::Zero();
-  for (const auto& v : vertices)
-    if (v.dot(u) > best) best = v.dot(u), top = v;
-  for (const auto& v : vertices)
-    if (v.dot(u) >= best - kTieTolerance * radius) add_flat(J, u, v - top, radius);
+// A hull: the witness lies on the planes of the faces containing it (to kExactFeature): one plane, a face (two
+// flats); two, an edge (one flat, along both normals' cross product); three or more, a vertex.
+void hull_feature(SupportJacobian& J, const ConvexHull& hull, const Eigen::Vector3d& u, const Eigen::Vector3d& p,
+                  double tolerance) {
+  Eigen::Vector3d planes[3];
+  int count = 0;
+  for (std::size_t f = 0; f < hull.faces.size() && count < 3; ++f) {
+    const Eigen::Vector3d& n = hull.face_normals[f];
+    if (n.dot(p - hull.vertices[hull.faces[f][0]]) < -tolerance) continue;
+    bool seen = false;  // triangulated faces repeat their plane
+    for (int k = 0; k < count; ++k) seen = seen || planes[k].dot(n) > 1.0 - 1e-9;
+    if (!seen) planes[count++] = n;
+  }
+  if (count == 1) {
+    const Eigen::Vector3d t = planes[0].unitOrthogonal();
+    add_flat(J, u, t, 1.0);
+    add_flat(J, u, planes[0].cross(t), 1.0);
+  } else if (count == 2) {
+    add_flat(J, u, planes[0].cross(planes[1]), 1.0);
+  }
+}
+
+// A triangle: the witness's barycentric coordinates; the vertices with a positive weight span its feature.
+void triangle_feature(SupportJacobian& J, const std::array<Eigen::Vector3d, 3>& v, const Eigen::Vector3d& u,
+                      const Eigen::Vector3d& p) {
+  const Eigen::Vector3d e1 = v[1] - v[0], e2 = v[2] - v[0], q = p - v[0];
+  Eigen::Matrix2d G;
+  G << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+  const Eigen::Vector2d l = G.inverse() * Eigen::Vector2d(e1.dot(q), e2.dot(q));
+  const double weights[3] = {1.0 - l.x() - l.y(), l.x(), l.y()};
+  const Eigen::Vector3d* first = nullptr;
+  for (int k = 0; k < 3; ++k) {
+    if (!(weights[k] > kExactFeature)) continue;
+    if (!first) first = &v[k];
+    else add_flat(J, u, v[k] - *first, std::sqrt(G.trace()));
+  }
 }
 
 }  // namespace
 
-SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u) {
+SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {
   SupportJacobian J;
-  const double rho = std::hypot(u.x(), u.y());
+  const double r = round_radius(s);
+  const Eigen::Vector3d p = witness - r * u;  // the witness on the core
+  const double tol = kExactFeature * s.bounding_radius(), curved_tol = kCurvedFeature * s.bounding_radius();
+  const double rho = std::hypot(u.x(), u.y()), rho_p = std::hypot(p.x(), p.y());
   const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
   switch (s.type) {
     case ShapeType::sphere: break;
     case ShapeType::capsule:
-      if (std::abs(u.z()) <= kTieTolerance) add_flat(J, u, ez, 1.0);
+      if (std::abs(p.z()) < s.size.y() - tol) add_flat(J, u, ez, 1.0);  // inside the segment
       break;
     case ShapeType::box:
       J.zero = true;
       for (int k = 0; k < 3; ++k)
-        if (std::abs(u(k)) <= kTieTolerance) add_flat(J, u, Eigen::Vector3d::Unit(k), 1.0);
+        if (std::abs(p(k)) < s.size(k) - tol) add_flat(J, u, Eigen::Vector3d::Unit(k), 1.0);
       break;
     case ShapeType::cylinder:
-      if (rho <= kTieTolerance) {  // a cap
+      if (rho_p < s.size.x() - curved_tol) {  // inside a cap
         add_flat(J, u, ex, 1.0);
         add_flat(J, u, ey, 1.0);
         break;
       }
-      add_rim(J.H, s.size.x(), u, rho);
-      if (std::abs(u.z()) <= kTieTolerance) add_flat(J, u, ez, 1.0);  // the side line
+      if (rho > 0.0) add_rim(J.H, s.size.x(), u, rho);
+      if (std::abs(p.z()) < s.size.y() - tol) add_flat(J, u, ez, 1.0);  // on the side line
       break;
     case ShapeType::cone: {
       const double h = s.size.y(), radius = s.size.x();
-      const double apex_minus_rim = 2.0 * h * u.z() - radius * rho;  // support value of the apex minus the rim's
-      if (rho <= kTieTolerance && u.z() < 0.0) {  // the base
+      if (p.z() < -h + tol && rho_p < radius - curved_tol) {  // inside the base
         add_flat(J, u, ex, 1.0);
         add_flat(J, u, ey, 1.0);
-        break;
-      }
-      if (std::abs(apex_minus_rim) <= kTieTolerance * (h + radius)) {  // a generator line, apex to rim
-        add_flat(J, u, Eigen::Vector3d(radius * u.x() / rho, radius * u.y() / rho, -2.0 * h), h + radius);
-        add_rim(J.H, radius, u, rho);  // the rim end's curvature; the generator's own direction is flat
-        J.approximate = true;
-      } else if (apex_minus_rim > 0.0) {
+      } else if ((p - h * ez).norm() <= tol) {  // the apex
         J.zero = true;
-      } else {
+      } else if (rho > 0.0) {
         add_rim(J.H, radius, u, rho);
+        if (rho_p < radius - curved_tol) {  // on a generator line, between apex and rim
+          add_flat(J, u, Eigen::Vector3d(radius * u.x() / rho, radius * u.y() / rho, -2.0 * h), h + radius);
+          J.approximate = true;  // the rim's curvature, not the generator point's
+        }
       }
       break;
     }
@@ -98,15 +124,14 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u) {
     }
     case ShapeType::convex:
       J.zero = true;
-      vertex_ties(J, s.hull->vertices, u, s.hull->radius);
+      hull_feature(J, *s.hull, u, p, tol);
       break;
     case ShapeType::triangle:
       J.zero = true;
-      vertex_ties(J, s.triangle, u, std::max({s.triangle[0].norm(), s.triangle[1].norm(), s.triangle[2].norm()}));
+      triangle_feature(J, s.triangle, u, p);
       break;
     case ShapeType::halfspace: J.unsupported = true; return J;
   }
-  const double r = round_radius(s);
   if (r > 0.0) J.H += r * (Eigen::Matrix3d::Identity() - u * u.transpose());
   J.zero = J.zero && r == 0.0 && J.flats == 0;
   return J;

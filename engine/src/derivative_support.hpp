@@ -11,16 +11,16 @@
 
 namespace batchcol::detail {
 
-/// Directions within this of a tie of the support map count as the tie. GJK's normals for polytopes come from the
-/// final simplex and are exact to a few ulps in the pairs this was written for (finite termination), and curved
-/// cores give no ties; a 1e-7 band (relative: direction components, or dot-product gaps over the hull radius)
-/// catches a face or edge contact with four orders of margin, while a random direction falls into it with
-/// probability ~1e-7.
-constexpr double kTieTolerance = 1e-7;
+/// Where the witness lies on its core decides which face, edge or vertex the contact is on. Positions, not the
+/// normal, are tested: GJK's normal on a curved pair is only accurate to ~sqrt(2 tol / R) (1e-4 rad at the default
+/// 1e-8 m tolerance), so a cylinder touching along its side would look like a rim contact, whereas GJK's witness on
+/// a polytope, a segment or a cylinder's side is a convex combination of support points of that very feature, on
+/// it to rounding. kExactFeature (relative to the shape's bounding radius) is that rounding with a wide margin.
+/// kCurvedFeature is for the one boundary that is curved, a cap's or base's rim: a witness combining nearby rim
+/// points lies r theta^2 / 2 ~ 1e-8 r inside the rim, far less than this.
+constexpr double kExactFeature = 1e-9;
+constexpr double kCurvedFeature = 1e-4;
 
-/// The support map's Jacobian at a unit direction u, split into a finite part H and flat directions: where u is
-/// (within kTieTolerance) normal to a face or edge of the core, S jumps along that face, which the derivatives treat
-/// as infinite curvature along the orthonormal columns of `flat` (the limit is taken exactly, derivative_ift.hpp).
 struct SupportJacobian {
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // d S(u) / d u at the unit direction u (degree -1 in |u|)
   Eigen::Matrix<double, 3, 2> flat = Eigen::Matrix<double, 3, 2>::Zero();
@@ -30,8 +30,9 @@ struct SupportJacobian {
   bool approximate = false;  // a cone's side: the curvature across a generator varies along it (the rim's is used)
 };
 
-/// Exact support-map Jacobian of `shape` at the unit local direction u.
-SupportJacobian support_jacobian(const Shape& shape, const Eigen::Vector3d& u);
+/// Exact support-map Jacobian of `shape` at the unit local direction u, the witness being `witness` (local frame,
+/// inflation included).
+SupportJacobian support_jacobian(const Shape& shape, const Eigen::Vector3d& u, const Eigen::Vector3d& witness);
 
 /// The full support point (core plus inflation radius) of `shape` at local direction u (not necessarily unit).
 Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);

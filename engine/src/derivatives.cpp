@@ -53,7 +53,9 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
   DerivativeStatus status = DerivativeStatus::smooth;
   if (o.method == DerivativeMethod::analytic) {
-    const SupportJacobian J_a = support_jacobian(a, u_a), J_b = support_jacobian(b, u_b);
+    const Eigen::Vector3d p_a = R_a.transpose() * (g.witness_a - batch.translation_a[i]);
+    const Eigen::Vector3d p_b = R_b.transpose() * (g.witness_b - batch.translation_b[i]);
+    const SupportJacobian J_a = support_jacobian(a, u_a, p_a), J_b = support_jacobian(b, u_b, p_b);
     g.H_a = R_a * J_a.H * R_a.transpose();
     g.H_b = R_b * J_b.H * R_b.transpose();
     g.flats_a = J_a.flats;
