@@ -20,7 +20,7 @@ namespace {
 struct DescentSettings {
   std::string out;
   int iterations = 100, samples = 16;
-  double noise = 0.05, step = 0.5, fd_step = 1e-6;
+  double noise = 0.05, step = 0.1, fd_step = 1e-6, max_twist = 0.05;
 };
 
 using Mat36 = Eigen::Matrix<double, 3, 6>;
@@ -104,7 +104,11 @@ void run_case(const std::string& name, Problem& p, const Pose& start, const Pose
       const bool ok = witness(p, T, xa, xb);
       csv += name + "," + method + "," + std::to_string(it) + "," + (ok ? std::to_string(cost(p, xa, xb)) : "") + "\n";
       if (!ok || it == s.iterations) break;
-      T = twisted(T, -s.step * gradient(p, T, method, s, it));
+      // One step for every method, capped at max_twist (m and rad) so that a noisy gradient cannot throw the
+      // shapes apart in one step: the curves then compare the gradients' directions, not their outliers.
+      Vec6 xi = -s.step * gradient(p, T, method, s, it);
+      if (xi.norm() > s.max_twist) xi *= s.max_twist / xi.norm();
+      T = twisted(T, xi);
     }
   }
 }
@@ -114,7 +118,8 @@ int run_descent(const DescentSettings& s) {
   check.samples = s.samples;
   check.noise = s.noise;
   validate(check);
-  if (!(s.step > 0.0) || !(s.fd_step > 0.0)) throw InputError("--step and --fd-step must be > 0");
+  if (!(s.step > 0.0) || !(s.fd_step > 0.0) || !(s.max_twist > 0.0))
+    throw InputError("--step, --fd-step and --max-twist must be > 0");
   std::string csv = "case,method,iteration,cost\n";
   const Pose start{Eigen::Vector3d(0.9, 0.3, 0.2), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, 2, 3).normalized()))};
   const Pose target{Eigen::Vector3d(0.7, -0.2, 0.1), Eigen::Quaterniond(Eigen::AngleAxisd(-0.4, Eigen::Vector3d(3, -1, 2).normalized()))};
@@ -156,6 +161,7 @@ Command add_descent_command(CLI::App& parent) {
   app->add_option("--noise", s->noise, "Relative noise of the smoothed derivatives");
   app->add_option("--step", s->step, "Step size (the twist is -step * gradient)");
   app->add_option("--fd-step", s->fd_step, "Finite-difference step (m, rad)");
+  app->add_option("--max-twist", s->max_twist, "Largest twist per step (m, rad)");
   return {app, [s] { return run_descent(*s); }};
 }
 
