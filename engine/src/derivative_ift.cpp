@@ -39,18 +39,27 @@ PairJacobians implicit_jacobians(const PairGeometry& g) {
       return J;
     }
   }
-  System S = System::Zero(3 + k, 3 + k);
-  S.topLeftCorner<3, 3>() = g.distance * Eigen::Matrix3d::Identity() + g.H_a + g.H_b;
-  S.topRightCorner(3, k) = C;
-  S.bottomLeftCorner(k, 3) = C.transpose();
-  const Eigen::SelfAdjointEigenSolver<System> eig(0.5 * (S + S.transpose()));
-  const auto lambda = eig.eigenvalues();
-  if (!(lambda.cwiseAbs().minCoeff() > 1e-9 * g.scale)) {
-    J.singular = true;
-    set_nan(J);
-    return J;
+  // Separated pairs without flats (the smooth common case): sd I + H_a + H_b >= sd I is positive definite, its
+  // Cholesky factor solves the system (an eigendecomposition is needed only to test the general case).
+  const Eigen::Matrix3d M0 = g.distance * Eigen::Matrix3d::Identity() + g.H_a + g.H_b;
+  const bool definite = k == 0 && g.distance > 1e-9 * g.scale;
+  System inverse(3 + k, 3 + k);
+  if (definite) {
+    inverse = M0.llt().solve(Eigen::Matrix3d::Identity());
+  } else {
+    System S = System::Zero(3 + k, 3 + k);
+    S.topLeftCorner<3, 3>() = M0;
+    S.topRightCorner(3, k) = C;
+    S.bottomLeftCorner(k, 3) = C.transpose();
+    const Eigen::SelfAdjointEigenSolver<System> eig(0.5 * (S + S.transpose()));
+    const auto lambda = eig.eigenvalues();
+    if (!(lambda.cwiseAbs().minCoeff() > 1e-9 * g.scale)) {
+      J.singular = true;
+      set_nan(J);
+      return J;
+    }
+    inverse = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
   }
-  const System inverse = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
   const Mat36 rotation_of_n = (Mat36() << Eigen::Matrix3d::Zero(), skew(n)).finished();  // [0, [n]x]
   const Mat36 F_a = (Mat36() << Eigen::Matrix3d::Identity(), -skew(g.witness_a) + g.H_a * skew(n)).finished();
   const Mat36 F_b = (Mat36() << -Eigen::Matrix3d::Identity(), skew(g.witness_b) + g.H_b * skew(n)).finished();

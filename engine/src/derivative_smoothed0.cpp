@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace batchcol::detail {
 namespace {
@@ -24,48 +25,52 @@ Noise noise_of(const ShapeTable& shapes, std::uint32_t b, const DerivativeOption
   return o.noise_scale == NoiseScale::relative ? Noise{o.noise * r, o.noise} : Noise{o.noise, o.noise / r};
 }
 
-// Standard normal z in R^6 of sample j of pair i; odd samples are the antithetic copies of the even ones.
-void sample_noise(const DerivativeOptions& o, std::size_t i, int j, double z[6]) {
-  gaussian_vector<6>(o.seed, i, static_cast<std::uint64_t>(j / 2), 0, z);
-  if (j % 2 == 1)
-    for (int k = 0; k < 6; ++k) z[k] = -z[k];
-}
-
-// Shape b's pose perturbed about its own origin: t + s_t z_v, exp(s_w z_w) R.
-void perturb(const PairBatch& batch, std::size_t i, const Noise& s, const double z[6], PairBatch& out,
-             std::size_t k) {
+// Shape b's pose perturbed about its own origin: t + s_t z_v, q R with q = exp(s_w z_w).
+void perturb(const PairBatch& batch, std::size_t i, const Noise& s, const double z[6], const Eigen::Quaterniond& q,
+             PairBatch& out, std::size_t k) {
   out.shape_a[k] = batch.shape_a[i];
   out.shape_b[k] = batch.shape_b[i];
   out.translation_a.set(k, batch.translation_a[i]);
   out.rotation_a.set(k, batch.rotation_a[i]);
   out.translation_b.set(k, batch.translation_b[i] + s.translation * Eigen::Vector3d(z[0], z[1], z[2]));
-  const Eigen::Vector3d w = s.rotation * Eigen::Vector3d(z[3], z[4], z[5]);
-  const double angle = w.norm();
-  const Eigen::Quaterniond q = angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle))
-                                           : Eigen::Quaterniond::Identity();
   out.rotation_b.set(k, (q * batch.rotation_b[i]).normalized());
 }
 
+// Fills the samples of pairs [first, first + count) and their standard normal noise (6 per sample, in `noise`).
+// Sample 2k draws z from the key (seed, pair, k); sample 2k+1 is its antithetic copy -z, whose rotation is the
+// inverse (conjugate) of sample 2k's: one draw and one exponential serve both.
 void build_samples(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                   const DerivativeOptions& o, int threads, std::size_t first, std::size_t count, PairBatch& out) {
+                   const DerivativeOptions& o, int threads, std::size_t first, std::size_t count, PairBatch& out,
+                   std::vector<double>& noise) {
   const std::size_t M = static_cast<std::size_t>(o.samples), total = count * M;
   out.shape_a.resize(total);
   out.shape_b.resize(total);
   for (Vec3Array* v : {&out.translation_a, &out.translation_b, &out.warm_start}) v->resize(total);
   out.rotation_a.resize(total);
   out.rotation_b.resize(total);
+  noise.resize(6 * total);
   const bool warm = results.direction.size() == batch.size();
   if (!warm) out.warm_start = Vec3Array();
   for_pairs(threads, count, [&](std::size_t begin, std::size_t end) {
-    double z[6];
     for (std::size_t p = begin; p < end; ++p) {
       const std::size_t i = first + p;
       const Noise s = noise_of(shapes, batch.shape_b[i], o);
-      for (int j = 0; j < o.samples; ++j) {
-        sample_noise(o, i, j, z);
-        perturb(batch, i, s, z, out, p * M + j);
-        if (warm) out.warm_start.set(p * M + j, results.direction[i]);
+      for (std::size_t j = 0; j < M; j += 2) {
+        double* z = &noise[6 * (p * M + j)];
+        gaussian_vector<6>(o.seed, i, j / 2, 0, z);
+        const Eigen::Vector3d w = s.rotation * Eigen::Vector3d(z[3], z[4], z[5]);
+        const double angle = w.norm();
+        const Eigen::Quaterniond q = angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle))
+                                                 : Eigen::Quaterniond::Identity();
+        perturb(batch, i, s, z, q, out, p * M + j);
+        if (j + 1 < M) {
+          double* minus = z + 6;
+          for (int k = 0; k < 6; ++k) minus[k] = -z[k];
+          perturb(batch, i, s, minus, q.conjugate(), out, p * M + j + 1);
+        }
       }
+      if (warm)
+        for (std::size_t j = 0; j < M; ++j) out.warm_start.set(p * M + j, results.direction[i]);
     }
   });
 }
@@ -80,7 +85,7 @@ bool sample_values(const PairResults& r, std::size_t k, Values& v) {
 
 void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                  const DerivativeOptions& o, std::size_t i, const PairResults& samples, std::size_t first_sample,
-                 DerivativeResults& d) {
+                 const double* noise, DerivativeResults& d) {
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;
   if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return;
@@ -90,10 +95,9 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
   g0 << g.distance, g.witness_a, g.witness_b, g.normal;
   Eigen::Matrix<double, 10, 6> G = Eigen::Matrix<double, 10, 6>::Zero();
   int valid = 0;
-  double z[6];
   for (int j = 0; j < o.samples; ++j) {
     if (!sample_values(samples, first_sample + j, v)) continue;
-    sample_noise(o, i, j, z);
+    const double* z = noise + 6 * j;
     Eigen::Matrix<double, 1, 6> score;  // S^-1 z: the score of the Gaussian over the noise scale
     score << z[0] / s.translation, z[1] / s.translation, z[2] / s.translation, z[3] / s.rotation,
         z[4] / s.rotation, z[5] / s.rotation;
@@ -134,13 +138,14 @@ void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOpti
   const std::size_t chunk = std::max<std::size_t>(1, kSamplesPerCall / M);
   PairBatch samples;
   PairResults sample_results;
+  std::vector<double> noise;
   for (std::size_t first = 0; first < n; first += chunk) {
     const std::size_t count = std::min(chunk, n - first);
-    build_samples(shapes, batch, results, o, query.threads, first, count, samples);
+    build_samples(shapes, batch, results, o, query.threads, first, count, samples, noise);
     collide(shapes, samples, query, sample_results);
     for_pairs(query.threads, count, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p)
-        reduce_pair(shapes, batch, results, o, first + p, sample_results, p * M, d);
+        reduce_pair(shapes, batch, results, o, first + p, sample_results, p * M, &noise[6 * p * M], d);
     });
   }
 }
