@@ -1,5 +1,6 @@
 // Throughput of differentiate() against the plain witness query on the same separated pairs (issue #18's speed
-// targets): analytic, and smoothed0 / smoothed1 with M = 4, 16, 64, for ellipsoid pairs and random 24-point hull pairs.
+// targets): analytic, and smoothed0 / smoothed1 with M = 4, 16, 64, for ellipsoid pairs and random 24-point hull
+// pairs.
 // Reports pairs per second of wall time (derivative pairs, not samples; TBB threads work outside the main
 // thread, so CPU time would miss them); compare rows of one run, the machine is shared.
 #include "support/derivative_reference.hpp"

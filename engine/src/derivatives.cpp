@@ -99,7 +99,8 @@ void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, con
   detail::check_sizes(batch, results);
   derivatives.resize(batch.size(), false);
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) detail::differentiate_pair(shapes, batch, results, options, i, derivatives);
+    for (std::size_t i = begin; i < end; ++i)
+      detail::differentiate_pair(shapes, batch, results, options, i, derivatives);
   });
 }
 

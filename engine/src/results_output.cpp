@@ -86,7 +86,8 @@ std::vector<std::string> derivative_columns(const DerivativeResults& d) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 6; ++c) names.push_back(m + std::to_string(r) + std::to_string(c));
   if (!d.smoothed_distance.empty())
-    for (const char* v : {"s_distance", "s_pa_x", "s_pa_y", "s_pa_z", "s_pb_x", "s_pb_y", "s_pb_z", "s_n_x", "s_n_y", "s_n_z"})
+    for (const char* v :
+         {"s_distance", "s_pa_x", "s_pa_y", "s_pa_z", "s_pb_x", "s_pb_y", "s_pb_z", "s_n_x", "s_n_y", "s_n_z"})
       names.push_back(v);
   return names;
 }

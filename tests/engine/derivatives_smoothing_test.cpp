@@ -96,7 +96,8 @@ TEST(DerivativesSmoothing, FirstOrderIsInformativeOnPolytopes) {
   for (DerivativeStatus st : analytic.status) ++counts[static_cast<int>(st)];
   std::printf("analytic statuses: smooth %d, zero_curvature %d, nonsmooth %d, singular %d\n", counts[0], counts[1],
               counts[2], counts[3]);
-  std::printf("pairs whose witness a is a vertex %d (%d with a non-zero smoothed1 Jacobian), face normals %d (%d) of %zu\n",
+  std::printf("pairs whose witness a is a vertex %d (%d with a non-zero smoothed1 Jacobian), face normals %d (%d) "
+              "of %zu\n",
               vertex_pairs, informative_vertex, face_pairs, informative_face, batch.size());
   EXPECT_GE(vertex_pairs, 10);
   EXPECT_GE(face_pairs, 10);
@@ -122,10 +123,11 @@ TEST(DerivativesSmoothing, FirstOrderNeedsFarFewerSamples) {
   ShapeTable shapes;
   Rng rng(3);
   PairBatch ellipsoids, hulls;
-  ellipsoids.add(shapes.add(Shape::ellipsoid(0.1, 0.2, 0.3)), Pose::identity(), shapes.add(Shape::ellipsoid(0.3, 0.15, 0.1)),
-                 {Eigen::Vector3d(0.5, 0.2, 0.1), random_rotation(rng)});
+  ellipsoids.add(shapes.add(Shape::ellipsoid(0.1, 0.2, 0.3)), Pose::identity(),
+                 shapes.add(Shape::ellipsoid(0.3, 0.15, 0.1)), {Eigen::Vector3d(0.5, 0.2, 0.1), random_rotation(rng)});
   hulls.add(shapes.add(Shape::convex(random_hull_points(rng, 8, 0.1, 0.3))), Pose::identity(),
-            shapes.add(Shape::convex(random_hull_points(rng, 8, 0.1, 0.3))), {Eigen::Vector3d(0.6, 0.1, 0.2), random_rotation(rng)});
+            shapes.add(Shape::convex(random_hull_points(rng, 8, 0.1, 0.3))),
+            {Eigen::Vector3d(0.6, 0.1, 0.2), random_rotation(rng)});
   std::printf("pair        M   SE 0th order   SE 1st order  (relative standard error of d witness_b / d xi_b, "
               "eps = 0.05, 40 seeds)\n");
   for (const auto* b : {&ellipsoids, &hulls}) {

@@ -26,7 +26,9 @@ bool strictly_convex(const Shape& s) {
 // Jacobian's own error only slows convergence, the fixed point is f's).
 void polish(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d& xa, Eigen::Vector3d& xb) {
   Eigen::Vector3d z = xb - xa;
-  const auto f = [&](const Eigen::Vector3d& v) { return Eigen::Vector3d(v + world_support(a, pa, v) - world_support(b, pb, -v)); };
+  const auto f = [&](const Eigen::Vector3d& v) {
+    return Eigen::Vector3d(v + world_support(a, pa, v) - world_support(b, pb, -v));
+  };
   for (int it = 0; it < 40; ++it) {
     const Eigen::Vector3d r = f(z);
     if (r.norm() <= 1e-17 * (1.0 + z.norm())) break;
@@ -44,7 +46,8 @@ void polish(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eige
 Pose twisted(const Pose& pose, const Eigen::Matrix<double, 6, 1>& xi, double h) {
   const Eigen::Vector3d w = h * xi.tail<3>();
   const double angle = w.norm();
-  const Eigen::Quaterniond q = angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond q =
+      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
   return {q * pose.translation + h * xi.head<3>(), (q * pose.rotation).normalized()};
 }
 

@@ -39,8 +39,8 @@ TEST_F(DerivativesCli, AnalyticAddsTheDerivativeColumns) {
 
 TEST_F(DerivativesCli, SmoothedZeroAddsTheSmoothedValuesToJson) {
   const fs::path out = dir_ / "d.json";
-  const RunResult r = run("query " + file("b.json", kSpheres) + " --derivatives smoothed0 --samples 8 --noise 0.01 --seed 3 --out '" +
-                          out.string() + "'");
+  const RunResult r = run("query " + file("b.json", kSpheres) +
+                          " --derivatives smoothed0 --samples 8 --noise 0.01 --seed 3 --out '" + out.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string json = read_text(out);
   EXPECT_NE(json.find("\"d_status\":\"smooth\""), std::string::npos);

@@ -29,7 +29,8 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 Pose twisted(const Pose& pose, const Vec6& xi) {
   const Eigen::Vector3d w = xi.tail<3>();
   const double angle = w.norm();
-  const Eigen::Quaterniond q = angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond q =
+      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
   return {q * pose.translation + xi.head<3>(), (q * pose.rotation).normalized()};
 }
 
@@ -61,7 +62,8 @@ double cost(const Problem& p, const Eigen::Vector3d& xa, const Eigen::Vector3d& 
 
 // dC/dxi_b from the witness Jacobians w.r.t. b's twist.
 Vec6 chain(const Problem& p, const Eigen::Vector3d& xa, const Eigen::Vector3d& xb, const Mat36& Ja, const Mat36& Jb) {
-  return 2.0 * (Ja.transpose() * (xa - p.xa_des) + Jb.transpose() * (xb - p.xb_des) + (Ja - Jb).transpose() * (xa - xb));
+  return 2.0 * (Ja.transpose() * (xa - p.xa_des) + Jb.transpose() * (xb - p.xb_des) +
+                (Ja - Jb).transpose() * (xa - xb));
 }
 
 Vec6 gradient(const Problem& p, const Pose& Tb, const std::string& method, const DescentSettings& s, int iteration) {
@@ -121,8 +123,10 @@ int run_descent(const DescentSettings& s) {
   if (!(s.step > 0.0) || !(s.fd_step > 0.0) || !(s.max_twist > 0.0))
     throw InputError("--step, --fd-step and --max-twist must be > 0");
   std::string csv = "case,method,iteration,cost\n";
-  const Pose start{Eigen::Vector3d(0.9, 0.3, 0.2), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, 2, 3).normalized()))};
-  const Pose target{Eigen::Vector3d(0.7, -0.2, 0.1), Eigen::Quaterniond(Eigen::AngleAxisd(-0.4, Eigen::Vector3d(3, -1, 2).normalized()))};
+  const Pose start{Eigen::Vector3d(0.9, 0.3, 0.2),
+                   Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, 2, 3).normalized()))};
+  const Pose target{Eigen::Vector3d(0.7, -0.2, 0.1),
+                    Eigen::Quaterniond(Eigen::AngleAxisd(-0.4, Eigen::Vector3d(3, -1, 2).normalized()))};
   {
     Problem p;
     p.a = p.shapes.add(Shape::ellipsoid(0.2, 0.3, 0.15));
