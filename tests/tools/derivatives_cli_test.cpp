@@ -62,5 +62,19 @@ TEST_F(DerivativesCli, BadDerivativeOptionsExitWithTwo) {
   }
 }
 
+TEST_F(DerivativesCli, BenchTimesDerivatives) {
+  RunResult r = run("bench --case sphere-ellipsoid --pairs 50 --runs 5 --min-run-ms 0 --no-peers --json "
+                    "--derivatives smoothed1 --samples 4");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"derivatives\""), std::string::npos);
+  EXPECT_NE(r.out.find("\"smoothed1\""), std::string::npos);
+  r = run("bench --case sphere-ellipsoid --pairs 50 --no-peers --derivatives smoothed0 --samples 0");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("samples"), std::string::npos) << r.err;
+  r = run("bench --case sphere-ellipsoid --pairs 50 --no-peers --derivatives analytic --query boolean");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--query"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace batchcol::testing

@@ -49,12 +49,6 @@ Format format_of(const std::string& path) {
   throw InputError("--out " + path + ": unknown output format (use a .csv or .json file name)");
 }
 
-DerivativeMethod parse_derivative_method(const std::string& name) {
-  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
-    if (name == to_string(m)) return m;
-  throw InputError("--derivatives: unknown method '" + name + "' (analytic, smoothed0 or smoothed1)");
-}
-
 int run_query(const QuerySettings& s) {
   const Format format = s.out.empty() ? Format::csv : format_of(s.out);
   const BatchFile batch = load_batch_file(s.batch_path);
@@ -97,6 +91,12 @@ int run_query(const QuerySettings& s) {
 }
 
 }  // namespace
+
+DerivativeMethod parse_derivative_method(const std::string& name) {
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
+    if (name == to_string(m)) return m;
+  throw InputError("--derivatives: unknown method '" + name + "' (analytic, smoothed0 or smoothed1)");
+}
 
 Command add_query_command(CLI::App& parent) {
   auto s = std::make_shared<QuerySettings>();
