@@ -78,6 +78,31 @@ TEST(DerivativesAnalytic, CapsulePairsMatchFiniteDifferences) {
   EXPECT_LE(e.normal, 1e-5);
 }
 
+// Spheres against cylinders and boxes (closed-form reference): a cylinder's rim (curved), side (a flat along the
+// axis) and caps (two flats), a box's faces, edges and vertices.
+TEST(DerivativesAnalytic, SpheresAgainstCylindersAndBoxesMatchFiniteDifferences) {
+  Rng rng(22);
+  ShapeTable shapes;
+  const PairBatch mixed =
+      random_separated_pairs(rng, shapes, {ShapeType::sphere, ShapeType::cylinder, ShapeType::box}, 3000);
+  PairBatch batch;  // the sphere-cylinder and sphere-box pairs without inflation on the solid
+  for (std::size_t i = 0; i < mixed.size(); ++i) {
+    const Shape& a = shapes[mixed.shape_a[i]];
+    const Shape& b = shapes[mixed.shape_b[i]];
+    const bool sphere_solid = (a.type == ShapeType::sphere) != (b.type == ShapeType::sphere);
+    const bool plain =
+        (a.type == ShapeType::sphere || a.inflation == 0.0) && (b.type == ShapeType::sphere || b.inflation == 0.0);
+    if (sphere_solid && plain) batch.add(mixed.shape_a[i], mixed.pose_a(i), mixed.shape_b[i], mixed.pose_b(i));
+  }
+  const PairResults exact = exact_witness(shapes, batch);
+  const Errors e = compare(shapes, batch, exact, 1e-4, {DerivativeStatus::smooth});
+  report("spheres against cylinders/boxes", e);
+  EXPECT_GE(e.compared, 500);
+  EXPECT_LE(e.distance, 1e-6);
+  EXPECT_LE(e.witness, 1e-5);
+  EXPECT_LE(e.normal, 1e-5);
+}
+
 // Polytopes (boxes, 8-vertex hulls): vertex-face and edge-edge contacts are smooth (a witness slides on the face or
 // edge), vertex-vertex ones have zero curvature; GJK terminates exactly on polytopes. Steps of 1e-4 distance keep
 // the contact features unchanged.

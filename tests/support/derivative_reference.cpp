@@ -3,6 +3,7 @@
 #include "kernels/shape_core.hpp"
 #include "kernels/support.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace batchcol::testing {
@@ -41,6 +42,38 @@ void polish(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eige
   xb = world_support(b, pb, -z);
 }
 
+// The closest point of a (non-inflated) cylinder or box to a point q, in closed form (local frame: clamp the
+// radial distance or each coordinate; a point inside is not handled, the tests' pairs are separated).
+bool closest_on_solid(const Shape& s, const Pose& pose, const Eigen::Vector3d& q, Eigen::Vector3d& out) {
+  if (s.inflation != 0.0 || (s.type != ShapeType::cylinder && s.type != ShapeType::box)) return false;
+  const Eigen::Matrix3d R = pose.rotation.toRotationMatrix();
+  Eigen::Vector3d p = R.transpose() * (q - pose.translation);
+  if (s.type == ShapeType::box) {
+    p = p.cwiseMax(-s.size).cwiseMin(s.size);
+  } else {
+    const double rho = std::hypot(p.x(), p.y());
+    if (rho > s.size.x()) p.head<2>() *= s.size.x() / rho;
+    p.z() = std::clamp(p.z(), -s.size.y(), s.size.y());
+  }
+  out = R * p + pose.translation;
+  return true;
+}
+
+// Spheres against cylinders and boxes: the closest point to the sphere's centre, then the sphere's witness on the
+// segment to it.
+bool sphere_against_solid(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Eigen::Vector3d& xa,
+                          Eigen::Vector3d& xb) {
+  if (a.type == ShapeType::sphere && closest_on_solid(b, pb, pa.translation, xb)) {
+    xa = pa.translation + (a.size.x() + a.inflation) * (xb - pa.translation).normalized();
+    return true;
+  }
+  if (b.type == ShapeType::sphere && closest_on_solid(a, pa, pb.translation, xa)) {
+    xb = pb.translation + (b.size.x() + b.inflation) * (xa - pb.translation).normalized();
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Pose twisted(const Pose& pose, const Eigen::Matrix<double, 6, 1>& xi, double h) {
@@ -65,9 +98,12 @@ PairResults exact_witness(const ShapeTable& shapes, const PairBatch& batch) {
   for (std::size_t i = 0; i < batch.size(); ++i) {
     const Shape& a = shapes[batch.shape_a[i]];
     const Shape& b = shapes[batch.shape_b[i]];
-    if (r.status[i] != Status::converged || !strictly_convex(a) || !strictly_convex(b)) continue;
+    if (r.status[i] != Status::converged) continue;
     Eigen::Vector3d xa = r.witness_a[i], xb = r.witness_b[i];
-    polish(a, batch.pose_a(i), b, batch.pose_b(i), xa, xb);
+    if (!sphere_against_solid(a, batch.pose_a(i), b, batch.pose_b(i), xa, xb)) {
+      if (!strictly_convex(a) || !strictly_convex(b)) continue;
+      polish(a, batch.pose_a(i), b, batch.pose_b(i), xa, xb);
+    }
     const double d = (xb - xa).norm();
     r.witness_a.set(i, xa);
     r.witness_b.set(i, xb);
