@@ -32,6 +32,10 @@ const char* to_string(DerivativeStatus status) {
 
 void validate(const DerivativeOptions& o) {
   if (o.samples < 1) throw InputError("samples must be >= 1, got " + std::to_string(o.samples));
+  // One pair's samples must fit one collide() call of the smoothed0 chunking (derivative_smoothed0.cpp).
+  if (o.samples > kMaxDerivativeSamples)
+    throw InputError("samples must be <= " + std::to_string(kMaxDerivativeSamples) + ", got " +
+                     std::to_string(o.samples));
   if (!std::isfinite(o.noise) || !(o.noise > 0.0))
     throw InputError("noise must be a finite number > 0, got " + std::to_string(o.noise));
   if (o.method != DerivativeMethod::analytic && o.method != DerivativeMethod::smoothed0 &&

@@ -13,7 +13,7 @@ namespace batchcol::detail {
 namespace {
 
 // Samples per collide() call: bounds the temporary batch and results (~250 bytes per sample) to ~250 MB.
-constexpr std::size_t kSamplesPerCall = std::size_t{1} << 20;
+constexpr std::size_t kSamplesPerCall = static_cast<std::size_t>(kMaxDerivativeSamples);
 
 struct Noise {
   double translation = 0.0, rotation = 0.0;  // standard deviations: metres, radians

@@ -51,16 +51,20 @@ enum class NoiseScale : std::uint8_t { relative, absolute };
 const char* to_string(DerivativeMethod method);
 const char* to_string(NoiseScale scale);
 
+/// The most samples per pair (smoothed0 runs at most this many samples per collide() call: ~250 MB of temporaries).
+constexpr int kMaxDerivativeSamples = 1 << 20;
+
 struct DerivativeOptions {
   DerivativeMethod method = DerivativeMethod::analytic;
-  int samples = 16;        // M >= 1 (smoothed methods only; ignored by analytic)
+  int samples = 16;        // 1 <= M <= kMaxDerivativeSamples (smoothed methods only; ignored by analytic)
   double noise = 1e-2;     // epsilon > 0 and finite (smoothed methods only), see "Noise scale" above
   NoiseScale noise_scale = NoiseScale::relative;
   std::uint64_t seed = 0;  // samples come from a counter-based generator keyed by (seed, pair, sample): results
                            // depend on the seed only, never on the thread count or the batch split
 };
 
-/// Throws InputError naming the option when `options` is invalid (samples < 1, noise <= 0 or not finite).
+/// Throws InputError naming the option when `options` is invalid (samples < 1 or too many, noise <= 0 or not
+/// finite).
 void validate(const DerivativeOptions& options);
 
 /// Per-pair derivative status. Values are NaN when the status says nothing was computed.
