@@ -1,5 +1,6 @@
 // Result output as CSV or JSON, one row per pair in input order. Numbers are written in the shortest form that
 // reads back to the same double (at most 17 significant digits), so output round-trips exactly.
+#include "batchcol/derivatives.hpp"
 #include "batchcol/io.hpp"
 
 #include <charconv>
@@ -7,6 +8,7 @@
 #include <limits>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace batchcol {
 namespace {
@@ -73,30 +75,82 @@ void append_row_values(std::string& line, const PairResults& r, std::size_t i, b
   line += std::to_string(r.iterations[i]);
 }
 
+// Derivative columns (derivatives.hpp): d_status, the distance gradients g_a0..g_a5, g_b0..g_b5, then the 3x6
+// Jacobians row by row (dpa_da_RC: d witness_a / d xi_a, row R, column C; dpa_db, dpb_da, dpb_db, dn_da, dn_db),
+// then for smoothed0 the smoothed values s_distance, s_pa_*, s_pb_*, s_n_*.
+std::vector<std::string> derivative_columns(const DerivativeResults& d) {
+  std::vector<std::string> names = {"d_status"};
+  for (const char* body : {"a", "b"})
+    for (int k = 0; k < 6; ++k) names.push_back(std::string("g_") + body + std::to_string(k));
+  for (const char* m : {"dpa_da_", "dpa_db_", "dpb_da_", "dpb_db_", "dn_da_", "dn_db_"})
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 6; ++c) names.push_back(m + std::to_string(r) + std::to_string(c));
+  if (!d.smoothed_distance.empty())
+    for (const char* v :
+         {"s_distance", "s_pa_x", "s_pa_y", "s_pa_z", "s_pb_x", "s_pb_y", "s_pb_z", "s_n_x", "s_n_y", "s_n_z"})
+      names.push_back(v);
+  return names;
+}
+
+void append_derivatives(std::string& line, const DerivativeResults& d, std::size_t i, bool json,
+                        const std::vector<std::string>& names) {
+  std::size_t column = 0;
+  const auto key = [&] {
+    line += ',';
+    if (json) line += '"' + names[column] + "\":";
+    ++column;
+  };
+  key();
+  line += json ? std::string("\"") + to_string(d.status[i]) + '"' : std::string(to_string(d.status[i]));
+  const char* missing = json ? "null" : "";
+  for (const Vec6Array* g : {&d.distance_gradient_a, &d.distance_gradient_b})
+    for (int k = 0; k < 6; ++k) key(), append_number(line, g->data[k * d.size() + i], missing, json);
+  for (const Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
+                              &d.normal_wrt_a, &d.normal_wrt_b})
+    for (int k = 0; k < 18; ++k) key(), append_number(line, m->data[k * d.size() + i], missing, json);
+  if (d.smoothed_distance.empty()) return;
+  key(), append_number(line, d.smoothed_distance[i], missing, json);
+  for (const Vec3Array* v : {&d.smoothed_witness_a, &d.smoothed_witness_b, &d.smoothed_normal})
+    for (const std::vector<double>* c : {&v->x, &v->y, &v->z}) key(), append_number(line, (*c)[i], missing, json);
+}
+
+void check_derivative_sizes(const PairResults& r, const DerivativeResults* d) {
+  if (d && d->size() != r.size())
+    throw InputError("derivatives: " + std::to_string(d->size()) + " pairs, the results have " +
+                     std::to_string(r.size()));
+}
+
 }  // namespace
 
-void write_results_csv(const PairResults& results, std::ostream& out) {
+void write_results_csv(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives) {
   check_sizes(results);
+  check_derivative_sizes(results, derivatives);
+  const std::vector<std::string> extra = derivatives ? derivative_columns(*derivatives) : std::vector<std::string>();
   std::string line;
   for (std::size_t c = 0; c < std::size(kColumns); ++c) line += (c ? "," : "") + std::string(kColumns[c]);
+  for (const std::string& name : extra) line += ',' + name;
   line += '\n';
   out << line;
   for (std::size_t i = 0; i < results.size(); ++i) {
     line = std::to_string(i);
     append_row_values(line, results, i, false);
+    if (derivatives) append_derivatives(line, *derivatives, i, false, extra);
     line += '\n';
     out.write(line.data(), static_cast<std::streamsize>(line.size()));
   }
 }
 
-void write_results_json(const PairResults& results, std::ostream& out) {
+void write_results_json(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives) {
   check_sizes(results);
+  check_derivative_sizes(results, derivatives);
+  const std::vector<std::string> extra = derivatives ? derivative_columns(*derivatives) : std::vector<std::string>();
   out << "{\"results\":[";
   std::string line;
   for (std::size_t i = 0; i < results.size(); ++i) {
     line = i ? ",\n" : "\n";
     line += "{\"pair\":" + std::to_string(i);
     append_row_values(line, results, i, true);
+    if (derivatives) append_derivatives(line, *derivatives, i, true, extra);
     line += '}';
     out.write(line.data(), static_cast<std::streamsize>(line.size()));
   }

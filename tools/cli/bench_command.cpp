@@ -10,6 +10,7 @@
 #include "cli/commands.hpp"
 
 #include <batchcol/batch.hpp>
+#include <batchcol/derivatives.hpp>
 #include <batchcol/io.hpp>
 
 #include <nlohmann/json.hpp>
@@ -35,6 +36,8 @@ struct BenchSettings {
   std::size_t pairs = 100000;
   std::uint64_t seed = 20240603;
   bool json = false, no_peers = false;
+  std::string derivatives;  // empty: time collide(); else differentiate() with this method (issue #18)
+  DerivativeOptions derivative_options;
 };
 
 struct CaseResult {
@@ -93,7 +96,14 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
   out.kernel = kernel_for(p.shapes[p.pairs.shape_a[0]], p.shapes[p.pairs.shape_b[0]], options);
   PairResults results;
   const double min_run_seconds = s.min_run_ms * 1e-3;
-  const CallTiming timing = time_calls([&] { collide(p.shapes, p.pairs, options, results); }, s.runs, min_run_seconds);
+  DerivativeResults derivatives;
+  DerivativeOptions d = s.derivative_options;
+  if (!s.derivatives.empty()) d.method = parse_derivative_method(s.derivatives);
+  const auto call = [&] {
+    if (s.derivatives.empty()) collide(p.shapes, p.pairs, options, results);
+    else differentiate(p.shapes, p.pairs, options, d, results, derivatives);
+  };
+  const CallTiming timing = time_calls(call, s.runs, min_run_seconds);
   out.calls_per_run = timing.calls_per_run;
   const double median = timing.seconds_per_call;
   const double n = double(p.pairs.size());
@@ -139,6 +149,9 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
                       {"reference_min", r.reference_min}, {"reference_max", r.reference_max}, {"iterations_mean", r.iterations_mean},
                       {"timed_runs", s.runs}, {"calls_per_run", r.calls_per_run}, {"min_run_ms", s.min_run_ms}, {"peers", peers}, {"peers_missing", r.peers.notes}};
   if (!r.note.empty()) j["note"] = r.note;
+  if (!s.derivatives.empty())
+    j["derivatives"] = {{"method", s.derivatives}, {"samples", s.derivative_options.samples},
+                        {"noise", s.derivative_options.noise}};
   return j;
 }
 
@@ -151,6 +164,9 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
               "warm-up, calls per run enough for %g ms\n",
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(resolve_solver(o.solver, o.level)),
               o.solver == Solver::automatic ? " (automatic)" : "", threads, s.pairs, s.runs, s.min_run_ms);
+  if (!s.derivatives.empty())
+    std::printf("timing differentiate() with derivatives %s (samples %d, noise %g), peers time plain queries\n",
+                s.derivatives.c_str(), s.derivative_options.samples, s.derivative_options.noise);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
   std::printf("%-22s %-11s %6s %10s %11s %10s %10s", "case", "kernel", "iters", "ns/pair", "pairs/s",
@@ -197,6 +213,12 @@ int run_bench(const BenchSettings& s) {
   }
   options.isa = resolve_instruction_set(options.isa);  // InputError when this CPU cannot run it
   validate(options);
+  if (!s.derivatives.empty()) {  // bad derivative options fail before any pair is generated
+    DerivativeOptions d = s.derivative_options;
+    d.method = parse_derivative_method(s.derivatives);
+    validate(d);
+    if (options.level < QueryLevel::witness) throw InputError("--derivatives needs --query witness or penetration");
+  }
   const int threads = s.threads > 0 ? s.threads : tbb::info::default_concurrency();
 
   std::vector<CaseResult> results;
@@ -243,6 +265,9 @@ Command add_bench_command(CLI::App& parent) {
   app->add_option("--seed", s->seed, "Seed of the pair generator")->capture_default_str();
   app->add_option("--save-pairs", s->save_pairs, "Write the generated pairs as a batch file (single --case)");
   app->add_flag("--no-peers", s->no_peers, "Do not time FCL and Bullet");
+  app->add_option("--derivatives", s->derivatives, "Time differentiate() instead: analytic, smoothed0 or smoothed1");
+  app->add_option("--samples", s->derivative_options.samples, "Samples per pair of the smoothed derivatives");
+  app->add_option("--noise", s->derivative_options.noise, "Relative noise of the smoothed derivatives");
   app->add_flag("--json", s->json, "Print JSON (one object, an array for --case all)");
   return {app, [s] { return run_bench(*s); }};
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <batchcol/derivatives.hpp>
 
 #include <functional>
 
@@ -18,5 +19,9 @@ Command add_query_command(CLI::App& parent);
 Command add_bench_command(CLI::App& parent);
 Command add_stress_command(CLI::App& parent);
 Command add_accuracy_command(CLI::App& parent);
+Command add_descent_command(CLI::App& parent);
+
+/// The derivative method named `name` (query and bench --derivatives); InputError naming --derivatives otherwise.
+DerivativeMethod parse_derivative_method(const std::string& name);
 
 }  // namespace batchcol::cli

@@ -3,6 +3,7 @@
 #include "cli/commands.hpp"
 
 #include <batchcol/batch.hpp>
+#include <batchcol/derivatives.hpp>
 #include <batchcol/io.hpp>
 
 #include <cmath>
@@ -20,6 +21,8 @@ struct QuerySettings {
   std::string batch_path, query, solver, precision, out;
   double tolerance = 0.0, margin = 0.0;
   int max_iterations = 0, threads = 0;
+  std::string derivatives;  // empty: none
+  DerivativeOptions derivative_options;
   CLI::Option *query_flag = nullptr, *solver_flag = nullptr, *precision_flag = nullptr, *tolerance_flag = nullptr,
               *margin_flag = nullptr, *max_iterations_flag = nullptr;
 };
@@ -62,11 +65,20 @@ int run_query(const QuerySettings& s) {
   validate(options);
 
   PairResults results;
-  collide(batch.shapes, batch.pairs, options, results);
+  DerivativeResults derivatives;
+  const bool differentiating = !s.derivatives.empty();
+  if (differentiating) {
+    DerivativeOptions d = s.derivative_options;
+    d.method = parse_derivative_method(s.derivatives);
+    differentiate(batch.shapes, batch.pairs, options, d, results, derivatives);
+  } else {
+    collide(batch.shapes, batch.pairs, options, results);
+  }
 
+  const DerivativeResults* columns = differentiating ? &derivatives : nullptr;
   const auto write = [&](std::ostream& out) {
-    if (format == Format::csv) write_results_csv(results, out);
-    else write_results_json(results, out);
+    if (format == Format::csv) write_results_csv(results, out, columns);
+    else write_results_json(results, out, columns);
   };
   if (s.out.empty()) {
     write(std::cout);
@@ -79,6 +91,12 @@ int run_query(const QuerySettings& s) {
 }
 
 }  // namespace
+
+DerivativeMethod parse_derivative_method(const std::string& name) {
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
+    if (name == to_string(m)) return m;
+  throw InputError("--derivatives: unknown method '" + name + "' (analytic, smoothed0 or smoothed1)");
+}
 
 Command add_query_command(CLI::App& parent) {
   auto s = std::make_shared<QuerySettings>();
@@ -95,6 +113,13 @@ Command add_query_command(CLI::App& parent) {
                         ->check(finite_non_negative());
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, std::numeric_limits<int>::max()));
+  app->add_option("--derivatives", s->derivatives,
+                  "Also differentiate w.r.t. the poses: analytic, smoothed0 or smoothed1 (needs --query witness or "
+                  "penetration; adds the derivative columns)");
+  app->add_option("--samples", s->derivative_options.samples, "Samples per pair of the smoothed derivatives (>= 1)");
+  app->add_option("--noise", s->derivative_options.noise,
+                  "Noise of the smoothed derivatives, relative to the perturbed shape's bounding radius (> 0)");
+  app->add_option("--seed", s->derivative_options.seed, "Seed of the smoothed derivatives' samples");
   app->add_option("--out", s->out, "Output file (.csv or .json); standard output (CSV) when absent");
   return {app, [s] { return run_query(*s); }};
 }

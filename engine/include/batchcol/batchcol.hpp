@@ -2,6 +2,7 @@
 #pragma once
 
 #include "batchcol/batch.hpp"
+#include "batchcol/derivatives.hpp"
 #include "batchcol/errors.hpp"
 #include "batchcol/io.hpp"
 #include "batchcol/pose.hpp"

@@ -41,7 +41,10 @@ InstructionSet parse_instruction_set(const std::string& name);
 
 /// Result rows: pair,status,collide,distance,pa_x,pa_y,pa_z,pb_x,pb_y,pb_z,n_x,n_y,n_z,iterations.
 /// Values the query level did not compute are empty (CSV) or null (JSON). Numbers use 17 significant digits.
-void write_results_csv(const PairResults& results, std::ostream& out);
-void write_results_json(const PairResults& results, std::ostream& out);
+/// With `derivatives` (same size), the derivative columns follow (d_status, g_a0.., dpa_da_00.., see
+/// results_output.cpp).
+struct DerivativeResults;
+void write_results_csv(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
+void write_results_json(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
 
 }  // namespace batchcol

@@ -1,0 +1,69 @@
+// Throughput of differentiate() against the plain witness query on the same separated pairs (issue #18's speed
+// targets): analytic, and smoothed0 / smoothed1 with M = 4, 16, 64, for ellipsoid pairs and random 24-point hull
+// pairs.
+// Reports pairs per second of wall time (derivative pairs, not samples; TBB threads work outside the main
+// thread, so CPU time would miss them); compare rows of one run, the machine is shared.
+#include "support/derivative_reference.hpp"
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace batchcol;
+
+struct Workload {
+  ShapeTable shapes;
+  PairBatch batch;
+};
+
+// Seeded: every row of a family times the same pairs.
+Workload workload(ShapeType type) {
+  Workload w;
+  testing::Rng rng(18);
+  w.batch = testing::random_separated_pairs(rng, w.shapes, {type}, 4096);
+  return w;
+}
+
+// range(0): 0 ellipsoids, 1 hulls; range(1): -1 witness query only, else the DerivativeMethod; range(2): M.
+void BM_Derivatives(benchmark::State& state) {
+  const Workload w = workload(state.range(0) == 0 ? ShapeType::ellipsoid : ShapeType::convex);
+  QueryOptions q;
+  q.level = QueryLevel::witness;
+  DerivativeOptions o;
+  o.samples = static_cast<int>(state.range(2));
+  PairResults r;
+  DerivativeResults d;
+  std::string label = state.range(0) == 0 ? "ellipsoids " : "hulls ";
+  if (state.range(1) < 0) {
+    label += "witness query";
+    for (auto _ : state) {
+      collide(w.shapes, w.batch, q, r);
+      benchmark::DoNotOptimize(r.witness_a.x.data());
+    }
+  } else {
+    o.method = static_cast<DerivativeMethod>(state.range(1));
+    label += to_string(o.method);
+    if (o.method != DerivativeMethod::analytic) label += " M=" + std::to_string(o.samples);
+    for (auto _ : state) {
+      differentiate(w.shapes, w.batch, q, o, r, d);
+      benchmark::DoNotOptimize(d.witness_a_wrt_b.data.data());
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(w.batch.size()));
+  state.SetLabel(label);
+}
+
+void rows(benchmark::internal::Benchmark* b) {
+  for (int family : {0, 1}) {
+    b->Args({family, -1, 1});
+    b->Args({family, static_cast<int>(DerivativeMethod::analytic), 1});
+    for (int method : {static_cast<int>(DerivativeMethod::smoothed0), static_cast<int>(DerivativeMethod::smoothed1)})
+      for (int M : {4, 16, 64}) b->Args({family, method, M});
+  }
+}
+
+BENCHMARK(BM_Derivatives)->Apply(rows)->Unit(benchmark::kMillisecond)->MinTime(0.2)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

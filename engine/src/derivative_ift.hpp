@@ -1,0 +1,77 @@
+// Derivatives of one pair's distance, witness points and normal by the envelope and implicit function theorems.
+//
+// With z = witness_b - witness_a = sd n, the witness points are support points, x_a = S_A(n), x_b = S_B(-n) (world
+// frame; for separated and penetrating pairs alike). For separated pairs z is the fixed point
+//   f(z, T) = z + S_A(z; T_a) - S_B(-z; T_b) = 0,
+// and for penetrating pairs the same with n = -z/|z|. Under the twist convention of derivatives.hpp,
+//   d S(u; T) / d xi = [I, -[x]x + H(u) [u]x]   (x = S(u), H = the support map's Jacobian in the world frame),
+// so with H_a = H_A(n), H_b = H_B(-n) at unit directions (S is homogeneous of degree 0, H of degree -1):
+//   F_a = df/dxi_a = [ I, -[x_a]x + H_a [n]x ],   F_b = df/dxi_b = [-I, [x_b]x + H_b [n]x ],
+//   K = (sd I + H_a + H_b)^-1,   dz/dxi = -sd K F   (the implicit function theorem, multiplied through by sd),
+//   dx_a/dxi = -H_a K F (+ F_a for xi_a),   dx_b/dxi = H_b K F (- F_b for xi_b),   dn/dxi = -(I - n n^T) K F,
+// none of which divides by sd, so they stay finite as the pair approaches contact when H_a + H_b is definite.
+// The distance gradient is the envelope theorem's: dsd/dxi_a = -(n, x_a x n), dsd/dxi_b = (n, x_b x n) (it equals
+// n^T dz/dxi because H n = 0).
+//
+// Faces and edges. Where n is normal to a face or edge of a core (a "flat" of its support map), S jumps along it:
+// its Jacobian is H' + lambda A A^T with lambda -> infinity (A: orthonormal flat directions, H': the finite part).
+// The limit exists whenever the flats of the two shapes are independent: writing mu_a = lambda A^T y for
+// y = K F, the system M y = F becomes the saddle-point system
+//   [ sd I + H'_a + H'_b   A   B ] [ y   ]   [ F'  ]
+//   [ A^T                  0   0 ] [ mu_a] = [ c_a ]      (c_a = A^T [0, [n]x] for xi_a, 0 for xi_b; c_b alike)
+//   [ B^T                  0   0 ] [ mu_b]   [ c_b ]
+// (F' is F without its infinite part lambda A A^T [n]x, which reappears as the constraint's right-hand side), and
+// H_a K F = H'_a y + A mu_a + lambda A c_a, whose last term cancels against F's in every witness Jacobian. That
+// is the vertex-face and edge-edge derivative of two polytopes: a witness on a face slides with the other witness.
+// Dependent flats (face-face, parallel edges, an edge on a face) make the witness points non-unique: no derivative.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace batchcol::detail {
+
+using Mat36 = Eigen::Matrix<double, 3, 6>;
+using Row6 = Eigen::Matrix<double, 1, 6>;
+
+struct PairGeometry {
+  Eigen::Vector3d witness_a, witness_b, normal;
+  double distance = 0.0;  // signed
+  Eigen::Matrix3d H_a, H_b;  // support-map Jacobians (finite parts), world frame, at the unit directions n, -n
+  Eigen::Matrix<double, 3, 2> flat_a = Eigen::Matrix<double, 3, 2>::Zero(), flat_b = flat_a;  // world, orthonormal
+  int flats_a = 0, flats_b = 0;
+  double scale = 1.0;        // a length of the problem (sum of bounding radii) for the singularity test
+};
+
+struct PairJacobians {
+  Row6 distance_a, distance_b;
+  Mat36 witness_a_a, witness_a_b, witness_b_a, witness_b_b, normal_a, normal_b;
+  bool singular = false;   // the system is singular (touching without curvature, some penetrations)
+  bool dependent = false;  // the flats of a and b are dependent: non-unique witness points
+};
+
+/// [x]x, the cross-product matrix: [x]x y = x x y.
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& x) {
+  Eigen::Matrix3d m;
+  m << 0, -x.z(), x.y(), x.z(), 0, -x.x(), -x.y(), x.x(), 0;
+  return m;
+}
+
+/// The rigid motion of a point x fixed on a body: [I, -[x]x] (v + w x x = v - [x]x w).
+inline Mat36 rigid_motion(const Eigen::Vector3d& x) {
+  Mat36 m;
+  m << Eigen::Matrix3d::Identity(), -skew(x);
+  return m;
+}
+
+/// Distance gradients by the envelope theorem.
+inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b) {
+  grad_a << -g.normal.transpose(), g.normal.cross(g.witness_a).transpose();
+  grad_b << g.normal.transpose(), g.witness_b.cross(g.normal).transpose();
+}
+
+/// Everything above for one pair; `singular` (Jacobians left NaN) when the system (its constraint rows scaled to
+/// lengths) has an eigenvalue within 1e-9 of the problem's length scale: its inverse would magnify the witness
+/// points' own error (~1e-8 of that scale at the default GJK tolerance) beyond any meaning.
+PairJacobians implicit_jacobians(const PairGeometry& g);
+
+}  // namespace batchcol::detail

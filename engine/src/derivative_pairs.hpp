@@ -1,0 +1,42 @@
+// Shared steps of the derivative entry points (derivatives.cpp, derivative_smoothed0.cpp).
+#pragma once
+
+#include "batchcol/derivatives.hpp"
+#include "derivative_ift.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <cstddef>
+
+namespace batchcol::detail {
+
+/// Runs body(begin, end) over [0, n) on `threads` threads (0 = all). Each index is independent, so the result does
+/// not depend on the split.
+template <class Body> void for_pairs(int threads, std::size_t n, const Body& body) {
+  const auto run = [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  };
+  if (threads <= 0 || threads == tbb::this_task_arena::max_concurrency()) {
+    run();
+  } else {
+    tbb::task_arena arena(threads);
+    arena.execute(run);
+  }
+}
+
+/// True when pair i has a converged witness query between two shapes with support maps (no halfspace); fills the
+/// witness points, normal and signed distance of `g` and the rotations.
+bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+                      PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b);
+
+/// Stores one pair's Jacobians.
+void store(DerivativeResults& d, std::size_t i, const PairJacobians& J);
+
+/// The 0th-order estimator (derivative_smoothed0.cpp); `results` holds the unperturbed query.
+void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
+               const DerivativeOptions& options, const PairResults& results, DerivativeResults& derivatives);
+
+}  // namespace batchcol::detail

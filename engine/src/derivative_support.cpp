@@ -1,0 +1,175 @@
+#include "derivative_support.hpp"
+
+#include "counter_rng.hpp"
+#include "kernels/shape_core.hpp"
+#include "kernels/support.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+
+namespace batchcol::detail {
+namespace {
+
+// Swept-sphere part of a shape: the Jacobian of r u / |u| at unit u is r (I - u u^T).
+double round_radius(const Shape& s) {
+  double r = s.inflation;
+  if (s.type == ShapeType::sphere || s.type == ShapeType::capsule) r += s.size.x();
+  return r;
+}
+
+// The Jacobian of (r u_xy / rho, .) in the xy block: the curvature of a circle of radius r seen along u_xy.
+void add_rim(Eigen::Matrix3d& H, double r, const Eigen::Vector3d& u, double rho) {
+  const Eigen::Vector2d t(u.x() / rho, u.y() / rho);
+  H.topLeftCorner<2, 2>() += (r / rho) * (Eigen::Matrix2d::Identity() - t * t.transpose());
+}
+
+// Adds d (made orthogonal to u and to the flats so far) as a flat direction unless it is (relatively) zero.
+void add_flat(SupportJacobian& J, const Eigen::Vector3d& u, Eigen::Vector3d d, double length) {
+  d -= u.dot(d) * u;
+  for (int k = 0; k < J.flats; ++k) d -= J.flat.col(k).dot(d) * J.flat.col(k);
+  if (J.flats < 2 && d.norm() > 1e-6 * length) J.flat.col(J.flats++) = d.normalized();
+}
+
+// A hull: the witness lies on the planes of the faces containing it (to kExactFeature): one plane, a face (two
+// flats); two, an edge (one flat, along both normals' cross product); three or more, a vertex.
+void hull_feature(SupportJacobian& J, const ConvexHull& hull, const Eigen::Vector3d& u, const Eigen::Vector3d& p,
+                  double tolerance) {
+  Eigen::Vector3d planes[3];
+  int count = 0;
+  for (std::size_t f = 0; f < hull.faces.size() && count < 3; ++f) {
+    const Eigen::Vector3d& n = hull.face_normals[f];
+    if (n.dot(p - hull.vertices[hull.faces[f][0]]) < -tolerance) continue;
+    bool seen = false;  // triangulated faces repeat their plane
+    for (int k = 0; k < count; ++k) seen = seen || planes[k].dot(n) > 1.0 - 1e-9;
+    if (!seen) planes[count++] = n;
+  }
+  if (count == 1) {
+    const Eigen::Vector3d t = planes[0].unitOrthogonal();
+    add_flat(J, u, t, 1.0);
+    add_flat(J, u, planes[0].cross(t), 1.0);
+  } else if (count == 2) {
+    add_flat(J, u, planes[0].cross(planes[1]), 1.0);
+  }
+}
+
+// A triangle: the witness's barycentric coordinates; the vertices with a positive weight span its feature.
+void triangle_feature(SupportJacobian& J, const std::array<Eigen::Vector3d, 3>& v, const Eigen::Vector3d& u,
+                      const Eigen::Vector3d& p) {
+  const Eigen::Vector3d e1 = v[1] - v[0], e2 = v[2] - v[0], q = p - v[0];
+  Eigen::Matrix2d G;
+  G << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+  const Eigen::Vector2d l = G.inverse() * Eigen::Vector2d(e1.dot(q), e2.dot(q));
+  const double weights[3] = {1.0 - l.x() - l.y(), l.x(), l.y()};
+  const Eigen::Vector3d* first = nullptr;
+  for (int k = 0; k < 3; ++k) {
+    if (!(weights[k] > kExactFeature)) continue;
+    if (!first) first = &v[k];
+    else add_flat(J, u, v[k] - *first, std::sqrt(G.trace()));
+  }
+}
+
+}  // namespace
+
+SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {
+  SupportJacobian J;
+  const double r = round_radius(s);
+  const Eigen::Vector3d p = witness - r * u;  // the witness on the core
+  const double tol = kExactFeature * s.bounding_radius(), curved_tol = kCurvedFeature * s.bounding_radius();
+  const double rho = std::hypot(u.x(), u.y()), rho_p = std::hypot(p.x(), p.y());
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
+  switch (s.type) {
+    case ShapeType::sphere: break;
+    case ShapeType::capsule:
+      if (std::abs(p.z()) < s.size.y() - tol) add_flat(J, u, ez, 1.0);  // inside the segment
+      break;
+    case ShapeType::box:
+      J.zero = true;
+      for (int k = 0; k < 3; ++k)
+        if (std::abs(p(k)) < s.size(k) - tol) add_flat(J, u, Eigen::Vector3d::Unit(k), 1.0);
+      break;
+    case ShapeType::cylinder:
+      if (rho_p < s.size.x() - curved_tol) {  // inside a cap
+        add_flat(J, u, ex, 1.0);
+        add_flat(J, u, ey, 1.0);
+        break;
+      }
+      if (rho > 0.0) add_rim(J.H, s.size.x(), u, rho);
+      if (std::abs(p.z()) < s.size.y() - tol) add_flat(J, u, ez, 1.0);  // on the side line
+      break;
+    case ShapeType::cone: {
+      const double h = s.size.y(), radius = s.size.x();
+      if (p.z() < -h + tol && rho_p < radius - curved_tol) {  // inside the base
+        add_flat(J, u, ex, 1.0);
+        add_flat(J, u, ey, 1.0);
+      } else if ((p - h * ez).norm() <= tol) {  // the apex
+        J.zero = true;
+      } else if (rho > 0.0) {
+        add_rim(J.H, radius, u, rho);
+        if (rho_p < radius - curved_tol) {  // on a generator line, between apex and rim
+          add_flat(J, u, Eigen::Vector3d(radius * u.x() / rho, radius * u.y() / rho, -2.0 * h), h + radius);
+          J.approximate = true;  // the rim's curvature, not the generator point's
+        }
+      }
+      break;
+    }
+    case ShapeType::ellipsoid: {
+      // S(u) = R^2 u / |R u| with R = diag(radii): dS/du = R^2 / |Ru| - (R^2 u)(R^2 u)^T / |Ru|^3.
+      const Eigen::Vector3d r2 = s.size.cwiseProduct(s.size);
+      const Eigen::Vector3d r2u = r2.cwiseProduct(u);
+      const double m = s.size.cwiseProduct(u).norm();
+      J.H = Eigen::Matrix3d(r2.asDiagonal()) / m - r2u * r2u.transpose() / (m * m * m);
+      break;
+    }
+    case ShapeType::convex:
+      J.zero = true;
+      hull_feature(J, *s.hull, u, p, tol);
+      break;
+    case ShapeType::triangle:
+      J.zero = true;
+      triangle_feature(J, s.triangle, u, p);
+      break;
+    case ShapeType::halfspace: J.unsupported = true; return J;
+  }
+  if (r > 0.0) J.H += r * (Eigen::Matrix3d::Identity() - u * u.transpose());
+  J.zero = J.zero && r == 0.0 && J.flats == 0;
+  return J;
+}
+
+Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
+  const auto core = kernels::make_core<double>(shape);
+  kernels::SupportHint hint;
+  Eigen::Vector3d p = kernels::support(core, u, hint);
+  const double n = u.norm();
+  if (core.radius > 0.0 && n > 0.0) p += core.radius * u / n;
+  return p;
+}
+
+Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
+                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream) {
+  const auto core = kernels::make_core<double>(shape);
+  kernels::SupportHint hint;
+  const auto support = [&](const Eigen::Vector3d& d) {
+    Eigen::Vector3d p = kernels::support(core, d, hint);
+    const double n = d.norm();
+    if (core.radius > 0.0 && n > 0.0) p += core.radius * d / n;
+    return p;
+  };
+  const Eigen::Vector3d s0 = support(u);
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  double z[4];
+  for (int j = 0; j < samples; ++j) {
+    if (j % 2 == 0) gaussian_vector<4>(seed, pair, static_cast<std::uint64_t>(j / 2), stream, z);
+    const double sign = j % 2 == 0 ? 1.0 : -1.0;
+    const Eigen::Vector3d zj(sign * z[0], sign * z[1], sign * z[2]);
+    sum += (support(u + e * zj) - s0) * zj.transpose();
+  }
+  Eigen::Matrix3d H = sum / (static_cast<double>(samples) * e);
+  H = (0.5 * (H + H.transpose())).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(H);
+  const Eigen::Vector3d clamped = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+}  // namespace batchcol::detail

@@ -1,0 +1,48 @@
+// The Jacobian of a shape's support map (the Hessian of its support function sigma(u) = max_{x in A} <x, u>) in the
+// shape's local frame, exact where it exists, and its randomized-smoothing estimate (Montaut et al. 2023, sec. IV;
+// the slide "Randomized smoothing - 1st order"). Used by the implicit-function derivatives (derivative_ift.hpp).
+#pragma once
+
+#include "batchcol/shapes.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace batchcol::detail {
+
+/// Where the witness lies on its core decides which face, edge or vertex the contact is on. Positions, not the
+/// normal, are tested: GJK's normal on a curved pair is only accurate to ~sqrt(2 tol / R) (1e-4 rad at the default
+/// 1e-8 m tolerance), so a cylinder touching along its side would look like a rim contact, whereas GJK's witness on
+/// a polytope, a segment or a cylinder's side is a convex combination of support points of that very feature, on
+/// it to rounding. kExactFeature (relative to the shape's bounding radius) is that rounding with a wide margin.
+/// kCurvedFeature is for the one boundary that is curved, a cap's or base's rim: a witness combining nearby rim
+/// points lies r theta^2 / 2 ~ 1e-8 r inside the rim, far less than this.
+constexpr double kExactFeature = 1e-9;
+constexpr double kCurvedFeature = 1e-4;
+
+struct SupportJacobian {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // d S(u) / d u at the unit direction u (degree -1 in |u|)
+  Eigen::Matrix<double, 3, 2> flat = Eigen::Matrix<double, 3, 2>::Zero();
+  int flats = 0;      // 0: no tie; 1: an edge, a capsule's or cylinder's side line, a cone's generator; 2: a face
+  bool zero = false;  // S is locally constant at u (a vertex of a non-inflated core)
+  bool unsupported = false;  // halfspace: no support map
+  bool approximate = false;  // a cone's side: the curvature across a generator varies along it (the rim's is used)
+};
+
+/// Exact support-map Jacobian of `shape` at the unit local direction u, the witness being `witness` (local frame,
+/// inflation included).
+SupportJacobian support_jacobian(const Shape& shape, const Eigen::Vector3d& u, const Eigen::Vector3d& witness);
+
+/// The full support point (core plus inflation radius) of `shape` at local direction u (not necessarily unit).
+Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
+
+/// The smoothed support-map Jacobian at unit local direction u: 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with
+/// z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k} (the baseline S(u) cancels within a pair),
+/// symmetrised and projected onto the positive semidefinite cone (the Hessian of the smoothed convex support
+/// function is symmetric PSD; the projection removes sampling noise that could make the implicit-function matrix
+/// singular, a bias that vanishes as M grows). Noise keyed by (seed, pair, sample, stream).
+Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
+                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream);
+
+}  // namespace batchcol::detail

@@ -1,0 +1,168 @@
+// Derivative options, levels and statuses at the API boundary; determinism and the rigid-motion identity.
+#include "batchcol/batchcol.hpp"
+#include "support/derivative_reference.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+#include <string>
+
+namespace batchcol::testing {
+namespace {
+
+struct Fixture {
+  ShapeTable shapes;
+  PairBatch batch;
+  Fixture() {
+    const auto s = shapes.add(Shape::sphere(0.2));
+    const auto e = shapes.add(Shape::ellipsoid(0.1, 0.2, 0.3));
+    batch.add(s, Pose::identity(), e, Pose::from_translation({1, 0, 0}));
+  }
+};
+
+void expect_input_error(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& q,
+                        const DerivativeOptions& o, const std::string& field) {
+  PairResults r;
+  DerivativeResults d;
+  try {
+    differentiate(shapes, batch, q, o, r, d);
+    ADD_FAILURE() << "no InputError for " << field;
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+  }
+}
+
+TEST(DerivativesOptions, BadOptionsAreInputErrorsNamingTheOption) {
+  Fixture f;
+  QueryOptions q;
+  DerivativeOptions o;
+  o.method = DerivativeMethod::smoothed0;
+  o.samples = 0;
+  expect_input_error(f.shapes, f.batch, q, o, "samples");
+  o.samples = -3;
+  expect_input_error(f.shapes, f.batch, q, o, "samples");
+  o.samples = kMaxDerivativeSamples + 1;  // would need a ~250 MB batch per pair
+  expect_input_error(f.shapes, f.batch, q, o, "samples");
+  o.samples = 8;
+  for (double bad : {0.0, -1e-3, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    o.noise = bad;
+    expect_input_error(f.shapes, f.batch, q, o, "noise");
+  }
+  o.noise = 1e-2;
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance}) {
+    q.level = level;
+    expect_input_error(f.shapes, f.batch, q, o, "level");
+  }
+  q.level = QueryLevel::witness;
+  PairResults r;
+  collide(f.shapes, f.batch, q, r);
+  DerivativeResults d;
+  EXPECT_THROW(differentiate_results(f.shapes, f.batch, r, o, 0, d), InputError);  // smoothed0 needs queries
+  o.method = DerivativeMethod::analytic;
+  q.level = QueryLevel::distance;
+  collide(f.shapes, f.batch, q, r);
+  EXPECT_THROW(differentiate_results(f.shapes, f.batch, r, o, 0, d), InputError);  // no witness arrays
+}
+
+TEST(DerivativesOptions, PairsWithoutWitnessAreFlaggedNotThrown) {
+  ShapeTable shapes;
+  const auto s = shapes.add(Shape::ellipsoid(0.5, 0.5, 0.5));  // a sphere by GJK (no closed form, no EPA below
+                                                                // the penetration level)
+  const auto h = shapes.add(Shape::halfspace({0, 0, 1}, 0));
+  PairBatch batch;
+  batch.add(s, Pose::identity(), s, Pose::from_translation({0.5, 0, 0}));  // overlapping, witness level
+  batch.add(s, Pose::identity(), 7, Pose::identity());                      // invalid shape index
+  batch.add(s, Pose::from_translation({0, 0, 2}), h, Pose::identity());     // halfspace
+  batch.add(s, Pose::identity(), s, Pose::from_translation({0.5, 0, 0}));  // overlapping, penetration below
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1}) {
+    DerivativeOptions o;
+    o.method = m;
+    o.samples = 1024;  // smoothed0's gradient below has a standard error of sqrt(2 / M) ~ 0.044
+    PairResults r;
+    DerivativeResults d;
+    differentiate(shapes, batch, QueryOptions{}, o, r, d);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(d.status[i], DerivativeStatus::no_witness) << to_string(m) << " pair " << i;
+      EXPECT_TRUE(std::isnan(d.distance_gradient_b[i](0)));
+    }
+    QueryOptions penetration;
+    penetration.level = QueryLevel::penetration;
+    differentiate(shapes, batch, penetration, o, r, d);
+    EXPECT_EQ(d.status[3], DerivativeStatus::smooth) << to_string(m);
+    // EPA's normal on this GJK-handled sphere is ~1e-4 rad off (its tolerance on a curved Minkowski difference),
+    // so the gradient's x component is 1 - O(1e-8).
+    EXPECT_NEAR(d.distance_gradient_b[3](0), 1.0, m == DerivativeMethod::smoothed0 ? 0.2 : 1e-7);
+  }
+}
+
+// Moving both shapes by one twist is a rigid motion of the scene: J_a + J_b is the rigid motion of the point
+// ([I, -[x]x]), of the normal ([0, -[n]x]), and the distance gradients cancel. Both sides are computed
+// independently by the analytic and first-order formulas, so this checks them on every shape type.
+TEST(DerivativesOptions, RigidMotionIdentityHoldsForEveryShapeType) {
+  Rng rng(7);
+  ShapeTable shapes;
+  const PairBatch batch = random_separated_pairs(rng, shapes, bounded_shape_types(), 2000);
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed1}) {
+    DerivativeOptions o;
+    o.method = m;
+    PairResults r;
+    DerivativeResults d;
+    differentiate(shapes, batch, QueryOptions{}, o, r, d);
+    int checked = 0;
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      if (d.status[i] != DerivativeStatus::smooth && d.status[i] != DerivativeStatus::zero_curvature) continue;
+      ++checked;
+      const auto skew = [](const Eigen::Vector3d& x) {
+        Eigen::Matrix3d s;
+        s << 0, -x.z(), x.y(), x.z(), 0, -x.x(), -x.y(), x.x(), 0;
+        return s;
+      };
+      Mat36 rigid_a, rigid_b, rigid_n;
+      rigid_a << Eigen::Matrix3d::Identity(), -skew(r.witness_a[i]);
+      rigid_b << Eigen::Matrix3d::Identity(), -skew(r.witness_b[i]);
+      rigid_n << Eigen::Matrix3d::Zero(), -skew(r.normal[i]);
+      const double scale = 1.0 + batch.translation_a[i].norm() + batch.translation_b[i].norm();
+      EXPECT_LE((d.distance_gradient_a[i] + d.distance_gradient_b[i]).cwiseAbs().maxCoeff(), 1e-12 * scale);
+      EXPECT_LE((d.witness_a_wrt_a[i] + d.witness_a_wrt_b[i] - rigid_a).cwiseAbs().maxCoeff(), 1e-9 * scale) << i;
+      EXPECT_LE((d.witness_b_wrt_a[i] + d.witness_b_wrt_b[i] - rigid_b).cwiseAbs().maxCoeff(), 1e-9 * scale) << i;
+      EXPECT_LE((d.normal_wrt_a[i] + d.normal_wrt_b[i] - rigid_n).cwiseAbs().maxCoeff(), 1e-9 * scale) << i;
+    }
+    EXPECT_GE(checked, 1500) << to_string(m);
+  }
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+TEST(DerivativesOptions, BitwiseIdenticalForAnyThreadCount) {
+  Rng rng(11);
+  ShapeTable shapes;
+  const PairBatch batch = random_separated_pairs(rng, shapes, bounded_shape_types(), 600);
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1}) {
+    DerivativeOptions o;
+    o.method = m;
+    o.samples = 7;  // odd: the last sample keeps the baseline
+    o.seed = 42;
+    DerivativeResults d1, d2;
+    PairResults r;
+    QueryOptions q;
+    q.threads = 1;
+    differentiate(shapes, batch, q, o, r, d1);
+    q.threads = 2;
+    differentiate(shapes, batch, q, o, r, d2);
+    EXPECT_EQ(d1.status, d2.status);
+    EXPECT_TRUE(same_bits(d1.distance_gradient_b.data, d2.distance_gradient_b.data)) << to_string(m);
+    EXPECT_TRUE(same_bits(d1.witness_a_wrt_b.data, d2.witness_a_wrt_b.data)) << to_string(m);
+    EXPECT_TRUE(same_bits(d1.normal_wrt_a.data, d2.normal_wrt_a.data)) << to_string(m);
+    EXPECT_TRUE(same_bits(d1.smoothed_distance, d2.smoothed_distance)) << to_string(m);
+    // Another seed gives other samples (smoothed methods only).
+    o.seed = 43;
+    differentiate(shapes, batch, q, o, r, d2);
+    EXPECT_EQ(same_bits(d1.witness_a_wrt_b.data, d2.witness_a_wrt_b.data), m == DerivativeMethod::analytic);
+  }
+}
+
+}  // namespace
+}  // namespace batchcol::testing
