@@ -8,6 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <ostream>
+#include <string>
+#include <vector>
+
 #ifdef BATCHCOL_HAVE_COAL
 #include "peers/coal_adapter.hpp"
 #endif
@@ -25,6 +30,25 @@ constexpr std::size_t kDirectPairsPerType = 3000;  // two more variants of the s
 // shapes, as for FCL and Bullet.
 constexpr double kCoalTolerance = 1e-10;
 constexpr double kCoalAgreement = 1e-6;
+// Coal's EPA runs at 1e-6 at best (peers/coal_adapter.hpp), so its depths differ from batchcol's by more than the
+// agreement tolerance on some pairs, and the certificates prove it: measured up to 1.7% of the overlapping
+// ellipsoid pairs (median 3e-6 m, max 1.1e-3 m), 0-0.6% on the other types. Separated distances never disagreed.
+constexpr double kCoalMaxPeerWrong = 0.02;
+
+/// Coal 3.0's sphereCylinderDistance (src/narrowphase/details.h), which coal::distance runs for sphere-cylinder
+/// pairs, returns the radial depth dPS - r_sphere - r_cylinder whenever the sphere's centre is between the caps, even
+/// when a cap is nearer: too deep when the centre is inside the cylinder closer to a cap than to the side.
+const char* coal_sphere_cylinder_bug(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
+  const bool sphere_a = a.type == ShapeType::sphere && b.type == ShapeType::cylinder;
+  const bool sphere_b = b.type == ShapeType::sphere && a.type == ShapeType::cylinder;
+  if (!sphere_a && !sphere_b) return nullptr;
+  const Pose& sphere = sphere_a ? pa : pb;
+  const Pose& cylinder = sphere_a ? pb : pa;
+  const Eigen::Vector3d& size = (sphere_a ? b : a).size;  // (radius, half_length)
+  const Eigen::Vector3d c = cylinder.rotation.conjugate() * (sphere.translation - cylinder.translation);
+  const bool inside = std::abs(c.z()) < size.y() && c.head<2>().norm() < size.x();
+  return inside ? "Coal sphereCylinderDistance: radial depth for a sphere centre inside the cylinder" : nullptr;
+}
 
 QueryOptions reference_query() {
   QueryOptions o;
@@ -59,10 +83,11 @@ TEST_P(CoalCrossCheck, RandomPairsAgree) {
   c.peer_distance = [](const Shape& a, const Pose& pa, const Shape& b, const Pose& pb) {
     return coal_distance(a, pa, b, pb, kCoalTolerance);
   };
+  c.known_peer_bug = coal_sphere_cylinder_bug;
   const RunSummary s = run_crosscheck(pairs, c);
   print_summary(c.label, s);
   expect_batchcol_certified(s);
-  expect_peer_settled(s);
+  expect_peer_settled(s, kCoalMaxPeerWrong);
 }
 
 INSTANTIATE_TEST_SUITE_P(ShapeTypes, CoalCrossCheck, ::testing::ValuesIn(testing::bounded_shape_types()),
@@ -72,6 +97,8 @@ struct DirectCase {
   ShapeType type;
   CoalGjkVariant variant;
 };
+
+void PrintTo(const DirectCase& d, std::ostream* os) { *os << to_string(d.variant) << " " << to_string(d.type); }
 
 class CoalDirectGjkCrossCheck : public ::testing::TestWithParam<DirectCase> {};
 
@@ -92,7 +119,7 @@ TEST_P(CoalDirectGjkCrossCheck, RandomPairsAgree) {
   const RunSummary s = run_crosscheck(pairs, c);
   print_summary(c.label, s);
   expect_batchcol_certified(s);
-  expect_peer_settled(s);
+  expect_peer_settled(s, kCoalMaxPeerWrong);
 }
 
 std::vector<DirectCase> direct_cases() {

@@ -6,9 +6,8 @@
 // - GJK called directly, as coal::GJKSolver::runGJKAndEPA does it but without the request/result/solver objects
 //   and the collide/distance function tables: a coal::details::MinkowskiDiff set from the two shapes and poses,
 //   then coal::details::GJK::evaluate from Coal's default guess (1, 0, 0). For booleans GJK stops as soon as a
-//   support point proves separation (setDistanceEarlyBreak(0), which is also what coal::collide sets for a zero
-//   security margin); for distances early break is disabled and the witness points are read from the final
-//   simplex. That is what a user after Coal's best speed calls.
+//   support point proves separation (setDistanceEarlyBreak(0)); for distances early break is disabled and the
+//   witness points are read from the final simplex. That is what a user after Coal's best speed calls.
 //
 // Shapes: every bounded type maps to a Coal shape of the same conventions (Box takes full sides, Capsule, Cylinder
 // and Cone full lengths, the cone's apex at +lz/2 as batchcol's; convex hulls become coal::Convex<Triangle> from the
@@ -29,11 +28,14 @@ namespace batchcol::peers {
 enum class CoalGjkVariant { plain, nesterov };
 const char* to_string(CoalGjkVariant variant);
 
-/// coal::collide with a default CollisionRequest (GJK tolerance 1e-6, no security margin); geometries built per call.
+/// coal::collide with a boolean CollisionRequest(NO_REQUEST, 1) and distance_upper_bound = 0, Coal's documented
+/// early stop (GJK tolerance 1e-6, no security margin); geometries built per call.
 PeerAnswer coal_collide(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb);
 
-/// coal::distance with enable_signed_distance and gjk_tolerance = epa_tolerance = `tolerance`; geometries built per
-/// call. Overlapping pairs get Coal's EPA depth as a negative distance.
+/// coal::distance with enable_signed_distance, gjk_tolerance = `tolerance` and epa_tolerance = max(`tolerance`, 1e-6)
+/// (Coal's EPA_MINIMUM_TOLERANCE: below it Coal's EPA gives centimetre errors on curved shapes); geometries built per
+/// call. Overlapping pairs get Coal's EPA depth as a negative distance. Pairs with a triangle, which coal::distance
+/// does not accept, go through GJKSolver::shapeDistance (the same GJK + EPA).
 PeerAnswer coal_distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, double tolerance);
 
 /// The direct GJK of CoalShapeCache::gjk_collide / gjk_distance on geometries built per call.
@@ -66,8 +68,8 @@ class CoalShapeCache {
 
   /// Direct GJK, distance: no early break, GJK tolerance `tolerance`, witness points from the final simplex (moved
   /// out by the swept-sphere radii and re-centred on their midpoint as Coal's GJKSolver does). When GJK finds the
-  /// origin inside the Minkowski difference: with `want_depth`, coal::details::EPA (tolerance `tolerance`, Coal's
-  /// default iteration cap) gives the depth as coal::distance would; without it the answer is the boolean only
+  /// origin inside the Minkowski difference: with `want_depth`, coal::details::EPA (tolerance max(`tolerance`, 1e-6),
+  /// Coal's default iteration cap) gives the depth as coal::distance would; without it the answer is the boolean only
   /// (collide = true, distance NaN), as batchcol answers below the penetration level.
   PeerAnswer gjk_distance(std::uint32_t a, const Pose& pa, std::uint32_t b, const Pose& pb, CoalGjkVariant variant,
                           double tolerance, bool want_depth) const;
