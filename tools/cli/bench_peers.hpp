@@ -27,9 +27,8 @@ struct PeerReport {
 };
 
 /// Boolean queries run the peers' collide, every other level their (signed) distance. Geometries are built once
-/// before timing (peers::FclShapeCache, peers::BulletShapeCache,
-/// peers::CoalShapeCache). Coal runs three ways: coal::collide / coal::distance, and GJK called directly, plain and
-/// Nesterov-accelerated.
+/// before timing (peers::FclShapeCache, peers::BulletShapeCache, peers::CoalShapeCache). Coal runs three ways:
+/// coal::collide / coal::distance, and its GJK called directly, plain and Nesterov-accelerated.
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& pairs, QueryLevel level, int threads,
                       int timed_runs, double min_run_seconds);
 
