@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -77,6 +78,38 @@ TEST_F(BenchCli, TimedRunsRepeatCheapCallsUntilTheMinimumRunTime) {
   const nlohmann::json k = nlohmann::json::parse(single.out);
   EXPECT_EQ(k["calls_per_run"], 1);
   for (const auto& peer : k["peers"]) EXPECT_EQ(peer["calls_per_run"], 1) << peer["name"];
+}
+
+// Coal is optional: when the build found it, the bench times it four ways on the same pairs (coal::collide or
+// coal::distance, GJK called directly, plain and Nesterov) and every row answers every pair like the reference
+// (close pairs, 1e-4..1e-2 m apart: no boolean disagreement, distances within 1e-6 m at Coal tolerance 1e-8);
+// otherwise no Coal row appears and the output says how to enable it.
+TEST_F(BenchCli, CoalRowsAnswerEveryPairWhenCoalWasFound) {
+  for (const std::string query : {"boolean", "witness"}) {
+    const RunResult r = run("bench --case cylinder-convex8 --regime close --query " + query +
+                            " --pairs 300 --runs 5 --min-run-ms 0 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    bool coal_missing = false;
+    for (const auto& note : j["peers_missing"]) coal_missing |= note.get<std::string>().rfind("Coal not found", 0) == 0;
+    std::vector<std::string> coal_rows;
+    for (const auto& peer : j["peers"]) {
+      const std::string name = peer["name"];
+      if (name.rfind("Coal", 0) != 0) continue;
+      coal_rows.push_back(name);
+      EXPECT_EQ(peer["pairs_answered"], 300) << name;
+      if (query == "boolean") EXPECT_EQ(peer["collide_disagreements"], 0) << name;
+      else EXPECT_LE(peer["error_max"].get<double>(), 1e-6) << name;
+      EXPECT_GT(peer["ns_per_pair"].get<double>(), 0.0) << name;
+    }
+    if (coal_missing) {
+      EXPECT_TRUE(coal_rows.empty());
+      continue;
+    }
+    const std::vector<std::string> expected = {query == "boolean" ? "Coal collide" : "Coal distance",
+                                               "Coal GJK direct", "Coal Nesterov direct"};
+    EXPECT_EQ(coal_rows, expected) << query;
+  }
 }
 
 TEST_F(BenchCli, TextOutputNamesTheKernelAndInstructionSet) {

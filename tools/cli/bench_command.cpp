@@ -1,6 +1,6 @@
 // `batchcol bench`: times collide() on generated pairs of one shape-type pair per case, in one distance regime,
-// reports throughput and the error against the double-precision reference, and times FCL and Bullet (when found at
-// configure time) on the same pairs and thread count. --isa picks the instruction set of the SIMD kernels (auto: the
+// reports throughput and the error against the double-precision reference, and times FCL, Bullet and Coal (when found
+// at configure time) on the same pairs and thread count. --isa picks the instruction set of the SIMD kernels (auto: the
 // best this CPU runs); closed forms run in SIMD lanes for sphere/capsule pairs and box-box boolean, per pair for
 // the other closed-form types.
 #include "cli/atomic_output.hpp"
@@ -241,7 +241,8 @@ int run_bench(const BenchSettings& s) {
 Command add_bench_command(CLI::App& parent) {
   auto s = std::make_shared<BenchSettings>();
   CLI::App* app = parent.add_subcommand(
-      "bench", "Time collide() per shape-type pair and distance regime against the double reference and FCL/Bullet");
+      "bench", "Time collide() per shape-type pair and distance regime against the double reference and the peers "
+               "(FCL, Bullet, Coal)");
   app->add_option("--case", s->cases, "TYPE-TYPE (sphere, capsule, box, cylinder, cone, ellipsoid, convex8, "
                                       "convex250, convex940) or all")
       ->capture_default_str();
@@ -264,7 +265,7 @@ Command add_bench_command(CLI::App& parent) {
   app->add_option("--isa", s->isa, "auto, scalar, avx2 or avx512 (auto: the best this CPU runs)")->capture_default_str();
   app->add_option("--seed", s->seed, "Seed of the pair generator")->capture_default_str();
   app->add_option("--save-pairs", s->save_pairs, "Write the generated pairs as a batch file (single --case)");
-  app->add_flag("--no-peers", s->no_peers, "Do not time FCL and Bullet");
+  app->add_flag("--no-peers", s->no_peers, "Do not time the peers (FCL, Bullet, Coal)");
   app->add_option("--derivatives", s->derivatives, "Time differentiate() instead: analytic, smoothed0 or smoothed1");
   app->add_option("--samples", s->derivative_options.samples, "Samples per pair of the smoothed derivatives");
   app->add_option("--noise", s->derivative_options.noise, "Relative noise of the smoothed derivatives");

@@ -9,6 +9,9 @@
 #ifdef BATCHCOL_HAVE_BULLET
 #include <peers/bullet_adapter.hpp>
 #endif
+#ifdef BATCHCOL_HAVE_COAL
+#include <peers/coal_adapter.hpp>
+#endif
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -21,7 +24,7 @@
 namespace batchcol::cli {
 namespace {
 
-#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET)
+#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET) || defined(BATCHCOL_HAVE_COAL)
 using PeerQuery = std::function<peers::PeerAnswer(std::size_t pair)>;
 
 PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p, int threads, int timed_runs,
@@ -62,7 +65,7 @@ PeerTiming time_peer(const std::string& name, bool boolean, const BenchPairs& p,
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLevel level, int threads,
                       int timed_runs, double min_run_seconds) {
   PeerReport report;
-#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET)
+#if defined(BATCHCOL_HAVE_FCL) || defined(BATCHCOL_HAVE_BULLET) || defined(BATCHCOL_HAVE_COAL)
   const bool boolean = level == QueryLevel::boolean;
   const PairBatch& b = p.pairs;
 #else
@@ -94,6 +97,33 @@ PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& p, QueryLev
 #else
   (void)bench_case;
   report.notes.push_back("Bullet not installed (apt-get install libbullet-dev)");
+#endif
+#ifdef BATCHCOL_HAVE_COAL
+  {
+    const peers::CoalShapeCache coal(p.shapes);
+    constexpr double kCoalTolerance = 1e-8;  // batchcol's default tolerance (QueryOptions::tolerance), as for FCL
+    const bool want_depth = level == QueryLevel::penetration;
+    report.timings.push_back(time_peer(boolean ? "Coal collide" : "Coal distance", boolean, p, threads, timed_runs,
+                                       min_run_seconds, [&](std::size_t i) {
+      return boolean ? coal.collide(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i))
+                     : coal.distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), kCoalTolerance);
+    }));
+    // GJK called directly (peers/coal_adapter.hpp): Coal's speed without its request/solver/dispatch overhead.
+    for (const peers::CoalGjkVariant variant : {peers::CoalGjkVariant::plain, peers::CoalGjkVariant::nesterov}) {
+      const char* name = variant == peers::CoalGjkVariant::plain ? "Coal GJK direct" : "Coal Nesterov direct";
+      report.timings.push_back(time_peer(name, boolean, p, threads, timed_runs, min_run_seconds, [&](std::size_t i) {
+        return boolean ? coal.gjk_collide(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), variant)
+                       : coal.gjk_distance(b.shape_a[i], b.pose_a(i), b.shape_b[i], b.pose_b(i), variant,
+                                           kCoalTolerance, want_depth);
+      }));
+      report.timings.back().query = boolean      ? "GJK::evaluate, early break at 0"
+                                    : want_depth ? "GJK::evaluate without early break, EPA for overlapping pairs"
+                                                 : "GJK::evaluate without early break (no depth for overlapping pairs)";
+    }
+  }
+#else
+  report.notes.push_back("Coal not found (build it with ../shared/peers/build-coal.sh, configure with "
+                         "-DCMAKE_PREFIX_PATH=/opt/coal)");
 #endif
   return report;
 }

@@ -1,4 +1,4 @@
-// Peer timings of `batchcol bench`: FCL and Bullet (when found at configure time) on the same pairs, with
+// Peer timings of `batchcol bench`: FCL, Bullet and Coal (when found at configure time) on the same pairs, with
 // tbb::parallel_for in a task_arena of the same thread count, timed as batchcol is (bench_timing.hpp).
 #pragma once
 
@@ -12,8 +12,8 @@
 namespace batchcol::cli {
 
 struct PeerTiming {
-  std::string name;              // "FCL" or "Bullet"
-  std::string query;             // what the peer ran: "collide" or "distance"
+  std::string name;              // "FCL", "Bullet", "Coal collide", "Coal distance", "Coal GJK direct", ...
+  std::string query;             // what the peer ran: "collide", "distance" or a description
   double ns_per_pair = 0;        // median per-call time / pairs (bench_timing.hpp)
   int calls_per_run = 1;
   std::size_t handled = 0;       // pairs the peer answered (ok)
@@ -27,7 +27,8 @@ struct PeerReport {
 };
 
 /// Boolean queries run the peers' collide, every other level their (signed) distance. Geometries are built once
-/// before timing (peers::FclShapeCache, peers::BulletShapeCache).
+/// before timing (peers::FclShapeCache, peers::BulletShapeCache, peers::CoalShapeCache). Coal runs three ways:
+/// coal::collide / coal::distance, and its GJK called directly, plain and Nesterov-accelerated.
 PeerReport time_peers(const BenchCase& bench_case, const BenchPairs& pairs, QueryLevel level, int threads,
                       int timed_runs, double min_run_seconds);
 

@@ -14,4 +14,10 @@ bool have_bullet() { return true; }
 bool have_bullet() { return false; }
 #endif
 
+#ifdef BATCHCOL_HAVE_COAL
+bool have_coal() { return true; }
+#else
+bool have_coal() { return false; }
+#endif
+
 }  // namespace batchcol::peers
