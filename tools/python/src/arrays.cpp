@@ -125,12 +125,12 @@ ConstSpan<std::uint32_t> index_input(const py::handle& obj, const char* name, st
                         "copy=True (got dtype " + dtype_text(a) + ")");
   if (n > 0) {
     const auto lowest = py::int_(a.attr("min")()).cast<long long>();
-    const auto highest = py::int_(a.attr("max")()).cast<unsigned long long>();
     if (lowest < 0) {
       const auto at = py::int_(a.attr("argmin")()).cast<long long>();
       throw ArgumentError(std::string(name) + "[" + std::to_string(at) + "] = " + std::to_string(lowest) +
                           " is negative (shape indices are >= 0)");
     }
+    const auto highest = py::int_(a.attr("max")()).cast<unsigned long long>();
     if (highest > std::numeric_limits<std::uint32_t>::max()) {
       const auto at = py::int_(a.attr("argmax")()).cast<long long>();
       throw ArgumentError(std::string(name) + "[" + std::to_string(at) + "] = " + std::to_string(highest) +
