@@ -54,11 +54,17 @@ def _collide_chunk(shapes, shape_a, shape_b, translation_a, quaternion_a, transl
 
 
 class DaskResults:
-    """Dask arrays of the results of batchcol.dask.collide(). `parts` are the per-chunk tasks (dicts of arrays)."""
+    """Dask arrays of the results of batchcol.dask.collide(). `parts` are the per-chunk tasks (dicts of arrays),
+    `table` the future of the ShapeTable on the workers."""
 
-    def __init__(self, parts, rows, level):
+    def __init__(self, parts, rows, level, table=None):
         self.parts = parts
+        self.table = table
         self.level = level
+        # Fields the level does not compute are empty, as in batchcol.Results.
+        for name, dtype, vector in _fields("penetration"):
+            empty = da.empty((0,), dtype=dtype)
+            setattr(self, name, XYZ(empty, empty, empty) if vector else empty)
         for name, dtype, vector in _fields(level):
             def column(key):
                 return da.concatenate([da.from_delayed(part[key], shape=(n,), dtype=dtype)
@@ -133,4 +139,4 @@ def collide(shapes, shape_a, shape_b, translation_a, quaternion_a, translation_b
     pieces = [_blocks(value, name, bounds) for name, value in args.items()]
     chunk = dask.delayed(_collide_chunk, pure=False)
     parts = [chunk(table, *(p[k] for p in pieces), options) for k in range(len(bounds) - 1)]
-    return DaskResults(parts, [int(r) for r in np.diff(bounds)], level)
+    return DaskResults(parts, [int(r) for r in np.diff(bounds)], level, table)
