@@ -62,12 +62,19 @@ void column_pointers(const py::handle& obj, const char* name, std::size_t n, int
                         "copy=True");
   py::array_t<double, py::array::c_style> soa({static_cast<py::ssize_t>(columns), static_cast<py::ssize_t>(n)});
   double* dst = soa.mutable_data();
-  for (int c = 0; c < columns; ++c)
+  {
+    // One pass over the rows (a C-ordered array is read sequentially), with the GIL released: the transpose is
+    // the whole cost of a copied argument.
+    py::gil_scoped_release release;
     for (std::size_t i = 0; i < n; ++i) {
-      double v;  // memcpy: the source may be unaligned
-      std::memcpy(&v, base + static_cast<py::ssize_t>(i) * row_stride + c * column_stride, sizeof v);
-      dst[static_cast<std::size_t>(c) * n + i] = v;
+      const char* row = base + static_cast<py::ssize_t>(i) * row_stride;
+      for (int c = 0; c < columns; ++c) {
+        double v;  // memcpy: the source may be unaligned
+        std::memcpy(&v, row + c * column_stride, sizeof v);
+        dst[static_cast<std::size_t>(c) * n + i] = v;
+      }
     }
+  }
   for (int c = 0; c < columns; ++c) out[c] = dst + static_cast<std::size_t>(c) * n;
   keep.push_back(std::move(soa));
 }

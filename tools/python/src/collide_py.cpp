@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 namespace batchcol::python {
@@ -46,40 +47,41 @@ std::string invalid_reason(const ShapeTable& shapes, const PairBatchView& b, std
 }
 
 void raise_invalid(const ShapeTable& shapes, const PairBatchView& b, const PairResults& r) {
-  std::size_t first = r.size(), count = 0;
-  for (std::size_t i = 0; i < r.size(); ++i)
-    if (r.status[i] == Status::invalid_input) {
-      if (count++ == 0) first = i;
-    }
-  if (count == 0) return;
+  // memchr: the common case (no invalid pair) costs one vectorised pass over one byte per pair.
+  static_assert(sizeof(Status) == 1, "statuses are bytes");
+  const auto* status = reinterpret_cast<const unsigned char*>(r.status.data());
+  const void* hit = r.size() == 0 ? nullptr : std::memchr(status, static_cast<int>(Status::invalid_input), r.size());
+  if (hit == nullptr) return;
+  const auto first = static_cast<std::size_t>(static_cast<const unsigned char*>(hit) - status);
+  std::size_t count = 0;
+  for (std::size_t i = first; i < r.size(); ++i) count += r.status[i] == Status::invalid_input;
   throw ArgumentError(invalid_reason(shapes, b, first) + " (" + std::to_string(count) + " of " +
                       std::to_string(r.size()) + " pairs have invalid input; invalid='status' reports them as "
                       "per-pair statuses instead of this error)");
 }
 
-/// Median-free raw timings of the C++ collide() on a PairBatch holding the same values as the arrays: the
-/// reference for the Python call's overhead (bench/python_overhead.py). Not part of the public API.
+/// Raw timings of the C++ collide() on the same arrays, for bench/python/overhead.py (not public API): on the
+/// view of the caller's memory itself (same pages: the binding's overhead alone), or on a PairBatch copy.
 std::vector<double> cpp_collide_seconds(const TableHolder& table, const PairBatchView& v, const QueryOptions& o,
-                                        int repeats, bool reuse_results) {
+                                        int repeats, bool reuse_results, bool copy_to_batch) {
   PairBatch batch;
-  batch.shape_a.assign(v.shape_a.data(), v.shape_a.data() + v.size());
-  batch.shape_b.assign(v.shape_b.data(), v.shape_b.data() + v.size());
-  const auto copy3 = [](const Vec3View& s, Vec3Array& d) {
-    d.x.assign(s.x.data(), s.x.data() + s.size()), d.y.assign(s.y.data(), s.y.data() + s.size());
-    d.z.assign(s.z.data(), s.z.data() + s.size());
-  };
-  const auto copy4 = [](const QuatView& s, QuatArray& d) {
-    d.w.assign(s.w.data(), s.w.data() + s.size()), d.x.assign(s.x.data(), s.x.data() + s.size());
-    d.y.assign(s.y.data(), s.y.data() + s.size()), d.z.assign(s.z.data(), s.z.data() + s.size());
-  };
-  copy3(v.translation_a, batch.translation_a), copy3(v.translation_b, batch.translation_b);
-  copy4(v.rotation_a, batch.rotation_a), copy4(v.rotation_b, batch.rotation_b);
+  if (copy_to_batch) {
+    batch.shape_a.assign(v.shape_a.data(), v.shape_a.data() + v.size());
+    batch.shape_b.assign(v.shape_b.data(), v.shape_b.data() + v.size());
+    const auto copy = [](const ConstSpan<double>& s, std::vector<double>& d) { d.assign(s.data(), s.data() + s.size()); };
+    for (auto [from, to] : {std::pair{&v.translation_a, &batch.translation_a}, {&v.translation_b, &batch.translation_b}})
+      copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
+    for (auto [from, to] : {std::pair{&v.rotation_a, &batch.rotation_a}, {&v.rotation_b, &batch.rotation_b}})
+      copy(from->w, to->w), copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
+  }
   std::vector<double> seconds;
   PairResults reused;
   for (int k = 0; k < repeats; ++k) {
     PairResults fresh;
+    PairResults& out = reuse_results ? reused : fresh;
     const auto start = std::chrono::steady_clock::now();
-    collide(*table.table, batch, o, reuse_results ? reused : fresh);
+    if (copy_to_batch) collide(*table.table, batch, o, out);
+    else collide(*table.table, v, o, out);
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return seconds;
@@ -205,17 +207,17 @@ void register_collide(py::module_& m) {
       "_cpp_collide_seconds",
       [](const TableHolder& table, const py::handle& shape_a, const py::handle& shape_b,
          const py::handle& translation_a, const py::handle& quaternion_a, const py::handle& translation_b,
-         const py::handle& quaternion_b, const std::string& level, int threads, int repeats, bool reuse_results) {
+         const py::handle& quaternion_b, const std::string& level, int threads, int repeats, bool reuse_results, bool copy_to_batch) {
         const QueryOptions o = options_from(level, "automatic", "double", 1e-8, 0.0, 0.0, 128, 1000, true, threads,
                                             "automatic");
         KeepAlive keep;
         const PairBatchView v = batch_input(shape_a, shape_b, translation_a, quaternion_a, translation_b,
                                             quaternion_b, py::none(), true, keep);
         py::gil_scoped_release release;
-        return cpp_collide_seconds(table, v, o, repeats, reuse_results);
+        return cpp_collide_seconds(table, v, o, repeats, reuse_results, copy_to_batch);
       },
       "shapes"_a, "shape_a"_a, "shape_b"_a, "translation_a"_a, "quaternion_a"_a, "translation_b"_a,
-      "quaternion_b"_a, "level"_a, "threads"_a, "repeats"_a, "reuse_results"_a);
+      "quaternion_b"_a, "level"_a, "threads"_a, "repeats"_a, "reuse_results"_a, "copy_to_batch"_a);
 }
 
 }  // namespace batchcol::python
