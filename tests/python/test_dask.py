@@ -5,6 +5,7 @@ import os
 import signal
 import time
 
+import dask
 import numpy as np
 import pytest
 
@@ -132,3 +133,33 @@ def test_worker_killed_mid_job_is_recovered_with_identical_results(client, gjk_t
     for name in ("witness_a", "normal"):
         for axis, values in zip("xyz", getattr(want, name)):
             assert same(np.concatenate([p[name + "_" + axis] for p in parts]), values), (name, axis)
+
+
+def make_chunk(seed, n):
+    """One chunk made by one task on a worker, as a loader of one file would: the six pair arguments as a dict."""
+    rng = np.random.default_rng(seed)
+    t_a = rng.uniform(-1, 1, (n, 3))
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return {"shape_a": rng.integers(0, 6, n), "shape_b": rng.integers(0, 6, n), "translation_a": t_a,
+            "quaternion_a": q, "translation_b": t_a + rng.uniform(-0.3, 0.3, (n, 3)), "quaternion_b": q[::-1].copy()}
+
+
+def test_collide_chunks_runs_one_task_per_loaded_chunk(client, gjk_table):
+    sizes = [3000, 1000, 2500]
+    loaders = [dask.delayed(make_chunk)(k, n) for k, n in enumerate(sizes)]
+    result = batchcol.dask.collide_chunks(gjk_table, loaders, level="distance", threads=1)
+    with pytest.raises(TypeError, match="unknown"):
+        len(result)  # no rows given: chunk sizes are known once computed
+    status, distance = result.compute("status", "distance")
+    want = [batchcol.collide(gjk_table, **make_chunk(k, n), level="distance", threads=1) for k, n in enumerate(sizes)]
+    assert same(distance, np.concatenate([w.distance for w in want]))
+    assert same(status, np.concatenate([w.status for w in want]))
+    futures = [client.submit(make_chunk, k, n, pure=False) for k, n in enumerate(sizes)]
+    result = batchcol.dask.collide_chunks(gjk_table, futures, rows=sizes, level="boolean", threads=1)
+    assert len(result) == sum(sizes)
+    (collide,) = result.compute("collide")
+    assert same(collide, np.concatenate([w.collide for w in want]))
+    bad = [client.submit(lambda: (1, 2, 3))]
+    with pytest.raises(ValueError, match="a chunk must hold the 6 pair arguments"):
+        batchcol.dask.collide_chunks(gjk_table, bad, rows=[1]).compute("status")

@@ -5,6 +5,7 @@
     client = Client("tcp://scheduler:8786")          # or Client(LocalCluster(...))
     r = batchcol.dask.collide(shapes, a, b, t_a, q_a, t_b, q_b, level="distance")   # Dask or NumPy arrays
     distance, collide = r.compute("distance", "collide")
+    r = batchcol.dask.collide_chunks(shapes, [dask.delayed(load)(path) for path in files])  # one task per chunk
 
 Each chunk of pairs runs batchcol.collide() on a worker (with threads=0 it uses all the worker's cores through
 TBB). The ShapeTable is sent once per worker (client.scatter(..., broadcast=True)), not once per chunk: it pickles
@@ -73,12 +74,52 @@ class DaskResults:
             setattr(self, name, value)
 
     def __len__(self):
-        return self.status.shape[0]
+        n = self.status.shape[0]
+        if n != n:  # NaN: chunks of unknown size (collide_chunks without rows)
+            raise TypeError("the number of pairs is unknown until computed")
+        return int(n)
 
     def compute(self, *names, **kwargs):
         """NumPy arrays of the named fields (all when none are named), computed together: each chunk runs once."""
         names = names or tuple(name for name, _, _ in _fields(self.level))
         return dask.compute(*(getattr(self, name) for name in names), **kwargs)
+
+
+_ARGUMENTS = ("shape_a", "shape_b", "translation_a", "quaternion_a", "translation_b", "quaternion_b")
+
+
+def _collide_loaded_chunk(shapes, chunk, options):
+    """A chunk given as one task's output: a tuple of the six pair arguments, or a dict with their names."""
+    if isinstance(chunk, dict):
+        missing = [name for name in _ARGUMENTS if name not in chunk]
+        if missing:
+            raise ValueError(f"a chunk dict lacks {missing}")
+        chunk = tuple(chunk[name] for name in _ARGUMENTS)
+    if len(chunk) != 6:
+        raise ValueError(f"a chunk must hold the 6 pair arguments {_ARGUMENTS}, got {len(chunk)} values")
+    return _collide_chunk(shapes, *chunk, options)
+
+
+def collide_chunks(shapes, chunks, *, client=None, rows=None, **options):
+    """batchcol.collide() on chunks that are each one task's output (a Dask delayed object or a Future holding a
+    tuple or dict of the six pair arguments), e.g. one task per file that loads its pairs on a worker. Each chunk's
+    collide runs where its chunk is (no transfer of the inputs). `rows` gives the pairs per chunk when known
+    (otherwise the result arrays have unknown chunk sizes, as Dask allows). Options as in collide()."""
+    client = client or default_client()
+    options.setdefault("invalid", "status")
+    if "out" in options:
+        raise ValueError("out is not supported by batchcol.dask")
+    level = options.get("level", "witness")
+    if level not in _LEVELS:
+        raise ValueError(f"level must be one of {_LEVELS}, got {level!r}")
+    chunks = list(chunks)
+    if rows is None:
+        rows = [np.nan] * len(chunks)
+    elif len(rows) != len(chunks):
+        raise ValueError(f"rows has {len(rows)} entries for {len(chunks)} chunks")
+    table = client.scatter(shapes, broadcast=True, hash=False)
+    run = dask.delayed(_collide_loaded_chunk, pure=False)
+    return DaskResults([run(table, chunk, options) for chunk in chunks], list(rows), level, table)
 
 
 def _column_count(name):
