@@ -190,9 +190,9 @@ def test_shape_factories_validate_like_cpp():
     assert batchcol.Shape.capsule(0.1, 0.2).inflated(0.05).inflation == 0.05
 
 
-def test_gil_is_released_while_the_engine_runs(table):
-    # Two Python threads run collide() at once; each result equals its single-threaded run. (That the GIL is
-    # released is visible as overlap only in timing; this checks the concurrent calls stay correct.)
+def test_concurrent_calls_from_two_python_threads_match_one_call(table):
+    # collide() releases the GIL (asserted by the next test), so two Python threads run the engine at once on one
+    # shared table; each result equals a lone call's.
     a, b, t_a, q_a, t_b, q_b = random_pairs(20000, len(table), seed=13)
     want = batchcol.collide(table, a, b, t_a, q_a, t_b, q_b, threads=1)
     got = [None, None]
@@ -206,3 +206,25 @@ def test_gil_is_released_while_the_engine_runs(table):
     for t in threads:
         t.join()
     assert all(same_results(want, g) for g in got)
+
+
+def test_gil_is_released_and_the_table_cannot_grow_while_the_engine_reads_it(table):
+    # add() may move the table's shapes; while a collide() runs with the GIL released it is refused. The table is
+    # marked busy and unmarked with the GIL held, so this thread can see it busy only if it runs while the engine
+    # does: the error below also proves that collide() releases the GIL.
+    a, b, t_a, q_a, t_b, q_b = random_pairs(400_000, len(table), seed=17)
+    grown = batchcol.ShapeTable()
+    for k in range(len(table)):
+        grown.add(table[k])
+    errors = []
+    worker = threading.Thread(target=lambda: batchcol.collide(grown, a, b, t_a, q_a, t_b, q_b, threads=1))
+    worker.start()
+    while worker.is_alive():
+        try:
+            grown.add(batchcol.Shape.sphere(0.1))
+        except RuntimeError as e:
+            errors.append(str(e))
+            break
+    worker.join()
+    assert errors and "in use by a running collide()" in errors[0]
+    grown.add(batchcol.Shape.sphere(0.1))  # allowed again once it returned
