@@ -182,6 +182,7 @@ void register_collide(py::module_& m) {
           // Reuse only when nothing is reallocated: arrays handed out earlier stay valid (and see the new values).
           result = py::reinterpret_borrow<py::object>(out);
           const auto& old = result.cast<ResultsHolder&>();
+          if (old.busy > 0) throw std::runtime_error("out is being written by another running collide()");
           if (old.results.size() != v.size() || old.level != o.level)
             throw ArgumentError("out must be a Results of " + std::to_string(v.size()) + " pairs at level '" +
                                 to_string(o.level) + "', got " + std::to_string(old.results.size()) + " pairs at '" +
@@ -191,6 +192,11 @@ void register_collide(py::module_& m) {
         holder.level = o.level;
         {
           TableUse use(table);
+          ++holder.busy;
+          struct Done {
+            int& busy;
+            ~Done() { --busy; }
+          } done{holder.busy};
           py::gil_scoped_release release;
           collide(*table.table, v, o, holder.results);
         }

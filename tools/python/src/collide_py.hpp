@@ -11,6 +11,7 @@ namespace batchcol::python {
 struct ResultsHolder {
   PairResults results;
   QueryLevel level = QueryLevel::witness;
+  int busy = 0;  // a collide(out=...) is writing it with the GIL released
 };
 
 /// Views (or copies, see arrays.hpp) of collide()'s pair arguments, named as in the Python signature.
