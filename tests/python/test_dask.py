@@ -21,6 +21,7 @@ def client():
     cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                        dashboard_address=":0")
     c = distributed.Client(cluster)
+    c.wait_for_workers(2)
     yield c
     c.close()
     cluster.close()
@@ -78,9 +79,11 @@ def test_two_workers_equal_one_process_and_table_sent_once_per_worker(client, gj
     assert len(result) == 60_000 and len(result.parts) == 8
     want = check_equal_to_one_process(client, gjk_table, arrays, result)
     assert 0 < want.collide.sum() < len(want)
-    # The table is held by both workers (broadcast), and no chunk task carries it in its arguments.
-    holders = client.who_has(result.table)[result.table.key]
-    assert len(holders) == 2
+    # Each worker received the table exactly once for the 8 chunks (and the second compute() inside
+    # check_equal_to_one_process ran them all again without sending it again).
+    received = client.run(lambda dask_worker: dask_worker._batchcol_table_setups.get(result.table, 0))
+    assert sorted(received.values()) == [1, 1]
+    # No chunk task carries the table in its arguments: they name it.
     graph = dict(result.status.__dask_graph__())
     assert not any(isinstance(arg, batchcol.ShapeTable) for task in graph.values() if isinstance(task, tuple)
                    for arg in task)
@@ -115,6 +118,7 @@ def test_worker_killed_mid_job_is_recovered_with_identical_results(client, gjk_t
     assert busy, "no worker was running a chunk"
     done_at_kill = sum(f.done() for f in futures)
     os.kill(pids[busy[0]], signal.SIGKILL)
+    killed = busy[0]
     assert done_at_kill < len(futures), "the job finished before the kill: make it longer"
     parts = client.gather(futures)  # Dask reruns the lost chunks (and their lost inputs) on the other worker
     deadline = time.time() + 60
@@ -125,6 +129,9 @@ def test_worker_killed_mid_job_is_recovered_with_identical_results(client, gjk_t
         time.sleep(0.2)
     else:
         pytest.fail("the killed worker was not replaced")
+    # The replacement received the table from the scheduler when it joined.
+    received = client.run(lambda dask_worker: dask_worker._batchcol_table_setups.get(result.table, 0))
+    assert killed not in received and sorted(received.values()) == [1, 1]
     local = [np.asarray(x) for x in client.compute(list(arrays), sync=True)]
     want = batchcol.collide(gjk_table, *local, level="penetration", threads=2, invalid="status")
     assert sum(len(p["status"]) for p in parts) == len(want) == 240_000

@@ -8,18 +8,21 @@
     r = batchcol.dask.collide_chunks(shapes, [dask.delayed(load)(path) for path in files])  # one task per chunk
 
 Each chunk of pairs runs batchcol.collide() on a worker (with threads=0 it uses all the worker's cores through
-TBB). The ShapeTable is sent once per worker (client.scatter(..., broadcast=True)), not once per chunk: it pickles
-as the exact fields of its shapes. Results are Dask arrays with the fields of batchcol.Results (vector fields are
+TBB). The ShapeTable is sent once per worker, not once per chunk, as a worker plugin (the scheduler hands it to
+every worker that joins, replacements of dead workers included): it pickles as the exact fields of its shapes. Results are Dask arrays with the fields of batchcol.Results (vector fields are
 XYZ of three Dask arrays). A worker that dies mid-job is replaced by its nanny and Dask runs its chunks again
 elsewhere: chunks computed from Dask arrays (generated or read by tasks) are recomputed; NumPy inputs are put into
 the graph as data, so they survive a worker's loss too (but travel through the scheduler: for large batches, build
 Dask arrays that load or generate their chunks on the workers).
 """
 
+import uuid
+import weakref
+
 import numpy as np
 import dask
 import dask.array as da
-from distributed import default_client
+from distributed import WorkerPlugin, default_client, get_worker
 
 from . import XYZ
 from . import collide as _collide
@@ -40,8 +43,42 @@ def _fields(level):
     return fields
 
 
-def _collide_chunk(shapes, shape_a, shape_b, translation_a, quaternion_a, translation_b, quaternion_b, options):
+class _TablePlugin(WorkerPlugin):
+    """Carries a ShapeTable to every worker once: the scheduler keeps the plugin and gives it to each worker that
+    joins, including one that replaces a dead worker, and Dask's memory manager never moves or drops it (a
+    scattered table's extra replicas are dropped whenever no task waits for them, and fetched again later)."""
+
+    def __init__(self, name, shapes):
+        self.name = name
+        self.shapes = shapes
+
+    def setup(self, worker):
+        tables = worker.__dict__.setdefault("_batchcol_tables", {})
+        tables[self.name] = self.shapes
+        setups = worker.__dict__.setdefault("_batchcol_table_setups", {})
+        setups[self.name] = setups.get(self.name, 0) + 1  # for the tests: how often this worker received it
+
+    def teardown(self, worker):
+        worker.__dict__.get("_batchcol_tables", {}).pop(self.name, None)
+
+
+def _send_table(client, shapes):
+    """Registers the table on every worker (now and later); returns its name. Unregistered with the results."""
+    name = "batchcol-table-" + uuid.uuid4().hex
+    client.register_worker_plugin(_TablePlugin(name, shapes), name=name)
+    return name
+
+
+def _release_table(client, name):
+    try:
+        client.unregister_worker_plugin(name)
+    except Exception:  # the client or cluster may be gone already: nothing left to release
+        pass
+
+
+def _collide_chunk(table, shape_a, shape_b, translation_a, quaternion_a, translation_b, quaternion_b, options):
     """One chunk on a worker: a dict of plain arrays (their buffers are the chunk's Results, no extra copy)."""
+    shapes = get_worker()._batchcol_tables[table] if isinstance(table, str) else table
     r = _collide(shapes, shape_a, shape_b, translation_a, quaternion_a, translation_b, quaternion_b, **options)
     out = {}
     for name, _, vector in _fields(r.level):
@@ -56,12 +93,14 @@ def _collide_chunk(shapes, shape_a, shape_b, translation_a, quaternion_a, transl
 
 class DaskResults:
     """Dask arrays of the results of batchcol.dask.collide(). `parts` are the per-chunk tasks (dicts of arrays),
-    `table` the future of the ShapeTable on the workers."""
+    `table` the name of the ShapeTable on the workers (released from them when this object is collected)."""
 
-    def __init__(self, parts, rows, level, table=None):
+    def __init__(self, parts, rows, level, table=None, client=None):
         self.parts = parts
         self.table = table
         self.level = level
+        if client is not None and table is not None:
+            weakref.finalize(self, _release_table, client, table)
         # Fields the level does not compute are empty, as in batchcol.Results.
         for name, dtype, vector in _fields("penetration"):
             empty = da.empty((0,), dtype=dtype)
@@ -117,9 +156,9 @@ def collide_chunks(shapes, chunks, *, client=None, rows=None, **options):
         rows = [np.nan] * len(chunks)
     elif len(rows) != len(chunks):
         raise ValueError(f"rows has {len(rows)} entries for {len(chunks)} chunks")
-    table = client.scatter(shapes, broadcast=True, hash=False)
+    table = _send_table(client, shapes)
     run = dask.delayed(_collide_loaded_chunk, pure=False)
-    return DaskResults([run(table, chunk, options) for chunk in chunks], list(rows), level, table)
+    return DaskResults([run(table, chunk, options) for chunk in chunks], list(rows), level, table, client)
 
 
 def _column_count(name):
@@ -175,9 +214,8 @@ def collide(shapes, shape_a, shape_b, translation_a, quaternion_a, translation_b
     level = options.get("level", "witness")
     if level not in _LEVELS:
         raise ValueError(f"level must be one of {_LEVELS}, got {level!r}")
-    # Once per worker, not once per chunk; a replacement worker fetches it from a surviving one.
-    table = client.scatter(shapes, broadcast=True, hash=False)
+    table = _send_table(client, shapes)  # once per worker, not once per chunk
     pieces = [_blocks(value, name, bounds) for name, value in args.items()]
     chunk = dask.delayed(_collide_chunk, pure=False)
     parts = [chunk(table, *(p[k] for p in pieces), options) for k in range(len(bounds) - 1)]
-    return DaskResults(parts, [int(r) for r in np.diff(bounds)], level, table)
+    return DaskResults(parts, [int(r) for r in np.diff(bounds)], level, table, client)
