@@ -100,7 +100,8 @@ class DaskResults:
         self.table = table
         self.level = level
         if client is not None and table is not None:
-            weakref.finalize(self, _release_table, client, table)
+            release = weakref.finalize(self, _release_table, client, table)
+            release.atexit = False  # at exit the cluster goes away anyway; a call into a closing client could block
         # Fields the level does not compute are empty, as in batchcol.Results.
         for name, dtype, vector in _fields("penetration"):
             empty = da.empty((0,), dtype=dtype)
