@@ -74,9 +74,9 @@ def check_equal_to_one_process(client, table, arrays, result):
 
 @pytest.mark.parametrize("level", ["boolean", "witness"])
 def test_two_workers_equal_one_process_and_table_sent_once_per_worker(client, gjk_table, level):
-    arrays = lazy_pairs(60_000, 7_500, len(gjk_table), seed=1)
+    arrays = lazy_pairs(30_000, 3_750, len(gjk_table), seed=1)
     result = batchcol.dask.collide(gjk_table, *arrays, level=level, threads=1)
-    assert len(result) == 60_000 and len(result.parts) == 8
+    assert len(result) == 30_000 and len(result.parts) == 8
     want = check_equal_to_one_process(client, gjk_table, arrays, result)
     assert 0 < want.collide.sum() < len(want)
     # Each worker received the table exactly once for the 8 chunks (and the second compute() inside
@@ -109,7 +109,7 @@ def worker_pids(client):
 
 
 def test_worker_killed_mid_job_is_recovered_with_identical_results(client, gjk_table):
-    arrays = lazy_pairs(240_000, 5_000, len(gjk_table), seed=2)
+    arrays = lazy_pairs(160_000, 4_000, len(gjk_table), seed=2)
     result = batchcol.dask.collide(gjk_table, *arrays, level="penetration", threads=1)
     futures = client.compute(result.parts)
     distributed.wait(futures, return_when="FIRST_COMPLETED")
@@ -134,7 +134,7 @@ def test_worker_killed_mid_job_is_recovered_with_identical_results(client, gjk_t
     assert killed not in received and sorted(received.values()) == [1, 1]
     local = [np.asarray(x) for x in client.compute(list(arrays), sync=True)]
     want = batchcol.collide(gjk_table, *local, level="penetration", threads=2, invalid="status")
-    assert sum(len(p["status"]) for p in parts) == len(want) == 240_000
+    assert sum(len(p["status"]) for p in parts) == len(want) == 160_000
     for name in ("status", "collide", "distance", "iterations"):
         assert same(np.concatenate([p[name] for p in parts]), getattr(want, name)), name
     for name in ("witness_a", "normal"):
