@@ -23,10 +23,12 @@ shift
 required=(cmake g++ libeigen3-dev libtbb-dev libqhull-dev nlohmann-json3-dev libcli11-dev libassimp-dev
           libgtest-dev libbenchmark-dev libgmock-dev)
 cross_check_peers=(libfcl-dev libbullet-dev)  # optional for the library, installed for the test suite
+# The Python package and its pytest suite (Debian's /usr/bin/python3); optional for the library and the demo.
+python_packages=(python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed)
 
 case "$command" in
   demo) packages=("${required[@]}") ;;
-  test | asan-test) packages=("${required[@]}" "${cross_check_peers[@]}") ;;
+  test | asan-test) packages=("${required[@]}" "${cross_check_peers[@]}" "${python_packages[@]}") ;;
   *) usage ;;
 esac
 

@@ -24,6 +24,13 @@ std::size_t PairBatch::add(std::uint32_t a, const Pose& pose_a, std::uint32_t b,
   return shape_a.size() - 1;
 }
 
+PairBatchView PairBatchView::of(const PairBatch& b) {
+  return {ConstSpan<std::uint32_t>::of(b.shape_a), ConstSpan<std::uint32_t>::of(b.shape_b),
+          Vec3View::of(b.translation_a),          Vec3View::of(b.translation_b),
+          QuatView::of(b.rotation_a),             QuatView::of(b.rotation_b),
+          Vec3View::of(b.warm_start)};
+}
+
 void PairResults::resize(std::size_t n, QueryLevel level) {
   detail::size_results(*this, n, level);
   for (std::size_t i = 0; i < n; ++i) detail::fill_pair_defaults(*this, i);

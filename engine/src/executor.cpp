@@ -51,7 +51,7 @@ void one_group(std::size_t group, std::size_t n, std::vector<std::uint32_t>& ord
 
 /// Indices [begin, end) of the batch sorted by (type of a, type of b), stable: pairs of one kernel run back to
 /// back. Grouping stays inside a tile so that memory access stays local. `keys` is scratch.
-void group_by_type(const ShapeTable& shapes, const PairBatch& batch, std::size_t begin, std::size_t end,
+void group_by_type(const ShapeTable& shapes, const PairBatchView& batch, std::size_t begin, std::size_t end,
                    std::vector<std::uint32_t>& order, std::vector<std::uint8_t>& keys, GroupStarts& groups) {
   static_assert(kTypePairs <= 256, "keys are bytes");
   const std::size_t n = end - begin, count = shapes.size();
@@ -122,7 +122,7 @@ WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) 
 /// Whether a group's pairs run through the SIMD GJK straight from the batch arrays (kernels::simd::gjk_pairs):
 /// below QueryLevel::penetration (EPA stays per pair), without warm start, for types other than triangle and
 /// halfspace, when setup_pair_into() has no closed form for the type pair.
-bool wide_gjk_group(std::size_t group, const QueryOptions& options, const PairBatch& batch) {
+bool wide_gjk_group(std::size_t group, const QueryOptions& options, const PairBatchView& batch) {
   if (options.level >= QueryLevel::penetration || !batch.warm_start.empty()) return false;
   const ShapeType a = type_a(group), b = type_b(group);
   const auto plain = [](ShapeType t) { return t != ShapeType::triangle && t != ShapeType::halfspace; };
@@ -156,7 +156,7 @@ template <class T> struct ChunkScratch {
 /// (status invalid_input written; everything else stays NaN / 0 from fill_pair_defaults). The pose arithmetic is
 /// spelled out (kernels/math.hpp) so that every path computing a relative pose gets the same bits.
 template <class T>
-bool prepare_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
+bool prepare_pair(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, std::size_t i,
                   PairFrame& frame, kernels::PairSetup<T>& setup, PairResults& out) {
   const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
   double qa[4] = {batch.rotation_a.w[i], batch.rotation_a.x[i], batch.rotation_a.y[i], batch.rotation_a.z[i]};
@@ -181,7 +181,7 @@ bool prepare_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryO
 /// Sphere and capsule pairs with closed forms on: world segments and the closed form, in double, without the
 /// relative frame and the setup. Returns false (nothing written) when the pair is not one, or is invalid: the
 /// generic path then answers it.
-bool solve_segment_pair(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, std::size_t i,
+bool solve_segment_pair(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, std::size_t i,
                         PairResults& out) {
   const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
   if (ia >= shapes.size() || ib >= shapes.size()) return false;
@@ -209,7 +209,7 @@ bool solve_segment_pair(const ShapeTable& shapes, const PairBatch& batch, const 
 /// The tile's pairs listed in s.order[0 .. count) (offsets from begin, grouped by type): closed forms answer at setup, the
 /// rest run through the SIMD GJK in chunks of one shape-pair type, then complete_pair() per pair.
 template <class T>
-void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
+void run_generic(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, InstructionSet isa,
                  std::size_t begin, std::size_t count, ChunkScratch<T>& s, PairResults& out) {
   if (count == 0) return;
   const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
@@ -258,7 +258,7 @@ void run_generic(const ShapeTable& shapes, const PairBatch& batch, const QueryOp
 }
 
 template <class T>
-void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, InstructionSet isa,
+void run_tile(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, InstructionSet isa,
               std::size_t begin, std::size_t end, ChunkScratch<T>& s, PairResults& out) {
   group_by_type(shapes, batch, begin, end, s.order, s.keys, s.groups);
   // Groups with a SIMD closed form or the batch-array GJK first; the pairs they leave (invalid input, touching
@@ -298,7 +298,12 @@ void run_tile(const ShapeTable& shapes, const PairBatch& batch, const QueryOptio
 
 }  // namespace
 
-void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& requested, PairResults& results) {
+void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results) {
+  detail::validate_batch_layout(batch);
+  collide(shapes, PairBatchView::of(batch), options, results);
+}
+
+void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& requested, PairResults& results) {
   validate(requested);
   QueryOptions options = requested;  // the kernels see the solver that runs, never `automatic`
   options.solver = resolve_solver(requested.solver, requested.level);

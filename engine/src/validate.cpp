@@ -31,6 +31,29 @@ void validate_batch_layout(const PairBatch& b) {
   if (!b.warm_start.empty()) check(length(b.warm_start), "warm_start");
 }
 
+void validate_batch_layout(const PairBatchView& b) {
+  const std::size_t n = b.size();
+  const auto check = [n](const auto& span, const char* name, const char* component) {
+    std::string what = std::string("PairBatchView::") + name + component;
+    if (span.size() != n)
+      throw InputError(what + " has " + std::to_string(span.size()) + " entries, expected " + std::to_string(n));
+    if (n > 0 && span.data() == nullptr) throw InputError(what + " has " + std::to_string(n) + " entries but no data");
+  };
+  check(b.shape_a, "shape_a", "");
+  check(b.shape_b, "shape_b", "");
+  const auto vec3 = [&](const Vec3View& v, const char* name) {
+    check(v.x, name, ".x"), check(v.y, name, ".y"), check(v.z, name, ".z");
+  };
+  const auto quat = [&](const QuatView& q, const char* name) {
+    check(q.w, name, ".w"), check(q.x, name, ".x"), check(q.y, name, ".y"), check(q.z, name, ".z");
+  };
+  vec3(b.translation_a, "translation_a");
+  vec3(b.translation_b, "translation_b");
+  quat(b.rotation_a, "rotation_a");
+  quat(b.rotation_b, "rotation_b");
+  if (!b.warm_start.empty()) vec3(b.warm_start, "warm_start");
+}
+
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
   if (!is_unit_quaternion(q)) return std::nullopt;
   return q.normalized();

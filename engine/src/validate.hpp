@@ -10,6 +10,8 @@ namespace batchcol::detail {
 
 /// Throws InputError when the arrays of `batch` have different lengths.
 void validate_batch_layout(const PairBatch& batch);
+/// Throws InputError when the arrays of `batch` have different lengths or a non-empty one has a null pointer.
+void validate_batch_layout(const PairBatchView& batch);
 
 /// The unit quaternion for `q`, or nothing when q is not finite or not unit within kUnitTolerance.
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q);

@@ -27,12 +27,13 @@ struct PairView {
   const Shape* shapes = nullptr;  // the table itself, for the per-lane setup of the batch-array GJK
   const double* bounding_radii = nullptr;  // ShapeTable::bounding_radii()
 
-  static PairView of(const ShapeTable& shapes, const PairBatch& batch) {
+  static PairView of(const ShapeTable& shapes, const PairBatch& batch) { return of(shapes, PairBatchView::of(batch)); }
+  static PairView of(const ShapeTable& shapes, const PairBatchView& batch) {
     PairView v;
     v.shape_a = batch.shape_a.data();
     v.shape_b = batch.shape_b.data();
-    const Vec3Array* t[2] = {&batch.translation_a, &batch.translation_b};
-    const QuatArray* q[2] = {&batch.rotation_a, &batch.rotation_b};
+    const Vec3View* t[2] = {&batch.translation_a, &batch.translation_b};
+    const QuatView* q[2] = {&batch.rotation_a, &batch.rotation_b};
     const double** tv[2] = {v.translation_a, v.translation_b};
     const double** qv[2] = {v.rotation_a, v.rotation_b};
     for (int s = 0; s < 2; ++s) {

@@ -109,6 +109,19 @@ struct PairBatch {
   Pose pose_b(std::size_t i) const { return {translation_b[i], rotation_b[i]}; }
 };
 
+/// A pair batch whose arrays are owned by the caller (NumPy arrays, memory-mapped files): the same layout as
+/// PairBatch, viewed instead of copied. Each component array must hold size() entries (warm_start may be empty) and
+/// stay unchanged until collide() returns.
+struct PairBatchView {
+  ConstSpan<std::uint32_t> shape_a, shape_b;
+  Vec3View translation_a, translation_b;
+  QuatView rotation_a, rotation_b;
+  Vec3View warm_start;
+
+  std::size_t size() const { return shape_a.size(); }
+  static PairBatchView of(const PairBatch& batch);
+};
+
 /// Per-pair results in input order (structure of arrays).
 struct PairResults {
   std::vector<Status> status;
@@ -127,6 +140,9 @@ struct PairResults {
 /// throws InputError only for problems with the call itself (mismatched array sizes, invalid options).
 /// Results are bitwise identical for any thread count.
 void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results);
+/// The same on caller-owned arrays (bitwise the same results as on a PairBatch holding the same values). Throws
+/// InputError when the view's arrays have different lengths or a non-empty one has no data pointer.
+void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, PairResults& results);
 
 /// Throws InputError naming the option when `options` is invalid (non-finite or negative tolerance, ...).
 void validate(const QueryOptions& options);

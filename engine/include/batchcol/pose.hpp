@@ -58,4 +58,42 @@ struct QuatArray {
   Eigen::Quaterniond operator[](std::size_t i) const { return {w[i], x[i], y[i], z[i]}; }
 };
 
+/// Read-only view of `count` contiguous values owned by someone else (a NumPy array, a memory-mapped file): the
+/// part of std::vector's interface the executor reads, so batches can be viewed instead of copied.
+template <class T>
+struct ConstSpan {
+  const T* ptr = nullptr;
+  std::size_t count = 0;
+
+  const T* data() const { return ptr; }
+  std::size_t size() const { return count; }
+  bool empty() const { return count == 0; }
+  const T& operator[](std::size_t i) const { return ptr[i]; }
+  static ConstSpan of(const std::vector<T>& v) { return {v.data(), v.size()}; }
+};
+
+/// Vec3Array's layout (one contiguous array per component) over memory owned elsewhere.
+struct Vec3View {
+  ConstSpan<double> x, y, z;
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  Eigen::Vector3d operator[](std::size_t i) const { return {x[i], y[i], z[i]}; }
+  static Vec3View of(const Vec3Array& a) {
+    return {ConstSpan<double>::of(a.x), ConstSpan<double>::of(a.y), ConstSpan<double>::of(a.z)};
+  }
+};
+
+/// QuatArray's layout ([w, x, y, z], one contiguous array per component) over memory owned elsewhere.
+struct QuatView {
+  ConstSpan<double> w, x, y, z;
+
+  std::size_t size() const { return w.size(); }
+  Eigen::Quaterniond operator[](std::size_t i) const { return {w[i], x[i], y[i], z[i]}; }
+  static QuatView of(const QuatArray& q) {
+    return {ConstSpan<double>::of(q.w), ConstSpan<double>::of(q.x), ConstSpan<double>::of(q.y),
+            ConstSpan<double>::of(q.z)};
+  }
+};
+
 }  // namespace batchcol
