@@ -1,0 +1,111 @@
+// Exact ray intervals of the flat-faced shapes (local frame): box (slabs, Kay & Kajiya 1986), convex hull (the
+// intersection of its face half-spaces: Cyrus-Beck clipping), triangle (Moeller-Trumbore 1997) and halfspace.
+#pragma once
+
+#include "batchcol/shapes.hpp"
+#include "kernels/rays/ray_interval.hpp"
+
+#include <cstddef>
+#include <vector>
+
+namespace batchcol::kernels::rays {
+
+/// Box with half extents e.
+template <class T> RayInterval<T> ray_box(const Vec3<T>& o, const Vec3<T>& d, const Vec3<T>& e) {
+  RayInterval<T> in = slab(o.x(), d.x(), -e.x(), e.x(), Vec3<T>(T(1), T(0), T(0)));
+  in = intersect(in, slab(o.y(), d.y(), -e.y(), e.y(), Vec3<T>(T(0), T(1), T(0))));
+  return intersect(in, slab(o.z(), d.z(), -e.z(), e.z(), Vec3<T>(T(0), T(0), T(1))));
+}
+
+/// Halfspace {x : <n, x> <= c}, n unit.
+template <class T> RayInterval<T> ray_halfspace(const Vec3<T>& o, const Vec3<T>& d, const Vec3<T>& n, T c) {
+  const T denom = dot3(n, d), dist = c - dot3(n, o);  // t denom <= dist inside
+  if (denom == T(0)) return dist >= T(0) ? RayInterval<T>::everything() : RayInterval<T>::nothing();
+  const T t = dist / denom;
+  if (denom < T(0)) return {t, infinity<T>(), n};
+  return {-infinity<T>(), t, n};
+}
+
+/// Triangle (a 2-D solid): [t, t] where the ray crosses its interior or edges, empty when the line lies in its
+/// plane (a set of measure zero that no tessellation reports either). The normal faces the ray.
+template <class T> RayInterval<T> ray_triangle(const Vec3<T>& o, const Vec3<T>& d, const Vec3<T>& a, const Vec3<T>& b,
+                                               const Vec3<T>& c) {
+  const Vec3<T> e1 = b - a, e2 = c - a;
+  const Vec3<T> p = cross3(d, e2);
+  const T det = dot3(e1, p);
+  if (det == T(0)) return RayInterval<T>::nothing();
+  const T inv = T(1) / det;
+  const Vec3<T> s = o - a;
+  const T u = dot3(s, p) * inv;
+  if (!(u >= T(0) && u <= T(1))) return RayInterval<T>::nothing();
+  const Vec3<T> q = cross3(s, e1);
+  const T v = dot3(d, q) * inv;
+  if (!(v >= T(0) && u + v <= T(1))) return RayInterval<T>::nothing();
+  const T t = dot3(e2, q) * inv;
+  Vec3<T> n = cross3(e1, e2);
+  n /= norm3(n);
+  if (dot3(n, d) > T(0)) n = -n;
+  return {t, t, n};
+}
+
+/// A hull's face planes <n_i, x> <= c_i in structure-of-arrays form, padded to a multiple of kHullPlaneBlock with
+/// planes 0 <= 1 (always satisfied), so that the clipping loop runs on whole blocks the compiler vectorises.
+constexpr std::size_t kHullPlaneBlock = 8;
+template <class T> struct HullPlanes {
+  std::vector<T> nx, ny, nz, c;
+  std::size_t faces = 0;  // real planes (the rest is padding)
+};
+
+template <class T> HullPlanes<T> make_hull_planes(const ConvexHull& hull) {
+  HullPlanes<T> p;
+  p.faces = hull.faces.size();
+  const std::size_t padded = (p.faces + kHullPlaneBlock - 1) / kHullPlaneBlock * kHullPlaneBlock;
+  p.nx.assign(padded, T(0)), p.ny.assign(padded, T(0)), p.nz.assign(padded, T(0)), p.c.assign(padded, T(1));
+  for (std::size_t i = 0; i < p.faces; ++i) {
+    const Eigen::Vector3d& n = hull.face_normals[i];
+    const Eigen::Vector3d& v = hull.vertices[hull.faces[i][0]];
+    p.nx[i] = T(n.x()), p.ny[i] = T(n.y()), p.nz[i] = T(n.z());
+    p.c[i] = T(n.dot(v));
+  }
+  return p;
+}
+
+/// Cyrus-Beck: enter = max over faces turned against d of dist_i / denom_i, exit = min over the others; a face
+/// parallel to the ray empties the interval when the line is outside it. Each lane j of a block keeps its own running
+/// max / min (branch-free selects), reduced at the end: the loop vectorises across faces.
+template <class T> RayInterval<T> ray_convex(const Vec3<T>& o, const Vec3<T>& d, const HullPlanes<T>& planes) {
+  constexpr std::size_t W = kHullPlaneBlock;
+  T enter[W], exit[W];
+  unsigned face[W];
+  for (std::size_t j = 0; j < W; ++j) enter[j] = -infinity<T>(), exit[j] = infinity<T>(), face[j] = 0;
+  const T *nx = planes.nx.data(), *ny = planes.ny.data(), *nz = planes.nz.data(), *c = planes.c.data();
+  const std::size_t n = planes.nx.size();
+  for (std::size_t b = 0; b < n; b += W) {
+    for (std::size_t j = 0; j < W; ++j) {
+      const std::size_t i = b + j;
+      const T denom = (nx[i] * d.x() + ny[i] * d.y()) + nz[i] * d.z();
+      const T dist = c[i] - ((nx[i] * o.x() + ny[i] * o.y()) + nz[i] * o.z());
+      const T t = dist / denom;  // +-inf or NaN when denom == 0: filtered by the selects below
+      const bool entering = denom < T(0) && t > enter[j];
+      enter[j] = entering ? t : enter[j];
+      face[j] = entering ? static_cast<unsigned>(i) : face[j];
+      const bool leaving = denom > T(0) && t < exit[j];
+      exit[j] = leaving ? t : exit[j];
+      exit[j] = (denom == T(0) && dist < T(0)) ? -infinity<T>() : exit[j];
+    }
+  }
+  RayInterval<T> in;
+  in.enter = enter[0], in.exit = exit[0];
+  unsigned best = face[0];
+  for (std::size_t j = 1; j < W; ++j) {
+    // Ties go to the lower face index, whatever lane found it: the normal does not depend on the block layout.
+    if (enter[j] > in.enter || (enter[j] == in.enter && face[j] < best)) in.enter = enter[j], best = face[j];
+    if (exit[j] < in.exit) in.exit = exit[j];
+  }
+  if (!in.empty() && in.enter > -infinity<T>()) {
+    in.normal = Vec3<T>(nx[best], ny[best], nz[best]);
+  }
+  return in;
+}
+
+}  // namespace batchcol::kernels::rays
