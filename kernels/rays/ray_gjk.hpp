@@ -1,12 +1,12 @@
 // Ray casting against any convex shape given by its support function: the GJK ray cast of G. van den Bergen,
 // "Ray casting against general convex objects with application to continuous collision detection", JGT 2004
-// (Algorithm 1). Used for the inflated shapes without an exact kernel (box, cylinder, cone, ellipsoid, hull and
-// triangle with inflation > 0): the support of core + ball(r) is support_core(v) + r v / |v|.
+// (Algorithm 1, with the margin handled on the core as in sec. 4 of that paper). Used for the inflated shapes without
+// an exact kernel (box, cylinder, cone, ellipsoid, hull and triangle with inflation > 0).
 //
 // Certificate: lambda only moves to the plane of a support point that separates the current point x from the shape,
 // so x(lambda) never enters the shape and lambda <= the exact hit. The loop stops when the simplex point v, whose norm
-// bounds the distance from x to the shape from above, satisfies |v| <= eps: the reported hit point is outside the
-// shape and within eps of it. A miss is certified by a separating plane the ray moves away from.
+// bounds the distance from x to the core from above, certifies that distance <= radius + eps: the reported hit point
+// is outside the shape and within eps of it. A miss is certified by a separating plane the ray moves away from.
 #pragma once
 
 #include "kernels/rays/ray_interval.hpp"
@@ -100,53 +100,75 @@ struct RayGjkSettings {
   int max_iterations = 64;
 };
 
-/// Ray cast against core(s) + ball(radius). `bound` is a bounding radius of the shape about the local origin.
+/// Ray cast against core(s) + ball(radius), radius > 0. The simplex is kept on the core (van den Bergen's margin
+/// variant: a polytope core converges in finitely many steps, a curved one like GJK's distance): with p = support of
+/// the core along v and w = x - p, the plane <v, y> = <v, p> + radius |v| supports the inflated shape, and x is beyond
+/// it when <v, w> > radius |v|. Stops when the distance from x to the core is certified <= radius + eps: either |v|
+/// (>= that distance, v being a point of x - core) is, or the duality gap |v|^2 - <v, w> <= eps |v| proves |v| <=
+/// radius + eps after a step that did not advance. `bound` is a bounding radius of the shape about its origin.
 template <class T> LocalHit<T> ray_gjk(const ShapeCore<T>& s, T radius, T bound, const Vec3<T>& o, const Vec3<T>& d,
                                        T t_max, const RayGjkSettings& settings) {
   // Coordinates of x - p are as large as |o| + bound near the end: below ~64 ulps of that, |v| is rounding noise.
   const T eps = std::max(T(settings.tolerance), T(64) * machine_epsilon<T>() * (norm3(o) + bound));
+  const T reach = radius + eps;
   SupportHint hint;
-  const auto support_point = [&](const Vec3<T>& v) -> Vec3<T> {
-    const Vec3<T> p = support(s, v, hint);
-    const T nv = norm3(v);
-    return nv > T(0) ? Vec3<T>(p + (radius / nv) * v) : p;
-  };
   LocalHit<T> h;
   T lambda = T(0);
   Vec3<T> x = o, normal = Vec3<T>::Zero();
   Vec3<T> v = x - s.center();
-  std::array<Vec3<T>, 4> P;  // support points of the current simplex
+  std::array<Vec3<T>, 4> P;  // core support points of the current simplex
   int n = 0;
-  int it = 0;
-  for (; it < settings.max_iterations && norm2(v) > eps * eps; ++it) {
-    const Vec3<T> p = support_point(v);
+  bool done = false;
+  int stalls = 0;
+  for (int it = 0; it < settings.max_iterations && !done; ++it) {
+    const T vv = norm2(v);
+    if (vv <= reach * reach) {
+      done = true;
+      break;
+    }
+    const T nv = std::sqrt(vv);
+    const Vec3<T> p = support(s, v, hint);
     const Vec3<T> w = x - p;
     const T vw = dot3(v, w);
-    if (vw > T(0)) {
+    const bool advance = vw > radius * nv;
+    if (advance) {
       const T vr = dot3(v, d);
       if (vr >= T(0)) return h;  // separating plane, and the ray moves away from it
-      lambda -= vw / vr;
+      lambda -= (vw - radius * nv) / vr;
       if (lambda > t_max) return h;
       x = o + lambda * d;
       normal = v;
+    } else if (vv - vw <= eps * nv) {
+      done = true;  // the gap certifies |v| <= radius + eps (see above)
+      break;
     }
-    // Replace a support point equal to p (the simplex would degenerate) instead of adding it twice.
-    bool duplicate = false;
+    bool duplicate = false;  // a repeated support point would make the simplex degenerate
     for (int i = 0; i < n; ++i) duplicate = duplicate || P[i] == p;
     if (!duplicate) P[n++] = p;
     std::array<Vec3<T>, 4> Y;
     for (int i = 0; i < n; ++i) Y[i] = x - P[i];
     const SimplexPoint<T> sp = closest_on_simplex(Y.data(), n);
-    v = sp.v;
     int kept = 0;
     for (int i = 0; i < n; ++i)
       if (sp.w[i] > T(0)) P[kept++] = P[i];
     n = kept;
-    if (n == 4) break;  // origin inside the simplex: x is on the shape (v = 0)
+    if (n == 4) {
+      v = sp.v;
+      done = true;  // x inside the core (only when the origin starts there)
+    } else if (!advance && norm2(sp.v) >= vv * (T(1) - T(64) * machine_epsilon<T>())) {
+      // No progress: on nearly degenerate simplices (a cone's apex and neighbouring rim points) the projection's
+      // rounding can drop the new point forever while the gap stays just above eps |v|. Restart the simplex from the
+      // newest support point (it keeps x's certificates: x and lambda do not change); give up after a few restarts.
+      if (++stalls > 4) break;
+      P[0] = p, n = 1, v = x - p;
+    } else {
+      v = sp.v;
+    }
   }
+  if (!done) done = norm2(v) <= reach * reach;
   h.hit = true;
   h.t = lambda;
-  h.status = norm2(v) <= eps * eps || n == 4 ? LocalStatus::converged : LocalStatus::max_iterations;
+  h.status = done ? LocalStatus::converged : LocalStatus::max_iterations;
   const T nn = norm3(normal);
   h.normal = nn > T(0) ? Vec3<T>(normal / nn) : Vec3<T>(-d / norm3(d));  // never advanced: the origin is inside
   return h;
