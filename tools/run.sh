@@ -22,7 +22,7 @@ shift
 
 required=(cmake g++ libeigen3-dev libtbb-dev libqhull-dev nlohmann-json3-dev libcli11-dev libassimp-dev
           libgtest-dev libbenchmark-dev libgmock-dev)
-cross_check_peers=(libfcl-dev libbullet-dev)  # optional for the library, installed for the test suite
+cross_check_peers=(libfcl-dev libbullet-dev libembree-dev)  # optional for the library, installed for the test suite
 
 case "$command" in
   demo) packages=("${required[@]}") ;;
