@@ -3,6 +3,7 @@
 #pragma once
 
 #include "batchcol/shapes.hpp"
+#include "kernels/rays/ray_convex_planes.hpp"
 #include "kernels/rays/ray_interval.hpp"
 
 #include <cstddef>
@@ -71,39 +72,16 @@ template <class T> HullPlanes<T> make_hull_planes(const ConvexHull& hull) {
 }
 
 /// Cyrus-Beck: enter = max over faces turned against d of dist_i / denom_i, exit = min over the others; a face
-/// parallel to the ray empties the interval when the line is outside it. Each lane j of a block keeps its own running
-/// max / min (branch-free selects), reduced at the end: the loop vectorises across faces.
+/// parallel to the ray empties the interval when the line is outside it (loop in ray_convex_planes.cpp).
 template <class T> RayInterval<T> ray_convex(const Vec3<T>& o, const Vec3<T>& d, const HullPlanes<T>& planes) {
-  constexpr std::size_t W = kHullPlaneBlock;
-  T enter[W], exit[W];
-  unsigned face[W];
-  for (std::size_t j = 0; j < W; ++j) enter[j] = -infinity<T>(), exit[j] = infinity<T>(), face[j] = 0;
-  const T *nx = planes.nx.data(), *ny = planes.ny.data(), *nz = planes.nz.data(), *c = planes.c.data();
-  const std::size_t n = planes.nx.size();
-  for (std::size_t b = 0; b < n; b += W) {
-    for (std::size_t j = 0; j < W; ++j) {
-      const std::size_t i = b + j;
-      const T denom = (nx[i] * d.x() + ny[i] * d.y()) + nz[i] * d.z();
-      const T dist = c[i] - ((nx[i] * o.x() + ny[i] * o.y()) + nz[i] * o.z());
-      const T t = dist / denom;  // +-inf or NaN when denom == 0: filtered by the selects below
-      const bool entering = denom < T(0) && t > enter[j];
-      enter[j] = entering ? t : enter[j];
-      face[j] = entering ? static_cast<unsigned>(i) : face[j];
-      const bool leaving = denom > T(0) && t < exit[j];
-      exit[j] = leaving ? t : exit[j];
-      exit[j] = (denom == T(0) && dist < T(0)) ? -infinity<T>() : exit[j];
-    }
-  }
+  const T oa[3] = {o.x(), o.y(), o.z()}, da[3] = {d.x(), d.y(), d.z()};
+  const PlaneClip<T> clip = clip_planes(planes.nx.data(), planes.ny.data(), planes.nz.data(), planes.c.data(),
+                                        planes.nx.size(), oa, da);
+  if (clip.outside) return RayInterval<T>::nothing();
   RayInterval<T> in;
-  in.enter = enter[0], in.exit = exit[0];
-  unsigned best = face[0];
-  for (std::size_t j = 1; j < W; ++j) {
-    // Ties go to the lower face index, whatever lane found it: the normal does not depend on the block layout.
-    if (enter[j] > in.enter || (enter[j] == in.enter && face[j] < best)) in.enter = enter[j], best = face[j];
-    if (exit[j] < in.exit) in.exit = exit[j];
-  }
+  in.enter = clip.enter, in.exit = clip.exit;
   if (!in.empty() && in.enter > -infinity<T>()) {
-    in.normal = Vec3<T>(nx[best], ny[best], nz[best]);
+    in.normal = Vec3<T>(planes.nx[clip.face], planes.ny[clip.face], planes.nz[clip.face]);
   }
   return in;
 }

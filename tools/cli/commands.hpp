@@ -18,5 +18,6 @@ Command add_query_command(CLI::App& parent);
 Command add_bench_command(CLI::App& parent);
 Command add_stress_command(CLI::App& parent);
 Command add_accuracy_command(CLI::App& parent);
+Command add_rays_command(CLI::App& parent);
 
 }  // namespace batchcol::cli
