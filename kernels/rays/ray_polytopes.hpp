@@ -4,6 +4,7 @@
 
 #include "batchcol/shapes.hpp"
 #include "kernels/rays/ray_convex_planes.hpp"
+#include "kernels/rays/ray_hull_walk.hpp"
 #include "kernels/rays/ray_interval.hpp"
 
 #include <cstddef>
@@ -55,7 +56,11 @@ constexpr std::size_t kHullPlaneBlock = 8;
 template <class T> struct HullPlanes {
   std::vector<T> nx, ny, nz, c;
   std::size_t faces = 0;  // real planes (the rest is padding)
+  HullWalk<T> walk;       // for hulls of kHullWalkMinFaces faces or more (ray_hull_walk.hpp)
 };
+
+/// Below this many faces the clipping loop over all planes is cheaper than the walk's climbs (a few blocks of 8).
+constexpr std::size_t kHullWalkMinFaces = 48;
 
 template <class T> HullPlanes<T> make_hull_planes(const ConvexHull& hull) {
   HullPlanes<T> p;
@@ -68,6 +73,7 @@ template <class T> HullPlanes<T> make_hull_planes(const ConvexHull& hull) {
     p.nx[i] = T(n.x()), p.ny[i] = T(n.y()), p.nz[i] = T(n.z());
     p.c[i] = T(n.dot(v));
   }
+  if (p.faces >= kHullWalkMinFaces) p.walk = make_hull_walk<T>(hull);
   return p;
 }
 

@@ -55,6 +55,11 @@ template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o,
       // them for the cost of one sphere test instead of a pass over every face.
       const RayInterval<T> ball = ray_sphere(o, d, s.bound * (T(1) + T(64) * machine_epsilon<T>()));
       if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return {};
+      if (s.planes->walk.planes() > 0) {
+        bool ok = false;
+        const LocalHit<T> h = ray_hull_walk(s.planes->walk, o, d, t_max, ok);
+        if (ok) return h;
+      }
       return finish(ray_convex(o, d, *s.planes), d, t_max);
     }
     case ShapeType::triangle:

@@ -202,3 +202,48 @@ TEST(RayShapesClosedForm, FloatKernelsAgreeWithDouble) {
 
 }  // namespace
 }  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+// Hulls of kHullWalkMinFaces faces or more go through the polar walk (ray_hull_walk.hpp): it must give the same hit,
+// the same t up to the choice between faces whose t tie in rounding, and agree with sphere tracing. One hull has
+// coplanar triangles (a cube: qhull triangulates its squares), which the walk merges into facets.
+TEST(RayHullWalk, MatchesClippingEveryPlaneAndSphereTracing) {
+  Rng rng(2024);
+  std::vector<Shape> hulls;
+  hulls.push_back(Shape::convex(testing::random_hull_points(rng, 250, 0.4, 1.2)));
+  hulls.push_back(Shape::convex(testing::random_hull_points(rng, 60, 0.5, 0.5)));
+  std::vector<Eigen::Vector3d> cube;
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j)
+      for (int k = 0; k <= 4; ++k)
+        if (i % 4 == 0 || j % 4 == 0 || k % 4 == 0) cube.push_back(Eigen::Vector3d(i, j, k) / 4.0 - Eigen::Vector3d(0.5, 0.5, 0.5));
+  hulls.push_back(Shape::convex(cube));
+  for (const Shape& hull : hulls) {
+    kr::HullPlanes<double> planes = kr::make_hull_planes<double>(*hull.hull);
+    planes.walk = kr::make_hull_walk<double>(*hull.hull);  // also below kHullWalkMinFaces (the cube has 12 faces)
+    int hits = 0;
+    for (const Ray& r : random_rays(rng, 3000, 1.0)) {
+      bool ok = false;
+      const kr::LocalHit<double> walk = kr::ray_hull_walk(planes.walk, r.o, r.d, r.t_max, ok);
+      ASSERT_TRUE(ok);
+      const kr::LocalHit<double> clip = kr::finish(kr::ray_convex(r.o, r.d, planes), r.d, r.t_max);
+      ASSERT_EQ(walk.hit, clip.hit) << r.o.transpose() << " / " << r.d.transpose();
+      if (!walk.hit) continue;
+      ++hits;
+      EXPECT_NEAR(walk.t, clip.t, 1e-12 * (1 + clip.t));
+      if (walk.t > 0) EXPECT_GT(walk.normal.dot(clip.normal), 1 - 1e-9);  // the same facet (or two that tie)
+    }
+    EXPECT_GT(hits, 500);
+    EXPECT_GE(check_shape(hull, 1500, 7).compared, 1450);
+  }
+  // qhull keeps the cube's 8 corners and triangulates each square: 12 triangles, merged into 6 facets. The large hull
+  // takes the walk in ray_local.
+  EXPECT_EQ(hulls[2].hull->faces.size(), 12u);
+  EXPECT_EQ(kr::make_hull_walk<double>(*hulls[2].hull).planes(), 6u);
+  EXPECT_GT(kr::make_hull_planes<double>(*hulls[0].hull).walk.planes(), 0u);
+}
+
+}  // namespace
+}  // namespace batchcol
