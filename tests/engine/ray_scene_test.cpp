@@ -250,3 +250,36 @@ TEST(RayScene, InvalidRaysGetAStatusAndBadCallsThrow) {
 
 }  // namespace
 }  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+TEST(RayScene, EmptySceneAndHalfspacesOnly) {
+  auto table = std::make_shared<ShapeTable>();
+  const std::uint32_t ground = table->add(Shape::halfspace(Eigen::Vector3d::UnitZ(), 0.0));
+  Scene scene(table);
+  RaySceneIndex index;
+  index.update(scene);
+  RayBatch rays;
+  rays.add({0, 0, 5}, {0, 0, -1}, INFINITY);
+  RayResults r;
+  index.cast(rays, {}, r);
+  EXPECT_EQ(r.status[0], RayStatus::ok);
+  EXPECT_EQ(r.hit[0], 0);
+  const ObjectHandle h = scene.add(ground, Pose::from_translation(Eigen::Vector3d(0, 0, 1)));
+  index.update(scene);
+  EXPECT_TRUE(index.last_update_rebuilt());
+  for (RayQuery q : {RayQuery::closest, RayQuery::any, RayQuery::all}) {
+    RayOptions o;
+    o.query = q;
+    index.cast(rays, o, r);
+    ASSERT_EQ(r.hit[0], 1) << to_string(q);
+    EXPECT_EQ(r.t[0], 4.0);
+    EXPECT_EQ(r.object[0], h);
+    EXPECT_EQ(r.normal[0], Eigen::Vector3d(0, 0, 1));
+  }
+  EXPECT_EQ(r.hit_begin, (std::vector<std::uint64_t>{0, 1}));
+}
+
+}  // namespace
+}  // namespace batchcol
