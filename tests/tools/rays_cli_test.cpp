@@ -117,3 +117,49 @@ TEST_F(RaysCli, BadFlagsExitWithCode2AndAClearMessage) {
 
 }  // namespace
 }  // namespace batchcol::testing
+
+namespace batchcol::testing {
+namespace {
+
+// Rays given in a batch file ("rays": shape, pose, origin, direction, t_max) are cast against their posed shapes.
+TEST_F(RaysCli, BatchFileRaysAreCastAndWritten) {
+  const std::string path = file("rays.json", R"({
+    "shapes": [{"type": "sphere", "radius": 1.0}, {"type": "box", "half_extents": [1, 2, 3]}],
+    "rays": [
+      {"shape": 0, "pose": {"translation": [10, 0, 0]}, "origin": [0, 0, 0], "direction": [2, 0, 0]},
+      {"shape": 1, "origin": [0, 0, 10], "direction": [0, 0, -1], "t_max": 5},
+      {"shape": 1, "origin": [0, 0, 10], "direction": [0, 0, -1], "t_max": 8}
+    ]})");
+  const std::string out = (dir_ / "hits.csv").string();
+  const json j = run_json("--batch " + path + " --out '" + out + "'");
+  EXPECT_EQ(j["rays"], 3);
+  EXPECT_EQ(j["hits"], 2);
+  EXPECT_EQ(read_text(out), "ray,status,hit,t,object_slot,object_generation,n_x,n_y,n_z\n"
+                            "0,ok,1,4.5,,,-1,0,0\n"
+                            "1,ok,0,,,,,,\n"  // no hit: the six value columns are empty
+                            "2,ok,1,7,,,0,0,1\n");
+}
+
+TEST_F(RaysCli, BadRaysInABatchFileExitWithCode2NamingTheRay) {
+  const struct {
+    const char* ray;
+    const char* message;
+  } cases[] = {
+      {R"({"shape": 0, "origin": [0, 0, 0], "direction": [0, 0, 0]})", "/rays/0/direction: the direction must not be zero"},
+      {R"({"shape": 0, "origin": [0, 0, 0], "direction": [1, 0, 0], "t_max": -1})", "/rays/0/t_max"},
+      {R"({"shape": 3, "origin": [0, 0, 0], "direction": [1, 0, 0]})", "/rays/0/shape"},
+      {R"({"shape": 0, "origin": [0, 0], "direction": [1, 0, 0]})", "/rays/0/origin"},
+      {R"({"shape": 0, "origin": [0, 0, 0], "direction": [1, 0, 0], "colour": 1})", "unknown key 'colour'"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.ray);
+    const std::string path =
+        file("bad.json", std::string(R"({"shapes": [{"type": "sphere", "radius": 1.0}], "rays": [)") + c.ray + "]}");
+    const RunResult r = run("rays --batch " + path);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace batchcol::testing

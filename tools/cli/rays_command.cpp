@@ -1,7 +1,7 @@
 // `batchcol rays`: times ray queries. Scene mode: builds a scene (hulls or mixed primitives), times the LBVH build,
 // its refit after every object moved, and the rays per second of the query; with --peers, the same scene and rays in
 // Embree 3 (build and rays/s) and the agreement of the closest hits. Shape mode: rays against one posed shape each
-// (sphere, box, hull), double and float. --out writes the hits as CSV.
+// (sphere, box, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
 #include "cli/atomic_output.hpp"
 #include "cli/commands.hpp"
 #include "cli/portable_random.hpp"
@@ -28,7 +28,7 @@ namespace {
 
 struct RaysSettings {
   RaysSceneSpec scene;
-  std::string mode = "scene", query = "closest", out;
+  std::string mode = "scene", query = "closest", out, batch;
   std::int64_t rays = 1000000;
   int threads = 0, runs = 3, frames = 5, segments = 64;
   bool json = false, peers = false;
@@ -50,7 +50,7 @@ void validate(const RaysSettings& s) {
   check(s.runs >= 1, "--runs must be >= 1");
   check(s.frames >= 1, "--frames must be >= 1");
   check(s.segments >= 3, "--segments must be >= 3");
-  check(s.out.empty() || s.mode == "scene", "--out is only available with --mode scene");
+  check(s.out.empty() || s.mode == "scene" || !s.batch.empty(), "--out is only available with --mode scene or --batch");
   check(s.query == "closest" || s.query == "any" || s.query == "all",
         "--query " + s.query + ": unknown (valid: closest, any, all)");
   check(!s.peers || peers::have_embree(), "--peers needs Embree 3 (install libembree-dev and rebuild)");
@@ -218,7 +218,28 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
   return j;
 }
 
+// The rays of a batch file (each against its own posed shape), through cast_rays().
+nlohmann::json run_batch_mode(const RaysSettings& s, RayResults& results) {
+  const BatchFile file = load_batch_file(s.batch);
+  check(file.rays.size() > 0, s.batch + ": the file has no \"rays\"");
+  RayOptions options;
+  options.threads = s.threads;
+  if (file.precision) options.precision = *file.precision;
+  const double ms = time_ms([&] { cast_rays(file.shapes, file.rays, options, results); });
+  std::size_t hits = 0;
+  for (std::uint8_t h : results.hit) hits += h;
+  return {{"mode", "batch"},
+          {"rays", file.rays.size()},
+          {"hits", hits},
+          {"hit_fraction", double(hits) / double(file.rays.size())},
+          {"cast_ms", ms}};
+}
+
 void print_text(const nlohmann::json& j) {
+  if (j["mode"] == "batch") {
+    std::cout << j["rays"] << " rays from the batch file, " << j["hits"] << " hits, " << j["cast_ms"] << " ms\n";
+    return;
+  }
   if (j["mode"] == "shape") {
     for (const char* n : {"sphere", "box", "hull"})
       for (const char* p : {"double", "float"})
@@ -246,9 +267,12 @@ void print_text(const nlohmann::json& j) {
 int run_rays(const RaysSettings& s) {
   validate(s);
   RayResults results;
-  const nlohmann::json j = s.mode == "scene" ? run_scene_mode(s, results) : run_shape_mode(s);
+  const nlohmann::json j = !s.batch.empty() ? run_batch_mode(s, results)
+                           : s.mode == "scene" ? run_scene_mode(s, results)
+                                               : run_shape_mode(s);
   if (!s.out.empty()) {
-    write_file_atomically(s.out, [&](std::ostream& out) { write_hits_csv(results, parse_ray_query(s.query), out); });
+    const RayQuery query = s.batch.empty() ? parse_ray_query(s.query) : RayQuery::closest;
+    write_file_atomically(s.out, [&](std::ostream& out) { write_hits_csv(results, query, out); });
   }
   if (s.json) std::cout << j.dump(2) << '\n';
   else print_text(j);
@@ -273,7 +297,8 @@ Command add_rays_command(CLI::App& parent) {
   app->add_option("--frames", s->frames, "Refit frames (every object moves 1 cm)")->capture_default_str();
   app->add_option("--segments", s->segments, "Embree tessellation of cylinders (segments around)")->capture_default_str();
   app->add_option("--seed", s->scene.seed, "Seed of the scene and rays")->capture_default_str();
-  app->add_option("--out", s->out, "Write the hits as CSV (scene mode)");
+  app->add_option("--out", s->out, "Write the hits as CSV (scene mode or --batch)");
+  app->add_option("--batch", s->batch, "Cast the \"rays\" of a batch file (each against its posed shape) instead");
   app->add_flag("--json", s->json, "Print one JSON object");
   app->add_flag("--peers", s->peers, "Also build and cast with Embree 3 and compare the hits");
   return {app, [s] { return run_rays(*s); }};
