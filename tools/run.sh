@@ -22,7 +22,7 @@ shift
 
 required=(cmake g++ libeigen3-dev libtbb-dev libqhull-dev nlohmann-json3-dev libcli11-dev libassimp-dev
           libgtest-dev libbenchmark-dev libgmock-dev)
-cross_check_peers=(libfcl-dev libbullet-dev)  # optional for the library, installed for the test suite
+cross_check_peers=(libfcl-dev libbullet-dev libembree-dev)  # optional for the library, installed for the test suite
 # The Python package and its pytest suite (Debian's /usr/bin/python3); optional for the library and the demo.
 python_packages=(python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed)
 

@@ -158,13 +158,19 @@ class BatchReader {
 
   BatchFile read(const json& root) const {
     if (!root.is_object()) fail("", "the top level must be an object, got " + describe(root));
-    check_keys(root, "", {"shapes", "pairs", "query", "solver", "tolerance", "precision", "margin"});
+    check_keys(root, "", {"shapes", "pairs", "rays", "query", "solver", "tolerance", "precision", "margin"});
     BatchFile file;
     const json& shapes = array_field(root, "", "shapes");
     for (std::size_t i = 0; i < shapes.size(); ++i) file.shapes.add(read_shape(shapes[i], "/shapes/" + std::to_string(i)));
-    const json& pairs = array_field(root, "", "pairs");
-    file.pairs.reserve(pairs.size());
-    for (std::size_t i = 0; i < pairs.size(); ++i) read_pair(pairs[i], "/pairs/" + std::to_string(i), file);
+    if (root.contains("pairs") || !root.contains("rays")) {  // a file of rays needs no pairs
+      const json& pairs = array_field(root, "", "pairs");
+      file.pairs.reserve(pairs.size());
+      for (std::size_t i = 0; i < pairs.size(); ++i) read_pair(pairs[i], "/pairs/" + std::to_string(i), file);
+    }
+    if (root.contains("rays")) {
+      const json& rays = array_field(root, "", "rays");
+      for (std::size_t i = 0; i < rays.size(); ++i) read_ray(rays[i], "/rays/" + std::to_string(i), file);
+    }
     if (root.contains("query")) file.query = parse_named(root["query"], "/query", parse_query_level);
     if (root.contains("solver")) file.solver = parse_named(root["solver"], "/solver", parse_solver);
     if (root.contains("precision")) file.precision = parse_named(root["precision"], "/precision", parse_precision);
@@ -410,6 +416,21 @@ class BatchReader {
     const Pose pose_a = v.contains("pose_a") ? read_pose(v["pose_a"], p + "/pose_a") : Pose::identity();
     const Pose pose_b = v.contains("pose_b") ? read_pose(v["pose_b"], p + "/pose_b") : Pose::identity();
     file.pairs.add(a, pose_a, b, pose_b);
+  }
+
+  // A ray against one posed shape (the shape form of batchcol/rays.hpp). A file states its rays, so a bad one is an
+  // error naming it rather than the per-ray invalid status of the API: a zero direction, a negative t_max.
+  void read_ray(const json& v, const std::string& p, BatchFile& file) const {
+    object_value(v, p);
+    check_keys(v, p, {"shape", "pose", "origin", "direction", "t_max"});
+    const std::uint32_t shape = shape_index(field(v, p, "shape"), p + "/shape", file.shapes.size());
+    const Pose pose = v.contains("pose") ? read_pose(v["pose"], p + "/pose") : Pose::identity();
+    const Eigen::Vector3d origin = vec3(field(v, p, "origin"), p + "/origin");
+    const Eigen::Vector3d direction = vec3(field(v, p, "direction"), p + "/direction");
+    if (!(direction.squaredNorm() > 0.0)) fail(p + "/direction", "the direction must not be zero");
+    // JSON has no infinity: an absent t_max is +inf.
+    const double t_max = v.contains("t_max") ? non_negative(v["t_max"], p + "/t_max") : INFINITY;
+    file.rays.add(shape, pose, origin, direction, t_max);
   }
 
   const std::string& source_;

@@ -24,4 +24,6 @@ Command add_descent_command(CLI::App& parent);
 /// The derivative method named `name` (query and bench --derivatives); InputError naming --derivatives otherwise.
 DerivativeMethod parse_derivative_method(const std::string& name);
 
+Command add_rays_command(CLI::App& parent);
+
 }  // namespace batchcol::cli

@@ -27,11 +27,12 @@ int main(int argc, char** argv) {
                                                           batchcol::cli::add_bench_command(app),
                                                           batchcol::cli::add_accuracy_command(app),
                                                           batchcol::cli::add_stress_command(app),
-                                                          batchcol::cli::add_descent_command(app)};
+                                                          batchcol::cli::add_descent_command(app),
+                                                          batchcol::cli::add_rays_command(app)};
     // CLI11 would only say "A subcommand is required" for a misspelt one.
     const auto named = [&](const batchcol::cli::Command& c) { return c.app->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && std::none_of(commands.begin(), commands.end(), named)) {
-      return fail((std::string("unknown subcommand '") + argv[1] + "' (valid: demo, query, bench, accuracy, stress)").c_str());
+      return fail((std::string("unknown subcommand '") + argv[1] + "' (valid: demo, query, bench, accuracy, stress, rays)").c_str());
     }
     try {
       app.parse(argc, argv);

@@ -21,3 +21,10 @@ bool have_coal() { return false; }
 #endif
 
 }  // namespace batchcol::peers
+
+#ifndef BATCHCOL_HAVE_EMBREE
+#include "peers/embree_rays.hpp"
+namespace batchcol::peers {
+bool have_embree() { return false; }  // the EmbreeRayScene class is only compiled with Embree
+}  // namespace batchcol::peers
+#endif

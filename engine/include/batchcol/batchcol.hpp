@@ -6,5 +6,6 @@
 #include "batchcol/errors.hpp"
 #include "batchcol/io.hpp"
 #include "batchcol/pose.hpp"
+#include "batchcol/rays.hpp"
 #include "batchcol/scene.hpp"
 #include "batchcol/shapes.hpp"

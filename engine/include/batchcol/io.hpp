@@ -4,6 +4,7 @@
 #pragma once
 
 #include "batchcol/batch.hpp"
+#include "batchcol/rays.hpp"
 #include "batchcol/shapes.hpp"
 
 #include <iosfwd>
@@ -17,6 +18,10 @@ namespace batchcol {
 struct BatchFile {
   ShapeTable shapes;
   PairBatch pairs;
+  /// "rays": [{"shape": i, "pose": {...}, "origin": [x, y, z], "direction": [x, y, z], "t_max": t}] (pose optional:
+  /// identity; t_max optional: +inf; a zero direction or negative t_max is an InputError naming the ray). With
+  /// "rays", "pairs" may be left out. `batchcol rays --batch FILE` casts them (cast_rays()).
+  ShapeRayBatch rays;
   std::optional<QueryLevel> query;
   std::optional<Solver> solver;
   std::optional<double> tolerance;

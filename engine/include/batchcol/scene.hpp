@@ -127,6 +127,7 @@ class Scene {
   struct State;  // private implementation (engine/src/scene_state.hpp)
 
  private:
+  friend class RaySceneIndex;  // reads the objects and poses to build its ray acceleration (batchcol/rays.hpp)
   std::unique_ptr<State> state_;
 };
 

@@ -1,0 +1,100 @@
+// RaySceneIndex::update(): snapshot of the scene's objects, world boxes (the scene's own vectorised AABB pass) and
+// the LBVH, rebuilt when the set of objects changed and refitted otherwise.
+#include "ray_scene_state.hpp"
+#include "rays_common.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+namespace batchcol {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+RayObject make_object(const PoseRecord& p, std::uint32_t shape, ObjectHandle handle) {
+  RayObject o;
+  o.R = kernels::rotation_matrix<double>(p.qw, p.qx, p.qy, p.qz);
+  o.t = kernels::Vec3<double>(p.tx, p.ty, p.tz);
+  o.shape = shape;
+  o.handle = handle;
+  return o;
+}
+
+}  // namespace
+
+RaySceneIndex::RaySceneIndex() : state_(std::make_unique<State>()) {}
+RaySceneIndex::~RaySceneIndex() = default;
+RaySceneIndex::RaySceneIndex(RaySceneIndex&&) noexcept = default;
+RaySceneIndex& RaySceneIndex::operator=(RaySceneIndex&&) noexcept = default;
+
+const RaySceneTimings& RaySceneIndex::timings() const { return state_->timings; }
+bool RaySceneIndex::last_update_rebuilt() const { return state_->rebuilt; }
+std::size_t RaySceneIndex::object_count() const { return state_->leaves.size() + state_->halfspaces.size(); }
+
+void RaySceneIndex::update(const Scene& scene, int threads, bool force_rebuild) {
+  if (threads < 0) throw InputError("RaySceneIndex::update: threads must be >= 0 (got " + std::to_string(threads) + ")");
+  const Scene::State& sc = *scene.state_;
+  State& s = *state_;
+  const auto start = std::chrono::steady_clock::now();
+  if (s.shapes != sc.shapes || s.prepared_shape_count != sc.shapes->size()) {
+    s.shapes = sc.shapes;
+    s.prepared.prepare(*s.shapes);
+    s.prepared_shape_count = s.shapes->size();
+    force_rebuild = true;
+  }
+  const FiniteObjects& f = sc.finite;
+  std::vector<ObjectHandle> halfspace_handles;
+  halfspace_handles.reserve(sc.halfspaces.size());
+  for (const HalfspaceObject& h : sc.halfspaces) halfspace_handles.push_back(sc.handle_of(h.slot));
+  const bool rebuild = force_rebuild || !s.ready || s.finite_slots != f.slot || s.finite_shapes != f.shape ||
+                       s.halfspace_handles != halfspace_handles;
+  // Slots are compared, not handles: a slot of a removed object is reused with a new generation, so the handles of
+  // the leaves are refreshed on every update below anyway.
+  detail::run_with_threads(threads, [&] {
+    compute_world_boxes(*s.shapes, f, 0.0, s.boxes, s.poses);
+    s.timings.boxes_ms = ms_since(start);
+    const auto build_start = std::chrono::steady_clock::now();
+    if (rebuild) {
+      s.bvh.build(s.boxes);
+      s.timings.build_ms = ms_since(build_start);
+      s.timings.refit_ms = 0.0;  // build() includes its refit
+    } else {
+      s.bvh.refit(s.boxes);
+      s.timings.build_ms = 0.0;
+      s.timings.refit_ms = ms_since(build_start);
+    }
+    const auto leaf_start = std::chrono::steady_clock::now();
+    const std::vector<std::uint32_t>& order = s.bvh.leaf_object();
+    s.leaves.resize(order.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t k = r.begin(); k < r.end(); ++k) {
+                          const std::uint32_t i = order[k];
+                          s.leaves[k] = make_object(s.poses[i], f.shape[i], sc.handle_of(f.slot[i]));
+                        }
+                      });
+    s.timings.boxes_ms += ms_since(leaf_start);
+  });
+  s.halfspaces.clear();
+  for (std::size_t h = 0; h < sc.halfspaces.size(); ++h) {
+    const HalfspaceObject& o = sc.halfspaces[h];
+    const Pose& p = o.pose;
+    const PoseRecord rec{p.translation.x(), p.translation.y(), p.translation.z(), p.rotation.w(),
+                         p.rotation.x(),    p.rotation.y(),    p.rotation.z()};
+    s.halfspaces.push_back(make_object(rec, o.shape, halfspace_handles[h]));
+  }
+  if (rebuild) {
+    s.finite_slots = f.slot;
+    s.finite_shapes = f.shape;
+    s.halfspace_handles = std::move(halfspace_handles);
+  }
+  s.rebuilt = rebuild;
+  s.ready = true;
+  s.timings.total_ms = ms_since(start);
+}
+
+}  // namespace batchcol

@@ -1,0 +1,232 @@
+// RaySceneIndex::cast(): each ray walks the LBVH depth first, nearer child first, and intersects the objects of the
+// leaves it reaches with the exact kernels (kernels/rays/); halfspaces (unbounded) are tested first for every ray.
+// Closest-hit pruning: a subtree is skipped when its box starts beyond the best hit so far. Ties in t go to the lower
+// object slot, so the answer does not depend on the traversal order. Rays are split into fixed chunks; all-hit rows
+// are collected per chunk and concatenated in ray order: bitwise the same for any thread count.
+#include "ray_scene_state.hpp"
+#include "rays_common.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace batchcol {
+namespace {
+
+using kernels::Vec3;
+namespace kr = kernels::rays;
+
+struct Hit {
+  double t;
+  Vec3<double> normal;
+  ObjectHandle object;
+};
+
+bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
+
+struct RayContext {
+  Vec3<double> o, d, inv;
+  double t_max;
+};
+
+// Slab test of a float box (outward-rounded, so it contains the object with room to spare for this double
+// arithmetic): the entry parameter, or +inf when the ray segment [0, t_far] misses the box. A zero direction
+// component gives inv = +-inf and (lo - o) * inv = NaN only when o lies on the slab plane; NaN loses every
+// comparison below, which keeps the box (conservative).
+double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
+  double t0 = 0.0, t1 = t_far;
+  for (int k = 0; k < 3; ++k) {
+    const double a = (double(b.lo[k]) - r.o[k]) * r.inv[k], c = (double(b.hi[k]) - r.o[k]) * r.inv[k];
+    const double near = a < c ? a : c, far = a < c ? c : a;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+  }
+  return t0 <= t1 ? t0 : kr::infinity<double>();
+}
+
+class Caster {
+ public:
+  Caster(const RaySceneIndex::State& s, const RayOptions& o) : s_(s), gjk_{o.tolerance, o.max_iterations} {}
+
+  // Intersects one object; true on a hit with t <= t_max.
+  bool test(const RayObject& obj, const RayContext& r, double t_max, Hit& hit, bool& capped) const {
+    const Vec3<double> o = kernels::mul_transposed(obj.R, Vec3<double>(r.o - obj.t));
+    const Vec3<double> d = kernels::mul_transposed(obj.R, r.d);
+    const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_);
+    capped = capped || h.status != kr::LocalStatus::converged;
+    if (!h.hit) return false;
+    hit = {h.t, kernels::mul(obj.R, h.normal), obj.handle};
+    return true;
+  }
+
+  // Visits the leaves whose boxes the ray segment [0, limit()] reaches; visit(leaf) returns false to stop.
+  template <class Visit, class Limit> void traverse(const RayContext& r, const Limit& limit, const Visit& visit) const {
+    const RayBvh& bvh = s_.bvh;
+    if (bvh.leaf_count() == 0) return;
+    if (bvh.leaf_count() == 1) {
+      if (box_entry(bvh.single_box(), r, limit()) < kr::infinity<double>()) visit(0u);
+      return;
+    }
+    // Depth <= 64: every level of a Karras tree splits on a distinct bit of the 64-bit keys.
+    struct Entry {
+      std::uint32_t node;
+      double t;
+    };
+    Entry stack[80];
+    int top = 0;
+    std::uint32_t node = 0;
+    const std::vector<BvhNode>& nodes = bvh.nodes();
+    for (;;) {
+      const BvhNode& n = nodes[node];
+      const double lim = limit();
+      const double t0 = box_entry(n.box[0], r, lim), t1 = box_entry(n.box[1], r, lim);
+      const bool h0 = t0 < kr::infinity<double>(), h1 = t1 < kr::infinity<double>();
+      std::uint32_t next[2];
+      double tn[2];
+      int count = 0;
+      if (h0 && h1) {
+        const int first = t1 < t0 ? 1 : 0;
+        next[0] = n.child[first], tn[0] = first ? t1 : t0;
+        next[1] = n.child[1 - first], tn[1] = first ? t0 : t1;
+        count = 2;
+      } else if (h0 || h1) {
+        next[0] = n.child[h0 ? 0 : 1], tn[0] = h0 ? t0 : t1;
+        count = 1;
+      }
+      // Leaves are visited at once (nearer first); the nearer internal child is descended, the other one stacked.
+      std::uint32_t descend = kLeafBit;
+      for (int c = 0; c < count; ++c) {
+        if (next[c] & kLeafBit) {
+          if (!visit(next[c] & ~kLeafBit)) return;
+        } else if (descend == kLeafBit) {
+          descend = next[c];
+        } else {
+          stack[top++] = {next[c], tn[c]};
+        }
+      }
+      if (descend != kLeafBit) {
+        node = descend;
+        continue;
+      }
+      // Pop the next subtree still within reach (the limit shrinks as closer hits are found).
+      for (;;) {
+        if (top == 0) return;
+        const Entry e = stack[--top];
+        if (e.t <= limit()) {
+          node = e.node;
+          break;
+        }
+      }
+    }
+  }
+
+  void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found, bool& capped) const {
+    double limit = r.t_max;
+    Hit h;
+    for (const RayObject& obj : s_.halfspaces) {
+      if (test(obj, r, limit, h, capped) && (!found || before(h, best))) best = h, found = true, limit = best.t;
+      if (found && any) return;
+    }
+    traverse(r, [&] { return limit; }, [&](std::uint32_t leaf) {
+      if (test(s_.leaves[leaf], r, limit, h, capped) && (!found || before(h, best))) {
+        best = h, found = true, limit = best.t;
+        if (any) return false;
+      }
+      return true;
+    });
+  }
+
+  void all(const RayContext& r, std::vector<Hit>& hits, bool& capped) const {
+    Hit h;
+    for (const RayObject& obj : s_.halfspaces)
+      if (test(obj, r, r.t_max, h, capped)) hits.push_back(h);
+    traverse(r, [&] { return r.t_max; }, [&](std::uint32_t leaf) {
+      if (test(s_.leaves[leaf], r, r.t_max, h, capped)) hits.push_back(h);
+      return true;
+    });
+  }
+
+ private:
+  const RaySceneIndex::State& s_;
+  kr::RayGjkSettings gjk_;
+};
+
+RayContext context(const RayBatch& rays, std::size_t i) {
+  RayContext r;
+  r.o = Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]);
+  r.d = Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]);
+  r.inv = Vec3<double>(1.0 / r.d.x(), 1.0 / r.d.y(), 1.0 / r.d.z());
+  r.t_max = rays.t_max[i];
+  return r;
+}
+
+void store(RayResults& out, std::size_t i, const Hit& h) {
+  out.hit[i] = 1;
+  out.t[i] = h.t;
+  out.normal.set(i, h.normal);
+  out.object[i] = h.object;
+}
+
+}  // namespace
+
+void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayResults& out) const {
+  validate(options);
+  detail::check_ray_batch(rays);
+  if (!state_->ready) throw InputError("RaySceneIndex::cast: call update(scene) first");
+  const std::size_t n = rays.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
+  detail::size_ray_results(out, n, true);
+  const Caster caster(*state_, options);
+  const bool all = options.query == RayQuery::all;
+  std::vector<std::vector<Hit>> chunk_hits(all ? chunks : 0);
+  std::vector<std::vector<std::uint32_t>> chunk_counts(all ? chunks : 0);
+  detail::run_with_threads(options.threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+        const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
+        for (std::size_t i = begin; i < end; ++i) {
+          if (all) chunk_counts[c].push_back(0);
+          if (!detail::ray_is_valid(rays, i)) continue;
+          const RayContext r = context(rays, i);
+          bool capped = false;
+          if (all) {
+            std::vector<Hit>& hits = chunk_hits[c];
+            const std::size_t first = hits.size();
+            caster.all(r, hits, capped);
+            std::sort(hits.begin() + static_cast<std::ptrdiff_t>(first), hits.end(), before);
+            chunk_counts[c].back() = static_cast<std::uint32_t>(hits.size() - first);
+            if (hits.size() > first) store(out, i, hits[first]);
+          } else {
+            Hit best{};
+            bool found = false;
+            caster.closest_or_any(r, options.query == RayQuery::any, best, found, capped);
+            if (found) store(out, i, best);
+          }
+          out.status[i] = capped ? RayStatus::max_iterations : RayStatus::ok;
+        }
+      }
+    });
+  });
+  if (!all) return;
+  out.hit_begin.assign(n + 1, 0);
+  std::size_t total = 0, i = 0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    for (const std::uint32_t k : chunk_counts[c]) out.hit_begin[i++] = total, total += k;
+  }
+  out.hit_begin[n] = total;
+  out.all_t.resize(total);
+  out.all_normal.resize(total);
+  out.all_object.resize(total);
+  std::size_t row = 0;
+  for (const std::vector<Hit>& hits : chunk_hits) {
+    for (const Hit& h : hits) {
+      out.all_t[row] = h.t;
+      out.all_normal.set(row, h.normal);
+      out.all_object[row] = h.object;
+      ++row;
+    }
+  }
+}
+
+}  // namespace batchcol

@@ -1,0 +1,43 @@
+// Private state of batchcol::RaySceneIndex: a snapshot of the scene's objects in BVH leaf order and the LBVH.
+#pragma once
+
+#include "batchcol/rays.hpp"
+#include "broadphase/aabb_soa.hpp"
+#include "kernels/math.hpp"
+#include "ray_bvh.hpp"
+#include "ray_prepared.hpp"
+#include "scene_state.hpp"
+
+#include <memory>
+#include <vector>
+
+namespace batchcol {
+
+/// One object as the ray traversal reads it: x_world = R x_local + t.
+struct RayObject {
+  kernels::Mat3<double> R;
+  kernels::Vec3<double> t;
+  std::uint32_t shape = 0;
+  ObjectHandle handle;
+};
+
+struct RaySceneIndex::State {
+  std::shared_ptr<const ShapeTable> shapes;
+  std::size_t prepared_shape_count = 0;
+  detail::PreparedRayShapes<double> prepared;
+
+  // What the last update saw, to tell a refit (same objects, new poses) from a rebuild.
+  std::vector<std::uint32_t> finite_slots, finite_shapes;
+  std::vector<ObjectHandle> halfspace_handles;
+
+  broadphase::AabbSoa boxes;  // by scene object index
+  std::vector<PoseRecord> poses;
+  RayBvh bvh;
+  std::vector<RayObject> leaves;      // leaf k = object bvh.leaf_object()[k]
+  std::vector<RayObject> halfspaces;  // tested against every ray
+  RaySceneTimings timings;
+  bool rebuilt = false;
+  bool ready = false;
+};
+
+}  // namespace batchcol

@@ -1,0 +1,79 @@
+// cast_rays(): rays against one posed shape each. Each ray is moved into its shape's local frame (x_local =
+// R^T (x - t)), intersected by the kernel of kernels/rays/ray_shape.hpp, and its normal rotated back.
+#include "rays_common.hpp"
+
+#include "ray_prepared.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace batchcol {
+namespace {
+
+using kernels::Mat3;
+using kernels::Vec3;
+
+template <class T> using PreparedShapes = detail::PreparedRayShapes<T>;
+
+template <class T>
+void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const kernels::rays::RayGjkSettings& gjk,
+                std::size_t begin, std::size_t end, RayResults& r) {
+  const RayBatch& rays = b.rays;
+  for (std::size_t i = begin; i < end; ++i) {
+    if (!detail::ray_is_valid(rays, i) || b.shape[i] >= prepared.shapes.size()) continue;
+    const Eigen::Quaterniond q(b.rotation.w[i], b.rotation.x[i], b.rotation.y[i], b.rotation.z[i]);
+    const Eigen::Vector3d p(b.translation.x[i], b.translation.y[i], b.translation.z[i]);
+    if (!is_unit_quaternion(q) || !p.allFinite()) continue;
+    const double qn = q.norm();
+    const Mat3<T> R = kernels::rotation_matrix<T>(T(q.w() / qn), T(q.x() / qn), T(q.y() / qn), T(q.z() / qn));
+    const Vec3<T> o(T(rays.origin.x[i] - p.x()), T(rays.origin.y[i] - p.y()), T(rays.origin.z[i] - p.z()));
+    const Vec3<T> d(T(rays.direction.x[i]), T(rays.direction.y[i]), T(rays.direction.z[i]));
+    const Vec3<T> ol = kernels::mul_transposed(R, o), dl = kernels::mul_transposed(R, d);
+    // t_max rounded up to T, so that no hit inside the requested range is lost.
+    T t_max = T(rays.t_max[i]);
+    if (double(t_max) < rays.t_max[i]) t_max = std::nextafter(t_max, kernels::rays::infinity<T>());
+    const kernels::rays::LocalHit<T> h = kernels::rays::ray_local(prepared.shapes[b.shape[i]], ol, dl, t_max, gjk);
+    r.status[i] = h.status == kernels::rays::LocalStatus::converged ? RayStatus::ok : RayStatus::max_iterations;
+    if (!h.hit) continue;
+    r.hit[i] = 1;
+    r.t[i] = double(h.t);
+    r.normal.set(i, kernels::mul(R, h.normal).template cast<double>());
+  }
+}
+
+template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& b, const RayOptions& o, RayResults& r) {
+  const PreparedShapes<T> prepared(shapes);
+  const kernels::rays::RayGjkSettings gjk{o.tolerance, o.max_iterations};
+  const std::size_t n = b.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
+  detail::run_with_threads(o.threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+        const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
+        cast_range(prepared, b, gjk, begin, end, r);
+      }
+    });
+  });
+}
+
+}  // namespace
+
+void cast_rays(const ShapeTable& shapes, const ShapeRayBatch& b, const RayOptions& options, RayResults& results) {
+  validate(options);
+  detail::check_ray_batch(b.rays);
+  const std::size_t n = b.size();
+  if (b.shape.size() != n || b.translation.size() != n || b.translation.y.size() != n ||
+      b.translation.z.size() != n || b.rotation.size() != n || b.rotation.x.size() != n ||
+      b.rotation.y.size() != n || b.rotation.z.size() != n) {
+    throw InputError("ShapeRayBatch: shape, translation and rotation must have one entry per ray (" +
+                     std::to_string(n) + " rays)");
+  }
+  detail::size_ray_results(results, n, false);
+  if (options.precision == Precision::float32) cast_all<float>(shapes, b, options, results);
+  else cast_all<double>(shapes, b, options, results);
+}
+
+}  // namespace batchcol

@@ -1,0 +1,25 @@
+// The clipping loop of a ray against a hull's face planes (Cyrus-Beck), compiled for AVX-512, AVX2 and the baseline
+// with GCC function multi-versioning (target_clones; the loader picks the version once per process). Every version
+// keeps the same 8 independent lanes (face i goes to lane i mod 8) and does the same operations per lane in the same
+// order under -ffp-contract=off, so the result is bitwise the same on every instruction set.
+#pragma once
+
+#include <cstddef>
+
+namespace batchcol::kernels::rays {
+
+/// Result of the clipping: the latest entry (t = enter) through face `face`, the earliest exit, and whether a plane
+/// parallel to the ray has the line outside it.
+template <class T> struct PlaneClip {
+  T enter, exit;
+  unsigned face;  // meaningful when enter > -inf
+  bool outside;
+};
+
+/// n is a multiple of 8; planes <(nx, ny, nz)_i, x> <= c_i; o, d the ray in the hull's frame.
+PlaneClip<double> clip_planes(const double* nx, const double* ny, const double* nz, const double* c, std::size_t n,
+                              const double* o, const double* d);
+PlaneClip<float> clip_planes(const float* nx, const float* ny, const float* nz, const float* c, std::size_t n,
+                             const float* o, const float* d);
+
+}  // namespace batchcol::kernels::rays

@@ -1,0 +1,164 @@
+// Ray entry into a convex hull without visiting every face: Newton's method on the hull's gauge function, with the
+// active face found by hill climbing on the polar (dual) polytope.
+//
+// With an interior point p and the facet planes <n_i, x> <= c_i (h_i = c_i - <n_i, p> > 0), x is in the hull iff
+// g(x) = max_i <u_i, x - p> <= 1, u_i = n_i / h_i: g is the support function of the polar polytope conv{u_i}, so the
+// face active at x (the argmax) is found by hill climbing over the polar's vertices, i.e. over facets that share an
+// edge: on a convex polytope a vertex that no neighbour improves on maximises a linear function. Along the ray,
+// g(o + t d) is convex and piecewise linear; from t = 0 (outside), Newton's step moves t to where the active face's
+// plane is crossed, which never passes the entry (the plane lies below g) and reaches it after finitely many steps.
+// The step is t = (c_f - <n_f, o>) / <n_f, d>, computed exactly as in the Cyrus-Beck kernel, so both give the same t
+// for the same face. A miss: the active face does not face the ray (g no longer decreases) or t passes t_max.
+// Coplanar triangles of one facet (qhull triangulates facets) are merged into one plane so the polar has no repeated
+// vertices, on which hill climbing could stop early.
+#pragma once
+
+#include "batchcol/shapes.hpp"
+#include "kernels/rays/ray_interval.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+namespace batchcol::kernels::rays {
+
+template <class T> struct HullWalk {
+  std::vector<T> nx, ny, nz, c;  // one plane per facet
+  std::vector<T> ux, uy, uz;     // polar vertices n / h
+  std::vector<std::uint32_t> adjacency_begin, adjacency;  // facets sharing an edge (compressed rows)
+  std::vector<std::uint32_t> seeds;  // facets maximising 14 fixed directions on the polar: where climbs start
+  Vec3<T> p = Vec3<T>::Zero();       // interior point (the vertex mean)
+  std::size_t planes() const { return nx.size(); }
+};
+
+inline std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
+  const std::size_t F = hull.faces.size();
+  const auto offset = [&](std::size_t f) { return hull.face_normals[f].dot(hull.vertices[hull.faces[f][0]]); };
+  // Triangles that share an edge and a plane (within 1e-12 of the hull's size) belong to one facet.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> edges;
+  for (std::uint32_t f = 0; f < F; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = hull.faces[f][k], b = hull.faces[f][(k + 1) % 3];
+      edges[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  std::vector<std::uint32_t> parent(F);
+  std::iota(parent.begin(), parent.end(), 0u);
+  const double tol = 1e-12 * (1.0 + hull.radius);
+  for (const auto& [edge, faces] : edges) {
+    if (faces.size() != 2) continue;
+    const std::uint32_t f = faces[0], g = faces[1];
+    if ((hull.face_normals[f] - hull.face_normals[g]).norm() <= 1e-12 && std::abs(offset(f) - offset(g)) <= tol)
+      parent[find_root(parent, f)] = find_root(parent, g);
+  }
+  std::vector<std::uint32_t> facet(F, UINT32_MAX);
+  HullWalk<T> w;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : hull.vertices) p += v;
+  p /= double(hull.vertices.size());
+  w.p = p.cast<T>();
+  std::vector<std::uint32_t> representative;
+  for (std::uint32_t f = 0; f < F; ++f) {
+    const std::uint32_t r = find_root(parent, f);
+    if (facet[r] == UINT32_MAX) facet[r] = static_cast<std::uint32_t>(representative.size()), representative.push_back(r);
+    facet[f] = facet[r];
+  }
+  for (std::uint32_t r : representative) {
+    const Eigen::Vector3d& n = hull.face_normals[r];
+    const double c = offset(r), h = c - n.dot(p);
+    w.nx.push_back(T(n.x())), w.ny.push_back(T(n.y())), w.nz.push_back(T(n.z())), w.c.push_back(T(c));
+    w.ux.push_back(T(n.x() / h)), w.uy.push_back(T(n.y() / h)), w.uz.push_back(T(n.z() / h));
+  }
+  std::vector<std::vector<std::uint32_t>> neighbours(representative.size());
+  for (const auto& [edge, faces] : edges)
+    for (std::uint32_t a : faces)
+      for (std::uint32_t b : faces)
+        if (facet[a] != facet[b]) neighbours[facet[a]].push_back(facet[b]);
+  w.adjacency_begin.push_back(0);
+  for (auto& n : neighbours) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+    w.adjacency.insert(w.adjacency.end(), n.begin(), n.end());
+    w.adjacency_begin.push_back(static_cast<std::uint32_t>(w.adjacency.size()));
+  }
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (std::abs(dx) + std::abs(dy) + std::abs(dz) != 1 && std::abs(dx) + std::abs(dy) + std::abs(dz) != 3) continue;
+        std::uint32_t best = 0;
+        double best_value = -1e300;
+        for (std::uint32_t i = 0; i < w.planes(); ++i) {
+          const double v = double(w.ux[i]) * dx + double(w.uy[i]) * dy + double(w.uz[i]) * dz;
+          if (v > best_value) best_value = v, best = i;
+        }
+        w.seeds.push_back(best);
+      }
+  return w;
+}
+
+/// The entry of the ray o + t d, t in [0, t_max], into the hull; `ok` false when the step budget ran out (the caller
+/// then clips against every plane).
+template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>& o, const Vec3<T>& d, T t_max,
+                                             bool& ok) {
+  ok = true;
+  LocalHit<T> h;
+  const auto value = [&](std::uint32_t i, const Vec3<T>& q) { return (w.ux[i] * q.x() + w.uy[i] * q.y()) + w.uz[i] * q.z(); };
+  Vec3<T> q = o - w.p;  // x - p
+  std::uint32_t f = w.seeds[0];
+  T best = value(f, q);
+  for (std::size_t s = 1; s < w.seeds.size(); ++s) {
+    const T v = value(w.seeds[s], q);
+    if (v > best) best = v, f = w.seeds[s];
+  }
+  // Rounding of g near 1: a point within a few ulps of the active plane counts as on it.
+  const T one = T(1) + T(16) * machine_epsilon<T>();
+  const std::size_t budget = 4 * w.planes() + 64;
+  std::size_t moves = 0;
+  T t = T(0);
+  for (int step = 0; step < 64; ++step) {
+    for (bool moved = true; moved;) {  // hill climbing to the active facet at q
+      moved = false;
+      const std::uint32_t from = f;
+      for (std::uint32_t k = w.adjacency_begin[from]; k < w.adjacency_begin[from + 1]; ++k) {
+        const std::uint32_t j = w.adjacency[k];
+        const T v = value(j, q);
+        if (v > best) best = v, f = j, moved = true;
+      }
+      if (++moves > budget) {
+        ok = false;
+        return h;
+      }
+    }
+    if (best <= one) {  // on or inside the hull
+      h.hit = true;
+      h.t = t;
+      h.normal = t > T(0) ? Vec3<T>(w.nx[f], w.ny[f], w.nz[f]) : Vec3<T>(-d / norm3(d));
+      return h;
+    }
+    const T denom = (w.nx[f] * d.x() + w.ny[f] * d.y()) + w.nz[f] * d.z();
+    if (!(denom < T(0))) return h;  // g does not decrease any more: the ray misses
+    const T next = (w.c[f] - ((w.nx[f] * o.x() + w.ny[f] * o.y()) + w.nz[f] * o.z())) / denom;
+    if (next > t_max) return h;
+    if (!(next > t)) {  // no progress: q is on the active plane up to rounding
+      h.hit = true;
+      h.t = t;
+      h.normal = t > T(0) ? Vec3<T>(w.nx[f], w.ny[f], w.nz[f]) : Vec3<T>(-d / norm3(d));
+      return h;
+    }
+    t = next;
+    q = (o + t * d) - w.p;
+    best = value(f, q);
+  }
+  ok = false;
+  return h;
+}
+
+}  // namespace batchcol::kernels::rays

@@ -1,0 +1,72 @@
+// One ray against one shape in its local frame: picks the exact kernel of the shape type, or the GJK ray cast for
+// inflated shapes that have none. Exact: sphere and capsule (their radius includes the inflation), halfspace (the
+// inflation moves its plane), and every other type without inflation. Inflated box, cylinder, cone, ellipsoid, hull
+// and triangle go through ray_gjk (certified: the hit point is outside the shape and within the tolerance of it).
+#pragma once
+
+#include "kernels/rays/ray_gjk.hpp"
+#include "kernels/rays/ray_polytopes.hpp"
+#include "kernels/rays/ray_quadrics.hpp"
+#include "kernels/shape_core.hpp"
+
+namespace batchcol::kernels::rays {
+
+/// A shape prepared for rays: its core, inflation, bounding radius and (hulls) face planes owned by the caller.
+template <class T> struct RayShape {
+  ShapeCore<T> core;
+  T inflation = T(0);
+  T bound = T(0);                         // bounding radius about the local origin (inflation included)
+  const HullPlanes<T>* planes = nullptr;  // convex only
+};
+
+template <class T> RayShape<T> make_ray_shape(const Shape& shape, const HullPlanes<T>* planes) {
+  RayShape<T> r;
+  r.core = make_core<T>(shape);
+  r.inflation = T(shape.inflation);
+  r.bound = shape.type == ShapeType::halfspace ? T(0) : T(shape.bounding_radius());
+  r.planes = planes;
+  return r;
+}
+
+/// True when the shape's rays go through the GJK ray cast (tolerance-certified) instead of an exact kernel.
+inline bool uses_ray_gjk(const Shape& shape) {
+  return shape.inflation > 0.0 && shape.type != ShapeType::sphere && shape.type != ShapeType::capsule &&
+         shape.type != ShapeType::halfspace;
+}
+
+template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d, T t_max,
+                                         const RayGjkSettings& settings) {
+  const ShapeCore<T>& c = s.core;
+  if (c.type == ShapeType::halfspace) {
+    return finish(ray_halfspace(o, d, c.halfspace_normal, c.halfspace_offset + s.inflation), d, t_max);
+  }
+  if (s.inflation > T(0) && c.type != ShapeType::sphere && c.type != ShapeType::capsule) {
+    return ray_gjk(c, s.inflation, s.bound, o, d, t_max, settings);
+  }
+  switch (c.type) {
+    case ShapeType::sphere: return finish(ray_sphere(o, d, c.radius), d, t_max);
+    case ShapeType::capsule: return finish(ray_capsule(o, d, c.radius, c.size.y()), d, t_max);
+    case ShapeType::box: return finish(ray_box(o, d, c.size), d, t_max);
+    case ShapeType::cylinder: return finish(ray_cylinder(o, d, c.size.x(), c.size.y()), d, t_max);
+    case ShapeType::cone: return finish(ray_cone(o, d, c.size.x(), c.size.y()), d, t_max);
+    case ShapeType::ellipsoid: return finish(ray_ellipsoid(o, d, c.size), d, t_max);
+    case ShapeType::convex: {
+      // The bounding ball first: most rays that reach a hull's box in a scene miss the hull, and the ball rejects
+      // them for the cost of one sphere test instead of a pass over every face.
+      const RayInterval<T> ball = ray_sphere(o, d, s.bound * (T(1) + T(64) * machine_epsilon<T>()));
+      if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return {};
+      if (s.planes->walk.planes() > 0) {
+        bool ok = false;
+        const LocalHit<T> h = ray_hull_walk(s.planes->walk, o, d, t_max, ok);
+        if (ok) return h;
+      }
+      return finish(ray_convex(o, d, *s.planes), d, t_max);
+    }
+    case ShapeType::triangle:
+      return finish(ray_triangle(o, d, c.triangle[0], c.triangle[1], c.triangle[2]), d, t_max);
+    case ShapeType::halfspace: break;
+  }
+  return {};
+}
+
+}  // namespace batchcol::kernels::rays

@@ -1,0 +1,285 @@
+// RaySceneIndex against brute force: every ray against every object through the shape form (cast_rays), on mixed
+// scenes (every shape type, inflated shapes, a halfspace). Closest, any and all queries; refit after moves, rebuild
+// after additions and removals; bitwise the same answers for 1 and 2 threads; invalid rays and calls.
+#include "support/generators.hpp"
+
+#include "batchcol/rays.hpp"
+#include "batchcol/scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <vector>
+
+namespace batchcol {
+namespace {
+
+using testing::Rng;
+using testing::uniform;
+
+std::shared_ptr<ShapeTable> mixed_table(Rng& rng) {
+  auto table = std::make_shared<ShapeTable>();
+  for (ShapeType type : testing::bounded_shape_types()) {
+    table->add(testing::random_shape(rng, type, 0.1, 0.6));
+    table->add(testing::random_shape(rng, type, 0.1, 0.6).inflated(0.05));
+  }
+  return table;
+}
+
+struct World {
+  std::shared_ptr<ShapeTable> table;
+  Scene scene;
+  std::vector<ObjectHandle> handles;
+  explicit World(std::shared_ptr<ShapeTable> t) : table(t), scene(t) {}
+};
+
+World make_world(Rng& rng, int objects, bool with_ground) {
+  World w(mixed_table(rng));
+  const std::uint32_t bounded = static_cast<std::uint32_t>(w.table->size());
+  for (int i = 0; i < objects; ++i) {
+    const Eigen::Vector3d t(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -5, 5));
+    w.handles.push_back(w.scene.add(static_cast<std::uint32_t>(i % bounded), {t, testing::random_rotation(rng)}));
+  }
+  if (with_ground) {
+    const std::uint32_t ground = w.table->add(Shape::halfspace(Eigen::Vector3d::UnitZ(), 0.0));
+    w.handles.push_back(w.scene.add(ground, Pose::from_translation(Eigen::Vector3d(0, 0, -6))));
+  }
+  return w;
+}
+
+RayBatch random_rays(Rng& rng, int n) {
+  RayBatch rays;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d o(uniform(rng, -8, 8), uniform(rng, -8, 8), uniform(rng, -8, 8));
+    const Eigen::Vector3d target(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -5, 5));
+    const double t_max = i % 3 == 0 ? uniform(rng, 0.5, 1.5) : std::numeric_limits<double>::infinity();
+    rays.add(o, (target - o).normalized() * (i % 5 == 0 ? 2.5 : 1.0), t_max);
+  }
+  return rays;
+}
+
+struct BruteHit {
+  double t;
+  ObjectHandle object;
+};
+
+// Every ray against every object of the scene, through cast_rays() (the shape form), hits sorted by (t, slot).
+std::vector<std::vector<BruteHit>> brute_force(const World& w, const RayBatch& rays) {
+  std::vector<ObjectHandle> live;
+  for (ObjectHandle h : w.handles)
+    if (w.scene.contains(h)) live.push_back(h);
+  ShapeRayBatch batch;
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    for (ObjectHandle h : live)
+      batch.add(w.scene.shape(h), w.scene.pose(h), rays.origin[i], rays.direction[i], rays.t_max[i]);
+  RayResults r;
+  cast_rays(*w.table, batch, RayOptions{}, r);
+  std::vector<std::vector<BruteHit>> hits(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    for (std::size_t k = 0; k < live.size(); ++k) {
+      const std::size_t row = i * live.size() + k;
+      EXPECT_NE(r.status[row], RayStatus::invalid_input);
+      if (r.hit[row]) hits[i].push_back({r.t[row], live[k]});
+    }
+    std::sort(hits[i].begin(), hits[i].end(), [](const BruteHit& a, const BruteHit& b) {
+      return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot);
+    });
+  }
+  return hits;
+}
+
+// The scene form transforms rays with its own copy of the rotation; the shape form normalises the quaternion again:
+// the two may differ by a few ulps.
+constexpr double kTransformSlack = 1e-9;
+
+void expect_matches_brute_force(const RaySceneIndex& index, const World& w, const RayBatch& rays) {
+  const auto brute = brute_force(w, rays);
+  RayResults closest, any, all;
+  RayOptions o;
+  index.cast(rays, o, closest);
+  o.query = RayQuery::any;
+  index.cast(rays, o, any);
+  o.query = RayQuery::all;
+  index.cast(rays, o, all);
+  int hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    SCOPED_TRACE(::testing::Message() << "ray " << i);
+    const auto& b = brute[i];
+    ASSERT_EQ(closest.status[i], RayStatus::ok);
+    ASSERT_EQ(closest.hit[i], b.empty() ? 0 : 1);
+    ASSERT_EQ(any.hit[i], closest.hit[i]);
+    ASSERT_EQ(all.hit_begin[i + 1] - all.hit_begin[i], b.size());
+    if (b.empty()) continue;
+    ++hits;
+    EXPECT_NEAR(closest.t[i], b[0].t, kTransformSlack);
+    // The same object, unless a second one is hit within the slack (a tie up to rounding).
+    if (b.size() < 2 || b[1].t - b[0].t > kTransformSlack) EXPECT_EQ(closest.object[i], b[0].object);
+    EXPECT_NEAR(closest.normal[i].norm(), 1.0, 1e-12);
+    // Any: one of the objects brute force hits, at its t.
+    const auto it = std::find_if(b.begin(), b.end(), [&](const BruteHit& h) { return h.object == any.object[i]; });
+    ASSERT_NE(it, b.end());
+    EXPECT_NEAR(any.t[i], it->t, kTransformSlack);
+    // All: the same objects with the same t (compared as sets: ties may be ordered differently).
+    for (std::uint64_t row = all.hit_begin[i]; row < all.hit_begin[i + 1]; ++row) {
+      const auto m = std::find_if(b.begin(), b.end(), [&](const BruteHit& h) { return h.object == all.all_object[row]; });
+      ASSERT_NE(m, b.end());
+      EXPECT_NEAR(all.all_t[row], m->t, kTransformSlack);
+      if (row > all.hit_begin[i]) EXPECT_LE(all.all_t[row - 1], all.all_t[row]);
+    }
+    EXPECT_EQ(all.t[i], all.all_t[all.hit_begin[i]]);
+  }
+  EXPECT_GT(hits, static_cast<int>(rays.size()) / 8);  // the scene is dense enough for the test to mean something
+}
+
+TEST(RayScene, MatchesBruteForceForEveryQuery) {
+  Rng rng(11);
+  World w = make_world(rng, 300, true);
+  RaySceneIndex index;
+  index.update(w.scene);
+  EXPECT_TRUE(index.last_update_rebuilt());
+  EXPECT_EQ(index.object_count(), 301u);
+  expect_matches_brute_force(index, w, random_rays(rng, 1500));
+}
+
+TEST(RayScene, SmallScenes) {
+  Rng rng(12);
+  for (int n : {1, 2, 3, 17}) {
+    World w = make_world(rng, n, false);
+    RaySceneIndex index;
+    index.update(w.scene);
+    RayBatch rays;
+    // Rays aimed at the objects so that most of them hit.
+    for (int i = 0; i < 200; ++i) {
+      const Pose p = w.scene.pose(w.handles[i % n]);
+      const Eigen::Vector3d o(uniform(rng, -8, 8), uniform(rng, -8, 8), uniform(rng, -8, 8));
+      rays.add(o, p.translation - o + 0.05 * testing::random_unit_vector(rng), INFINITY);
+    }
+    expect_matches_brute_force(index, w, rays);
+  }
+}
+
+TEST(RayScene, RefitAfterMovesAndRebuildAfterAddRemove) {
+  Rng rng(13);
+  World w = make_world(rng, 200, false);
+  RaySceneIndex index;
+  index.update(w.scene);
+  for (ObjectHandle h : w.handles) {
+    Pose p = w.scene.pose(h);
+    p.translation += Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    w.scene.set_pose(h, {p.translation, testing::random_rotation(rng)});
+  }
+  index.update(w.scene);
+  EXPECT_FALSE(index.last_update_rebuilt());
+  EXPECT_EQ(index.timings().build_ms, 0.0);
+  expect_matches_brute_force(index, w, random_rays(rng, 800));
+  w.scene.remove(w.handles[5]);
+  w.handles.push_back(w.scene.add(0, Pose::from_translation(Eigen::Vector3d(1, 2, 3))));
+  index.update(w.scene);
+  EXPECT_TRUE(index.last_update_rebuilt());
+  expect_matches_brute_force(index, w, random_rays(rng, 800));
+  // A forced rebuild over unchanged objects gives the same answers as the refit tree would.
+  index.update(w.scene, 0, true);
+  EXPECT_TRUE(index.last_update_rebuilt());
+}
+
+template <class T> bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+TEST(RayScene, BitwiseIdenticalForAnyThreadCount) {
+  Rng rng(14);
+  World w = make_world(rng, 2000, true);
+  const RayBatch rays = random_rays(rng, 5000);
+  for (RayQuery q : {RayQuery::closest, RayQuery::any, RayQuery::all}) {
+    RayResults r1, r2;
+    RaySceneIndex i1, i2;
+    i1.update(w.scene, 1);
+    i2.update(w.scene, 2);
+    RayOptions o;
+    o.query = q;
+    o.threads = 1;
+    i1.cast(rays, o, r1);
+    o.threads = 2;
+    i2.cast(rays, o, r2);
+    EXPECT_TRUE(same_bits(r1.hit, r2.hit) && same_bits(r1.t, r2.t) && same_bits(r1.normal.x, r2.normal.x) &&
+                same_bits(r1.normal.z, r2.normal.z) && same_bits(r1.hit_begin, r2.hit_begin) &&
+                same_bits(r1.all_t, r2.all_t))
+        << to_string(q);
+    for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(r1.object[i], r2.object[i]);
+  }
+}
+
+TEST(RayScene, InvalidRaysGetAStatusAndBadCallsThrow) {
+  Rng rng(15);
+  World w = make_world(rng, 20, false);
+  RaySceneIndex index;
+  RayBatch rays;
+  rays.add({0, 0, 20}, {0, 0, -1}, INFINITY);  // valid, infinite t_max
+  rays.add({0, 0, 20}, {0, 0, 0}, 1.0);        // zero direction
+  rays.add({NAN, 0, 0}, {0, 0, 1}, 1.0);       // non-finite origin
+  rays.add({0, 0, 0}, {INFINITY, 0, 0}, 1.0);  // non-finite direction
+  rays.add({0, 0, 0}, {1, 0, 0}, -1.0);        // negative t_max
+  rays.add({0, 0, 0}, {1, 0, 0}, NAN);         // NaN t_max
+  RayResults r;
+  EXPECT_THROW(index.cast(rays, {}, r), InputError);  // before update()
+  index.update(w.scene);
+  index.cast(rays, {}, r);
+  EXPECT_EQ(r.status[0], RayStatus::ok);
+  for (std::size_t i = 1; i < rays.size(); ++i) {
+    EXPECT_EQ(r.status[i], RayStatus::invalid_input) << i;
+    EXPECT_EQ(r.hit[i], 0);
+    EXPECT_TRUE(std::isnan(r.t[i]));
+    EXPECT_EQ(r.object[i], ObjectHandle{});
+  }
+  rays.t_max.pop_back();
+  EXPECT_THROW(index.cast(rays, {}, r), InputError);
+  rays.t_max.push_back(1.0);
+  RayOptions bad;
+  bad.tolerance = 0.0;
+  EXPECT_THROW(index.cast(rays, bad, r), InputError);
+  bad = {};
+  bad.threads = -1;
+  EXPECT_THROW(index.cast(rays, bad, r), InputError);
+  EXPECT_THROW(parse_ray_query("nearest"), InputError);
+  EXPECT_EQ(parse_ray_query("all"), RayQuery::all);
+}
+
+}  // namespace
+}  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+TEST(RayScene, EmptySceneAndHalfspacesOnly) {
+  auto table = std::make_shared<ShapeTable>();
+  const std::uint32_t ground = table->add(Shape::halfspace(Eigen::Vector3d::UnitZ(), 0.0));
+  Scene scene(table);
+  RaySceneIndex index;
+  index.update(scene);
+  RayBatch rays;
+  rays.add({0, 0, 5}, {0, 0, -1}, INFINITY);
+  RayResults r;
+  index.cast(rays, {}, r);
+  EXPECT_EQ(r.status[0], RayStatus::ok);
+  EXPECT_EQ(r.hit[0], 0);
+  const ObjectHandle h = scene.add(ground, Pose::from_translation(Eigen::Vector3d(0, 0, 1)));
+  index.update(scene);
+  EXPECT_TRUE(index.last_update_rebuilt());
+  for (RayQuery q : {RayQuery::closest, RayQuery::any, RayQuery::all}) {
+    RayOptions o;
+    o.query = q;
+    index.cast(rays, o, r);
+    ASSERT_EQ(r.hit[0], 1) << to_string(q);
+    EXPECT_EQ(r.t[0], 4.0);
+    EXPECT_EQ(r.object[0], h);
+    EXPECT_EQ(r.normal[0], Eigen::Vector3d(0, 0, 1));
+  }
+  EXPECT_EQ(r.hit_begin, (std::vector<std::uint64_t>{0, 1}));
+}
+
+}  // namespace
+}  // namespace batchcol
