@@ -46,10 +46,14 @@ void validate(const QueryOptions& o) {
   if (!std::isfinite(o.margin) || o.margin < 0.0) fail("margin must be a finite number >= 0");
   if (o.max_iterations < 1) fail("max_iterations must be >= 1");
   if (o.epa_max_iterations < 1) fail("epa_max_iterations must be >= 1");
-  if (o.threads < 0) fail("threads must be >= 0 (0 = all cores)");
+  if (o.threads < 0 || o.threads > kMaxThreads) {
+    fail("threads must be between 0 (all cores) and " + std::to_string(kMaxThreads) + ", got " +
+         std::to_string(o.threads));
+  }
   if (static_cast<int>(o.level) > static_cast<int>(QueryLevel::penetration)) fail("level is not a QueryLevel");
   if (static_cast<int>(o.solver) > static_cast<int>(Solver::automatic)) fail("solver is not a Solver");
   if (static_cast<int>(o.precision) > static_cast<int>(Precision::float32)) fail("precision is not a Precision");
+  if (static_cast<int>(o.isa) > static_cast<int>(InstructionSet::avx512)) fail("isa is not an InstructionSet");
 }
 
 }  // namespace batchcol
