@@ -12,9 +12,10 @@ bool is_unit_quaternion(const Eigen::Quaterniond& q) {
 
 Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
   if (!q.coeffs().allFinite()) throw InputError("the quaternion has a non-finite component");
-  const double norm = q.norm();
   if (!is_unit_quaternion(q)) {
+    const double norm = q.coeffs().stableNorm();  // q.norm() overflows for components beyond 1e154
     std::ostringstream msg;
+    msg.precision(17);  // a norm of 1.0000011 must not print as "1"
     msg << "the quaternion [w, x, y, z] must have norm 1 (within " << kUnitTolerance << "), its norm is " << norm;
     throw InputError(msg.str());
   }
@@ -27,6 +28,7 @@ Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R) {
   const double det = R.determinant();
   if (!(orthogonality <= kUnitTolerance) || !(std::abs(det - 1.0) <= kUnitTolerance)) {
     std::ostringstream msg;
+    msg.precision(17);
     msg << "not a rotation matrix (needs R R^T = I and det R = +1 within " << kUnitTolerance
         << "; max |R R^T - I| = " << orthogonality << ", det = " << det << ")";
     throw InputError(msg.str());
