@@ -1,6 +1,9 @@
 #include "validate.hpp"
 
+#include "results_fill.hpp"
+
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace batchcol {
@@ -29,6 +32,24 @@ void validate_batch_layout(const PairBatch& b) {
   check(length(b.rotation_a), "rotation_a");
   check(length(b.rotation_b), "rotation_b");
   if (!b.warm_start.empty()) check(length(b.warm_start), "warm_start");
+}
+
+void validate_shapes_for(const ShapeTable& shapes, const QueryOptions& options) {
+  if (options.precision != Precision::float32 || shapes.size() == 0) return;
+  if (shapes.smallest_size() >= kMinLengthFloat && shapes.largest_radius() <= kMaxLengthFloat) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "precision float32 answers shapes of sizes %g to %g m only (the table holds sizes down to %g m and "
+                "bounding radii up to %g m): use precision double",
+                kMinLengthFloat, kMaxLengthFloat, shapes.smallest_size(), shapes.largest_radius());
+  throw InputError(text);
+}
+
+void refuse_beyond_float_limits(const PairBatch& batch, std::size_t begin, std::size_t end, PairResults& results) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const Eigen::Vector3d t = batch.translation_b[i] - batch.translation_a[i];
+    if (!((std::abs(t.x()) + std::abs(t.y())) + std::abs(t.z()) <= kMaxLengthFloat)) fill_pair_defaults(results, i);
+  }
 }
 
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {

@@ -85,7 +85,10 @@ struct QueryOptions {
   double tolerance = 1e-8;
   double relative_tolerance = 0.0;
   /// Security margin: a pair collides when its distance is <= margin (boolean queries stop once that is decided).
-  /// collide is conservative: false only when a separating plane beyond the margin is certified.
+  /// collide is conservative: false only when a separating plane beyond the margin is certified (GJK's lower bound
+  /// > margin), while `distance` is GJK's upper estimate. A converged pair may therefore report collide = 1 with a
+  /// distance above the margin by at most the effective tolerance max(tolerance, relative_tolerance * distance,
+  /// precision floor); collide = 0 always comes with a distance above the margin.
   double margin = 0.0;
   int max_iterations = 128;       // GJK iterations per pair
   int epa_max_iterations = 1000;  // EPA expansions per pair (near-concentric curved pairs need hundreds)
