@@ -91,7 +91,7 @@ TEST_F(CliOutput, ConcurrentRunsWithTheSameOutLeaveOneCompleteResult) {
   EXPECT_FALSE(fs::exists(dir_ / "failures")) << read_text(dir_ / "failures");
   const std::string written = read_text(out);
   EXPECT_THAT(expected, ::testing::Contains(written)) << written.size() << " bytes";
-  EXPECT_THAT(leftover_temporaries(), ::testing::IsEmpty());
+  EXPECT_TRUE(leftover_temporaries().empty()) << leftover_temporaries().front();
 #endif
 }
 
@@ -101,7 +101,7 @@ TEST_F(CliOutput, FailedRunLeavesNoTemporary) {
                           out.string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(fs::exists(out));
-  EXPECT_THAT(leftover_temporaries(), ::testing::IsEmpty());
+  EXPECT_TRUE(leftover_temporaries().empty()) << leftover_temporaries().front();
 }
 
 }  // namespace
