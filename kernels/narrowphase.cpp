@@ -3,6 +3,7 @@
 #include "kernels/closed_forms.hpp"
 #include "kernels/epa.hpp"
 #include "kernels/gjk.hpp"
+#include "kernels/point_depth.hpp"
 
 #include <type_traits>
 
@@ -182,6 +183,35 @@ bool complete_from_gjk(const GjkCompletion<T>& c, const GjkResult<T>& g, const Q
   return true;
 }
 
+namespace {
+
+/// EPA's answer, in closed form, when one core is a point (a sphere) inside the other, a cylinder or cone core:
+/// the depth is the point's distance to that core's boundary. False for every other pair.
+template <class T> bool point_core_depth(const PairSetup<T>& s, EpaResult<T>& e) {
+  PointDepth<T> d;
+  if (s.B.type == ShapeType::sphere) {
+    const Vec3<T> p = s.X.t;  // B's point core, in A's frame
+    if (!point_depth_in_core(s.A, p, d)) return false;
+    e.normal = d.normal;  // from A to B: B leaves A through A's boundary
+    e.witness_b = p;
+    e.witness_a = p + d.depth * d.normal;
+  } else if (s.A.type == ShapeType::sphere) {
+    const Vec3<T> p = mul_transposed(s.X.R, Vec3<T>(-s.X.t));  // A's point core, in B's frame
+    if (!point_depth_in_core(s.B, p, d)) return false;
+    e.normal = -mul(s.X.R, d.normal);  // A leaves B through B's boundary: from A to B is against B's outward normal
+    e.witness_a = Vec3<T>::Zero();
+    e.witness_b = s.X.apply(Vec3<T>(p + d.depth * d.normal));
+  } else {
+    return false;
+  }
+  e.depth = d.depth;  // witness_a - witness_b = depth * normal, as EPA's
+  e.status = EpaStatus::converged;
+  e.iterations = 0;
+  return true;
+}
+
+}  // namespace
+
 template <class T>
 PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const QueryOptions& opt) {
   const GjkCompletion<T> c{s.A.radius, s.B.radius, s.radii, s.scale, s.floor, s.params.tolerance,
@@ -191,8 +221,10 @@ PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const 
   if (g.status != GjkStatus::overlap) {
     if constexpr (std::is_same_v<T, float>) return redo_in_double(s, g, opt);
   }
-  // Overlapping cores at QueryLevel::penetration: depth and witnesses by EPA.
-  const EpaResult<T> e = epa(s.difference(), g.simplex, s.params.tolerance, s.scale, opt.epa_max_iterations);
+  // Overlapping cores at QueryLevel::penetration: depth and witnesses by EPA, or in closed form for a sphere
+  // centred inside a cylinder or cone (where EPA converges too slowly: kernels/point_depth.hpp).
+  EpaResult<T> e;
+  if (!point_core_depth(s, e)) e = epa(s.difference(), g.simplex, s.params.tolerance, s.scale, opt.epa_max_iterations);
   out = PairOutput<T>{};
   out.iterations = g.iterations + e.iterations;
   out.direction = g.direction;

@@ -3,6 +3,9 @@
 // line and column.
 #include "batchcol/io.hpp"
 
+#include "batch_json.hpp"
+#include "printable.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -24,159 +27,63 @@ namespace {
 using json = nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string pointer_token(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
+using detail::pointer_token;
+using detail::printable;
 
-// Builds the DOM like json::parse, but also rejects duplicate keys (json::parse keeps the last silently) and keeps
-// the byte offset and JSON pointer of a parse error.
-class DomBuilder final : public nlohmann::json_sax<json> {
- public:
-  DomBuilder(const std::string& text, json& root) : text_(text), root_(root) {}
-
-  bool null() override { return add(json(nullptr)); }
-  bool boolean(bool v) override { return add(json(v)); }
-  bool number_integer(number_integer_t v) override { return add(json(v)); }
-  bool number_unsigned(number_unsigned_t v) override { return add(json(v)); }
-  bool number_float(number_float_t v, const string_t&) override { return add(json(v)); }
-  bool string(string_t& v) override { return add(json(std::move(v))); }
-  bool binary(binary_t&) override { return false; }  // JSON text never holds binary values
-  bool start_object(std::size_t) override { return open(json::object()); }
-  bool start_array(std::size_t) override { return open(json::array()); }
-  bool end_object() override { return close(); }
-  bool end_array() override { return close(); }
-
-  bool key(string_t& k) override {
-    Frame& frame = stack_.back();
-    if (frame.value->contains(k)) {
-      error_pointer = container_pointer() + "/" + pointer_token(k);
-      error_message = "duplicate key";
-      return false;
-    }
-    frame.key = std::move(k);
-    return true;
-  }
-
-  bool parse_error(std::size_t position, const std::string& last_token, const json::exception& ex) override {
-    // `position` counts the characters read, i.e. it is just past the offending token; point at the token's start.
-    error_index = position > 0 ? position - 1 : 0;
-    if (!last_token.empty() && position >= last_token.size() &&
-        text_.compare(position - last_token.size(), last_token.size(), last_token) == 0) {
-      error_index = position - last_token.size();
-    }
-    // A number overflow is a complete value, so the pointer of that value is exact; other errors name the container.
-    error_pointer = ex.id == 406 ? value_pointer() : container_pointer();
-    std::string what = ex.what();
-    const auto bracket = what.find("] ");
-    if (bracket != std::string::npos) what.erase(0, bracket + 2);
-    if (what.rfind("parse error", 0) == 0) {  // drop nlohmann's own "parse error at line L, column C: "
-      const auto colon = what.find(": ");
-      if (colon != std::string::npos) what.erase(0, colon + 2);
-    }
-    error_message = "invalid JSON: " + what;
-    return false;
-  }
-
-  std::optional<std::size_t> error_index;  // index into the text, for syntax errors only
-  std::string error_pointer;
-  std::string error_message;
-
- private:
-  struct Frame {
-    json* value;
-    std::string key;  // key of the member being read (objects only)
-  };
-
-  json* insert(json v) {
-    if (stack_.empty()) {
-      root_ = std::move(v);
-      return &root_;
-    }
-    Frame& parent = stack_.back();
-    if (parent.value->is_array()) {
-      parent.value->push_back(std::move(v));
-      return &parent.value->back();
-    }
-    json& slot = (*parent.value)[parent.key];
-    slot = std::move(v);
-    return &slot;
-  }
-  bool add(json v) {
-    insert(std::move(v));
-    return true;
-  }
-  bool open(json v) {
-    stack_.push_back({insert(std::move(v)), {}});
-    return true;
-  }
-  bool close() {
-    stack_.pop_back();
-    return true;
-  }
-  std::string child_token(const Frame& frame, bool next) const {
-    if (!frame.value->is_array()) return pointer_token(frame.key);
-    const std::size_t n = frame.value->size();
-    return std::to_string(next ? n : n - 1);
-  }
-  std::string container_pointer() const {
-    std::string out;
-    for (std::size_t i = 1; i < stack_.size(); ++i) out += "/" + child_token(stack_[i - 1], false);
-    return out;
-  }
-  std::string value_pointer() const {
-    return stack_.empty() ? std::string() : container_pointer() + "/" + child_token(stack_.back(), true);
-  }
-
-  const std::string& text_;
-  json& root_;
-  std::vector<Frame> stack_;
-};
-
-// 1-based line and column of the character at `index` (index == size means the end of the text).
-std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t index) {
-  index = std::min(index, text.size());
-  std::size_t line = 1, line_start = 0;
-  for (std::size_t i = 0; i < index; ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      line_start = i + 1;
-    }
-  }
-  return {line, index - line_start + 1};
-}
-
-// Turns the DOM into a BatchFile. Pointers are built only along the path being read.
+// Turns the streamed elements and the top-level DOM into a BatchFile. Pointers are built only along the path being
+// read. Shapes and pairs are read as the parser completes them; a pair read before the shapes array ended has its
+// shape indices range-checked in finish().
 class BatchReader {
  public:
-  BatchReader(const std::string& source, const std::string& base_dir) : source_(source), base_dir_(base_dir) {}
+  static constexpr const char* kTopLevelKeys[] = {"shapes", "pairs", "rays", "query", "solver", "tolerance",
+                                                  "precision", "margin"};
 
-  BatchFile read(const json& root) const {
+  BatchReader(const std::string& source, const std::string& base_dir, std::size_t text_bytes)
+      : source_(source), base_dir_(base_dir), text_bytes_(text_bytes) {}
+
+  void element(const std::string& array, std::size_t i, const json& v) {
+    // The pair count is not known while streaming: reserve for the most pairs the text can hold (a pair is at least
+    // the 14 bytes of `{"a":0,"b":0},`). Pages never written are never resident, so this costs address space only,
+    // and the arrays never reallocate (growth by doubling would briefly hold them twice).
+    if (array == "pairs" && i == 0) file_.pairs.reserve(text_bytes_ / 14 + 1);
+    if (array == "shapes") file_.shapes.add(read_shape(v, "/shapes/" + std::to_string(i)));
+    else if (array == "rays") read_ray(v, "/rays/" + std::to_string(i), file_);
+    else read_pair(v, "/pairs/" + std::to_string(i), file_);
+  }
+  void array_end(const std::string& array) {
+    if (array == "shapes") shapes_done_ = true;
+  }
+
+  BatchFile finish(const json& root) {
     if (!root.is_object()) fail("", "the top level must be an object, got " + describe(root));
-    check_keys(root, "", {"shapes", "pairs", "rays", "query", "solver", "tolerance", "precision", "margin"});
-    BatchFile file;
-    const json& shapes = array_field(root, "", "shapes");
-    for (std::size_t i = 0; i < shapes.size(); ++i) file.shapes.add(read_shape(shapes[i], "/shapes/" + std::to_string(i)));
-    if (root.contains("pairs") || !root.contains("rays")) {  // a file of rays needs no pairs
-      const json& pairs = array_field(root, "", "pairs");
-      file.pairs.reserve(pairs.size());
-      for (std::size_t i = 0; i < pairs.size(); ++i) read_pair(pairs[i], "/pairs/" + std::to_string(i), file);
+    check_keys(root, "", kTopLevelKeys);
+    array_field(root, "", "shapes");
+    if (root.contains("pairs") || !root.contains("rays")) array_field(root, "", "pairs");  // a file of rays needs no pairs
+    if (root.contains("rays")) array_field(root, "", "rays");
+    if (!shapes_checked_) {  // pairs came before the shapes: check their indices now
+      const std::size_t n = file_.shapes.size();
+      for (std::size_t i = 0; i < file_.pairs.size(); ++i)
+        for (const auto& [index, name] : {std::pair{file_.pairs.shape_a[i], "a"}, std::pair{file_.pairs.shape_b[i], "b"}})
+          if (index >= n) {
+            fail("/pairs/" + std::to_string(i) + "/" + name, "shape index " + std::to_string(index) +
+                                                             " is out of range (the batch has " + std::to_string(n) +
+                                                             " shapes)");
+          }
     }
-    if (root.contains("rays")) {
-      const json& rays = array_field(root, "", "rays");
-      for (std::size_t i = 0; i < rays.size(); ++i) read_ray(rays[i], "/rays/" + std::to_string(i), file);
+    if (!rays_checked_) {  // rays came before the shapes
+      const std::size_t n = file_.shapes.size();
+      for (std::size_t i = 0; i < file_.rays.shape.size(); ++i)
+        if (file_.rays.shape[i] >= n)
+          fail("/rays/" + std::to_string(i) + "/shape", "shape index " + std::to_string(file_.rays.shape[i]) +
+                                                          " is out of range (the batch has " + std::to_string(n) +
+                                                          " shapes)");
     }
-    if (root.contains("query")) file.query = parse_named(root["query"], "/query", parse_query_level);
-    if (root.contains("solver")) file.solver = parse_named(root["solver"], "/solver", parse_solver);
-    if (root.contains("precision")) file.precision = parse_named(root["precision"], "/precision", parse_precision);
-    if (root.contains("tolerance")) file.tolerance = non_negative(root["tolerance"], "/tolerance");
-    if (root.contains("margin")) file.margin = non_negative(root["margin"], "/margin");
-    return file;
+    if (root.contains("query")) file_.query = parse_named(root["query"], "/query", parse_query_level);
+    if (root.contains("solver")) file_.solver = parse_named(root["solver"], "/solver", parse_solver);
+    if (root.contains("precision")) file_.precision = parse_named(root["precision"], "/precision", parse_precision);
+    if (root.contains("tolerance")) file_.tolerance = non_negative(root["tolerance"], "/tolerance");
+    if (root.contains("margin")) file_.margin = non_negative(root["margin"], "/margin");
+    return std::move(file_);
   }
 
  private:
@@ -193,14 +100,15 @@ class BatchReader {
     return std::string(v.type_name()) + " " + text;
   }
 
-  void check_keys(const json& object, const std::string& pointer, std::initializer_list<const char*> allowed) const {
+  template <std::size_t N>
+  void check_keys(const json& object, const std::string& pointer, const char* const (&allowed)[N]) const {
     for (const auto& item : object.items()) {
       bool known = false;
       for (const char* name : allowed) known = known || item.key() == name;
       if (known) continue;
       std::string list;
       for (const char* name : allowed) list += (list.empty() ? "" : ", ") + std::string(name);
-      fail(pointer + "/" + pointer_token(item.key()), "unknown key '" + item.key() + "' (allowed here: " + list + ")");
+      fail(pointer + "/" + pointer_token(item.key()), "unknown key '" + printable(item.key(), 64) + "' (allowed here: " + list + ")");
     }
   }
 
@@ -345,7 +253,7 @@ class BatchReader {
       shape = build(p, [&] { return Shape::halfspace(n, offset); });
     } else {
       fail(p + "/type",
-           "unknown shape type '" + type +
+           "unknown shape type '" + printable(type, 64) +
                "' (valid: sphere, capsule, box, cylinder, cone, ellipsoid, convex, mesh, triangle, halfspace)");
     }
     if (v.contains("inflation")) {
@@ -365,7 +273,7 @@ class BatchReader {
       fail(pointer, e.what());
     }
     // The hull is named after the mesh file (not "vertices") so a flat mesh's message says which file is flat.
-    return build(pointer, [&] { return Shape::convex(compute_convex_hull(pts, "mesh '" + path + "'")); });
+    return build(pointer, [&] { return Shape::convex(compute_convex_hull(pts, "mesh '" + printable(path, 200) + "'")); });
   }
 
   std::uint32_t shape_index(const json& v, const std::string& pointer, std::size_t shape_count) const {
@@ -408,11 +316,14 @@ class BatchReader {
     return pose;
   }
 
-  void read_pair(const json& v, const std::string& p, BatchFile& file) const {
+  void read_pair(const json& v, const std::string& p, BatchFile& file) {
     object_value(v, p);
     check_keys(v, p, {"a", "b", "pose_a", "pose_b"});
-    const std::uint32_t a = shape_index(field(v, p, "a"), p + "/a", file.shapes.size());
-    const std::uint32_t b = shape_index(field(v, p, "b"), p + "/b", file.shapes.size());
+    // Before the shapes array has ended, only the index's type is checked here (finish() checks the range).
+    shapes_checked_ = shapes_checked_ && shapes_done_;
+    const std::size_t count = shapes_done_ ? file.shapes.size() : std::size_t{1} << 32;
+    const std::uint32_t a = shape_index(field(v, p, "a"), p + "/a", count);
+    const std::uint32_t b = shape_index(field(v, p, "b"), p + "/b", count);
     const Pose pose_a = v.contains("pose_a") ? read_pose(v["pose_a"], p + "/pose_a") : Pose::identity();
     const Pose pose_b = v.contains("pose_b") ? read_pose(v["pose_b"], p + "/pose_b") : Pose::identity();
     file.pairs.add(a, pose_a, b, pose_b);
@@ -420,10 +331,13 @@ class BatchReader {
 
   // A ray against one posed shape (the shape form of batchcol/rays.hpp). A file states its rays, so a bad one is an
   // error naming it rather than the per-ray invalid status of the API: a zero direction, a negative t_max.
-  void read_ray(const json& v, const std::string& p, BatchFile& file) const {
+  void read_ray(const json& v, const std::string& p, BatchFile& file) {
     object_value(v, p);
     check_keys(v, p, {"shape", "pose", "origin", "direction", "t_max"});
-    const std::uint32_t shape = shape_index(field(v, p, "shape"), p + "/shape", file.shapes.size());
+    // As for pairs: before the shapes array has ended, finish() checks the index's range.
+    rays_checked_ = rays_checked_ && shapes_done_;
+    const std::size_t count = shapes_done_ ? file.shapes.size() : std::size_t{1} << 32;
+    const std::uint32_t shape = shape_index(field(v, p, "shape"), p + "/shape", count);
     const Pose pose = v.contains("pose") ? read_pose(v["pose"], p + "/pose") : Pose::identity();
     const Eigen::Vector3d origin = vec3(field(v, p, "origin"), p + "/origin");
     const Eigen::Vector3d direction = vec3(field(v, p, "direction"), p + "/direction");
@@ -435,6 +349,11 @@ class BatchReader {
 
   const std::string& source_;
   const std::string& base_dir_;
+  std::size_t text_bytes_;
+  BatchFile file_;
+  bool shapes_done_ = false;
+  bool shapes_checked_ = true;  // no pair has skipped the range check so far
+  bool rays_checked_ = true;    // no ray has skipped the range check so far
 };
 
 }  // namespace
@@ -449,32 +368,40 @@ void BatchFile::apply_to(QueryOptions& options) const {
 
 BatchFile parse_batch_json(const std::string& text, const std::string& source, const std::string& base_dir) {
   json root;
-  DomBuilder builder(text, root);
+  BatchReader reader(source, base_dir, text.size());
+  std::vector<std::string> allowed;
+  for (const char* key : BatchReader::kTopLevelKeys) allowed.emplace_back(key);
+  detail::JsonConsumer consumer{[&](const std::string& array, std::size_t i, const json& v) { reader.element(array, i, v); },
+                                [&](const std::string& array) { reader.array_end(array); }};
+  detail::StreamingDom builder(text, root, {"shapes", "pairs", "rays"}, allowed, consumer);
   if (!json::sax_parse(text, &builder)) {
     std::string where;
     if (builder.error_index) {
-      const auto [line, column] = line_and_column(text, *builder.error_index);
+      const auto [line, column] = detail::line_and_column(text, *builder.error_index);
       where = "line " + std::to_string(line) + ", column " + std::to_string(column) + ": ";
     }
     if (!builder.error_pointer.empty()) where += builder.error_pointer + ": ";
     throw InputError(source + ": " + where + builder.error_message);
   }
-  return BatchReader(source, base_dir).read(root);
+  return reader.finish(root);
 }
 
 BatchFile load_batch_file(const std::string& path) {
+  const std::string name = printable(path, 200);  // for messages
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) throw InputError(path + ": no such file");
-  if (fs::is_directory(status)) throw InputError(path + ": is a directory, expected a batch file (.json)");
-  if (!fs::is_regular_file(status)) throw InputError(path + ": not a regular file");
+  if (!fs::exists(status)) throw InputError(name + ": no such file");
+  if (fs::is_directory(status)) throw InputError(name + ": is a directory, expected a batch file (.json)");
+  if (!fs::is_regular_file(status)) throw InputError(name + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": read error");
+  if (!in) throw InputError(name + ": cannot open: " + std::strerror(errno));
+  // Read straight into one string of the file's size (a stringstream would hold the text twice).
+  std::string text(static_cast<std::size_t>(fs::file_size(path, ec)), '\0');
+  if (ec) throw InputError(name + ": cannot read the file size: " + ec.message());
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (static_cast<std::size_t>(in.gcount()) != text.size() || in.bad()) throw InputError(name + ": read error");
   const fs::path parent = fs::path(path).parent_path();
-  return parse_batch_json(text.str(), path, parent.empty() ? std::string(".") : parent.string());
+  return parse_batch_json(text, name, parent.empty() ? std::string(".") : parent.string());
 }
 
 }  // namespace batchcol

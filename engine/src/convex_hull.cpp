@@ -134,6 +134,10 @@ std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::V
   coords.reserve(points.size() * 3);
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite()) throw InputError(what + ": point " + std::to_string(i) + " is not finite");
+    // Beyond the input limits qhull's own arithmetic overflows and calls valid tetrahedra "collinear".
+    if (points[i].cwiseAbs().maxCoeff() > kMaxLength) {
+      throw InputError(what + ": point " + std::to_string(i) + " has a coordinate beyond the input limit of 1e50 m");
+    }
     coords.insert(coords.end(), {points[i].x(), points[i].y(), points[i].z()});
   }
 

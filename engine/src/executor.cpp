@@ -163,7 +163,7 @@ bool prepare_pair(const ShapeTable& shapes, const PairBatchView& batch, const Qu
   double qb[4] = {batch.rotation_b.w[i], batch.rotation_b.x[i], batch.rotation_b.y[i], batch.rotation_b.z[i]};
   const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
   if (ia >= shapes.size() || ib >= shapes.size() || !detail::normalize_unit_quaternion(qa) ||
-      !detail::normalize_unit_quaternion(qb) || !ta.allFinite() || !tb.allFinite()) {
+      !detail::normalize_unit_quaternion(qb) || !detail::translation_in_range(ta) || !detail::translation_in_range(tb)) {
     out.status[i] = Status::invalid_input;
     return false;
   }
@@ -191,7 +191,7 @@ bool solve_segment_pair(const ShapeTable& shapes, const PairBatchView& batch, co
   const auto qa = detail::unit_quaternion(batch.rotation_a[i]);
   const auto qb = detail::unit_quaternion(batch.rotation_b[i]);
   const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
-  if (!qa || !qb || !ta.allFinite() || !tb.allFinite()) return false;
+  if (!qa || !qb || !detail::translation_in_range(ta) || !detail::translation_in_range(tb)) return false;
   const kernels::WorldSegment A = kernels::world_segment(a, *qa, ta), B = kernels::world_segment(b, *qb, tb);
   const kernels::PairOutput<double> r =
       kernels::segments_with_radii<double>(A.p0, A.p1, B.p0, B.p1, A.radius, B.radius, tb - ta);
@@ -305,6 +305,7 @@ void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOption
 
 void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& requested, PairResults& results) {
   validate(requested);
+  detail::validate_shapes_for(shapes, requested);
   QueryOptions options = requested;  // the kernels see the solver that runs, never `automatic`
   options.solver = resolve_solver(requested.solver, requested.level);
   detail::validate_batch_layout(batch);
@@ -322,8 +323,12 @@ void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOp
     thread_local ChunkScratch<float> scratch_float;
     for (std::size_t t = range.begin(); t != range.end(); ++t) {
       const std::size_t begin = t * tile, end = std::min(n, begin + tile);
-      if (options.precision == Precision::float32) run_tile(shapes, batch, options, isa, begin, end, scratch_float, results);
-      else run_tile(shapes, batch, options, isa, begin, end, scratch_double, results);
+      if (options.precision == Precision::float32) {
+        run_tile(shapes, batch, options, isa, begin, end, scratch_float, results);
+        detail::refuse_beyond_float_limits(batch, begin, end, results);
+      } else {
+        run_tile(shapes, batch, options, isa, begin, end, scratch_double, results);
+      }
     }
   };
   const auto run_all = [&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles), run_tiles); };

@@ -3,11 +3,15 @@
 //
 // Assimp is lenient with broken files and some of its readers crash or hang on them (found by tools/fuzz), so:
 // the path must be a readable, non-empty regular file with a supported extension; a binary STL must have exactly
-// 84 + 50 * count bytes and finite coordinates; a PLY header must end with end_header; only the readers of the
+// 84 + 50 * count bytes and finite coordinates; a PLY file must hold exactly what its header declares (mesh_ply.cpp);
+// assimp opens files (an OBJ's material libraries) only when they are regular files; only the readers of the
 // supported formats are registered; a COLLADA file's declared counts and index lists must fit its size
 // (check_collada); no assimp post-processing runs (its steps trust the file's face indices); every vertex must be
 // finite. Each problem is one InputError naming the file.
 #include "batchcol/io.hpp"
+
+#include "mesh_checks.hpp"
+#include "printable.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -27,8 +31,14 @@
 
 #include <Eigen/Geometry>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #ifdef BATCHCOL_HAVE_ASSIMP
 #include <assimp/BaseImporter.h>
+#include <assimp/DefaultIOStream.h>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/importerdesc.h>
 #include <assimp/scene.h>
@@ -114,66 +124,6 @@ void check_stl(const std::string& path, std::uint64_t size, const std::string& w
         throw InputError(what + ": binary STL triangle " + std::to_string(t) + " has a non-finite coordinate");
       }
     }
-}
-
-/// PLY (assimp picks its PLY reader for any file starting with "ply"). Assimp 5.2.5 loops forever on a header
-/// without end_header and overflows a heap buffer on a header that declares an element twice (both found by
-/// fuzzing), so the header grammar is checked here first: "ply", one "format ascii|binary_little_endian|
-/// binary_big_endian 1.0", then "comment"/"obj_info" lines, "element NAME COUNT" (unique names) each followed by its
-/// "property TYPE NAME" or "property list COUNT_TYPE ITEM_TYPE NAME" lines, then "end_header".
-void check_ply_header(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  // Assimp takes any capitalisation of the magic ("pLy" was a fuzzer find): so does this check.
-  if (!std::getline(in, line) || line.size() < 3) return;
-  std::string magic = line.substr(0, 3);
-  std::transform(magic.begin(), magic.end(), magic.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (magic != "ply") return;  // not a PLY file: assimp decides
-  const auto fail = [&](std::size_t number, const std::string& problem) {
-    throw InputError(what + ": PLY header line " + std::to_string(number) + ": " + problem);
-  };
-  const auto is_scalar = [](const std::string& t) {
-    static const char* const kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double",
-                                         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-    return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* k) { return t == k; });
-  };
-  if (line != "ply" && line != "ply\r") fail(1, "expected 'ply' alone on the first line");
-  std::vector<std::string> elements;
-  bool format_seen = false;
-  for (std::size_t number = 2; std::getline(in, line); ++number) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (std::any_of(line.begin(), line.end(), [](unsigned char c) { return c < 32 && c != '\t'; }) ||
-        std::any_of(line.begin(), line.end(), [](unsigned char c) { return c >= 127; })) {
-      if (line.rfind("comment", 0) != 0 && line.rfind("obj_info", 0) != 0) fail(number, "not a text line");
-    }
-    std::istringstream words(line);
-    std::vector<std::string> w;
-    for (std::string word; words >> word;) w.push_back(word);
-    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
-    if (w[0] == "end_header") {
-      if (!format_seen) fail(number, "end_header before the format line");
-      return;
-    }
-    if (w[0] == "format") {
-      if (format_seen || w.size() != 3 || w[2] != "1.0" ||
-          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian")) {
-        fail(number, "expected one 'format ascii|binary_little_endian|binary_big_endian 1.0' line");
-      }
-      format_seen = true;
-    } else if (w[0] == "element") {
-      if (w.size() != 3 || w[2].find_first_not_of("0123456789") != std::string::npos || w[2].size() > 10)
-        fail(number, "expected 'element NAME COUNT'");
-      if (std::find(elements.begin(), elements.end(), w[1]) != elements.end()) fail(number, "element '" + w[1] + "' declared twice");
-      elements.push_back(w[1]);
-    } else if (w[0] == "property") {
-      const bool scalar = w.size() == 3 && is_scalar(w[1]);
-      const bool list = w.size() == 5 && w[1] == "list" && is_scalar(w[2]) && is_scalar(w[3]);
-      if (elements.empty() || !(scalar || list)) fail(number, "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an element");
-    } else {
-      fail(number, "unknown keyword '" + w[0].substr(0, 40) + "'");
-    }
-  }
-  throw InputError(what + ": PLY header has no end_header line");
 }
 
 /// COLLADA: assimp 5.2.5 trusts the numbers a COLLADA file declares (found by fuzzing, tools/fuzz/known/):
@@ -293,6 +243,35 @@ void keep_only_supported_readers(Assimp::Importer& importer) {
   }
 }
 
+/// Assimp opens more files than the one it is given (an OBJ's `mtllib` material libraries): one naming a FIFO blocked
+/// the load forever, a device could be read without end. This file system opens regular files only, for reading:
+/// open() with O_NONBLOCK cannot block on a FIFO, and fstat() on the open descriptor decides (no race with a rename).
+/// A refused material library is a missing one to assimp's OBJ reader, which then uses its default material.
+class RegularFilesOnly final : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* file) const override {
+    struct stat info{};
+    return ::stat(file, &info) == 0 && S_ISREG(info.st_mode);
+  }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (mode == nullptr || mode[0] != 'r' || std::strchr(mode, '+') != nullptr) return nullptr;
+    const int fd = ::open(file, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return nullptr;
+    struct stat info{};
+    FILE* stream = ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) ? ::fdopen(fd, "rb") : nullptr;
+    if (stream == nullptr) {
+      ::close(fd);
+      return nullptr;
+    }
+    return new Stream(stream, file);
+  }
+
+ private:
+  struct Stream final : Assimp::DefaultIOStream {  // its FILE* constructor is protected
+    Stream(FILE* file, const std::string& name) : Assimp::DefaultIOStream(file, name) {}
+  };
+};
+
 /// Every vertex of every mesh a node refers to, in the file's world frame (the node transforms composed from the
 /// root: COLLADA places meshes and carries its unit scale there), duplicates removed. Iterative: a deep node
 /// hierarchy must not overflow the stack.
@@ -341,19 +320,20 @@ std::vector<Eigen::Vector3d> scene_points(const aiScene& scene, const std::strin
 }  // namespace
 
 std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path) {
-  const std::string what = "mesh '" + path + "'";
+  const std::string what = "mesh '" + detail::printable(path, 200) + "'";
   const std::uint64_t size = checked_file_size(path, what);
   const std::string extension = lowercase_extension(path);
   if (!is_supported_extension(extension)) {
     throw InputError(what + ": unsupported mesh format '" + extension + "' (supported: " + kSupportedList + ")");
   }
   if (extension == ".stl") check_stl(path, size, what);
-  check_ply_header(path, what);
+  detail::check_ply(path, size, what, extension == ".ply");
   if (extension == ".dae") check_collada(path, size, what);
 
 #ifdef BATCHCOL_HAVE_ASSIMP
   Assimp::Importer importer;
   keep_only_supported_readers(importer);
+  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
   // No post-processing: assimp's steps trust the face indices a broken file gives them (found by fuzzing). The node
   // transforms are applied below and duplicate points are removed before the hull.
   const aiScene* scene = nullptr;

@@ -2,6 +2,7 @@
 #include "batchcol/pose.hpp"
 
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace batchcol {
@@ -12,10 +13,12 @@ bool is_unit_quaternion(const Eigen::Quaterniond& q) {
 
 Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
   if (!q.coeffs().allFinite()) throw InputError("the quaternion has a non-finite component");
-  const double norm = q.norm();
   if (!is_unit_quaternion(q)) {
+    const double norm = q.coeffs().stableNorm();  // q.norm() overflows for components beyond 1e154
     std::ostringstream msg;
-    msg << "the quaternion [w, x, y, z] must have norm 1 (within " << kUnitTolerance << "), its norm is " << norm;
+    // 10 digits: a norm of 1.0000011 must not print as "1" (6 digits, the default).
+    msg << "the quaternion [w, x, y, z] must have norm 1 (within " << kUnitTolerance << "), its norm is "
+        << std::setprecision(10) << norm;
     throw InputError(msg.str());
   }
   return q.normalized();
@@ -28,7 +31,7 @@ Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R) {
   if (!(orthogonality <= kUnitTolerance) || !(std::abs(det - 1.0) <= kUnitTolerance)) {
     std::ostringstream msg;
     msg << "not a rotation matrix (needs R R^T = I and det R = +1 within " << kUnitTolerance
-        << "; max |R R^T - I| = " << orthogonality << ", det = " << det << ")";
+        << std::setprecision(10) << "; max |R R^T - I| = " << orthogonality << ", det = " << det << ")";
     throw InputError(msg.str());
   }
   return Eigen::Quaterniond(R).normalized();

@@ -1,19 +1,32 @@
 #include "batchcol/shapes.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
 namespace batchcol {
 namespace {
 
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+const std::string kLimits = " (input limits: sizes from " + number(kMinLength) + " to " + number(kMaxLength) + " m)";
+
 void require_positive(double v, const char* field) {
-  if (!std::isfinite(v)) throw InputError(std::string(field) + " must be a finite number, got " + std::to_string(v));
-  if (!(v > 0.0)) throw InputError(std::string(field) + " must be > 0, got " + std::to_string(v));
+  if (!std::isfinite(v)) throw InputError(std::string(field) + " must be a finite number, got " + number(v));
+  if (!(v > 0.0)) throw InputError(std::string(field) + " must be > 0, got " + number(v));
+  if (v < kMinLength || v > kMaxLength) throw InputError(std::string(field) + " = " + number(v) + " is out of range" + kLimits);
 }
 
 void require_finite(const Eigen::Vector3d& v, const std::string& field) {
   if (!v.allFinite()) throw InputError(field + " must be finite");
+  if (v.cwiseAbs().maxCoeff() > kMaxLength)
+    throw InputError(field + " has a coordinate beyond " + number(kMaxLength) + " m" + kLimits);
 }
 
 Shape make(ShapeType type, const Eigen::Vector3d& size) {
@@ -66,6 +79,13 @@ Shape Shape::convex(const std::vector<Eigen::Vector3d>& points) { return convex(
 
 Shape Shape::convex(std::shared_ptr<const ConvexHull> hull) {
   if (!hull || hull->vertices.size() < 4) throw InputError("vertices: a convex hull needs at least 4 vertices");
+  for (const auto& v : hull->vertices) require_finite(v, "vertices");
+  Shape probe;
+  probe.type = ShapeType::convex;
+  probe.hull = hull;
+  if (probe.smallest_size() < kMinLength) {
+    throw InputError("vertices: the hull is smaller than " + number(kMinLength) + " m along every axis" + kLimits);
+  }
   Shape s;
   s.type = ShapeType::convex;
   s.hull = std::move(hull);
@@ -79,6 +99,7 @@ Shape Shape::triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   // A triangle without area has no normal; reject it rather than let the kernels meet a zero-length cross product.
   const double area2 = (b - a).cross(c - a).norm();
   const double scale = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+  if (scale < kMinLength) throw InputError("vertices: the triangle is smaller than " + number(kMinLength) + " m" + kLimits);
   if (!(area2 > 1e-12 * scale * scale))
     throw InputError("vertices: the triangle is degenerate (its three points are collinear or coincide)");
   Shape s;
@@ -88,18 +109,25 @@ Shape Shape::triangle_shape(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
 }
 
 Shape Shape::halfspace(const Eigen::Vector3d& normal, double offset) {
-  require_finite(normal, "normal");
+  if (!normal.allFinite()) throw InputError("normal must be finite");  // a direction: any finite magnitude
   if (!std::isfinite(offset)) throw InputError("offset must be a finite number");
-  const double n = normal.norm();
-  if (!(n > 0.0)) throw InputError("normal must be non-zero");
-  Shape s = make(ShapeType::halfspace, normal / n);
-  s.offset = offset / n;  // {x : normal.x <= offset} is unchanged by scaling both sides
+  // Scaled by the largest component first: normal.norm() squares the components, which overflow beyond 1e154 (a
+  // [1e200, 0, 0] normal became zero) and lose digits below 1e-154 ([3e-162, 4e-162, 0] got length 1.006).
+  const double largest = normal.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0)) throw InputError("normal must be non-zero");
+  const Eigen::Vector3d scaled = normal / largest;
+  const double n = scaled.norm();  // in [1, sqrt 3]
+  Shape s = make(ShapeType::halfspace, scaled / n);
+  s.offset = offset / largest / n;  // {x : normal.x <= offset} is unchanged by scaling both sides
+  if (!(std::abs(s.offset) <= kMaxLength)) {
+    throw InputError("offset / |normal| = " + number(s.offset) + " is beyond " + number(kMaxLength) + " m" + kLimits);
+  }
   return s;
 }
 
 Shape Shape::inflated(double radius) const {
-  if (!std::isfinite(radius) || radius < 0.0)
-    throw InputError("inflation must be a finite number >= 0, got " + std::to_string(radius));
+  if (!std::isfinite(radius) || radius < 0.0) throw InputError("inflation must be a finite number >= 0, got " + number(radius));
+  if (radius > kMaxLength) throw InputError("inflation = " + number(radius) + " is out of range" + kLimits);
   Shape s = *this;
   s.inflation = radius;
   return s;
@@ -128,10 +156,40 @@ double Shape::bounding_radius() const {
   return core + inflation;
 }
 
+double Shape::smallest_size() const {
+  switch (type) {
+    case ShapeType::sphere: return size.x();
+    case ShapeType::capsule:
+    case ShapeType::cylinder:
+    case ShapeType::cone: return std::min(size.x(), size.y());
+    case ShapeType::box:
+    case ShapeType::ellipsoid: return size.minCoeff();
+    case ShapeType::convex: {
+      Eigen::Vector3d lo = hull->vertices.front(), hi = lo;
+      for (const auto& v : hull->vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      return (hi - lo).maxCoeff() / 2;
+    }
+    case ShapeType::triangle: {
+      const auto& t = triangle;
+      return (t[0].cwiseMax(t[1]).cwiseMax(t[2]) - t[0].cwiseMin(t[1]).cwiseMin(t[2])).maxCoeff() / 2;
+    }
+    case ShapeType::halfspace: break;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
 std::uint32_t ShapeTable::add(Shape shape) {
   if (shapes_.size() >= std::numeric_limits<std::uint32_t>::max()) throw InputError("shape table is full");
   const ShapeType type = shape.type;
-  const double radius = shape.bounding_radius();
+  const double radius = shape.bounding_radius(), smallest = shape.smallest_size();
+  // The factories check these; a Shape whose fields were set by hand is checked here.
+  const bool in_limits = type == ShapeType::halfspace
+                             ? std::abs(shape.offset) <= kMaxLength && std::abs(shape.size.norm() - 1.0) <= 1e-12
+                             : smallest >= kMinLength && radius <= 4 * kMaxLength;  // implied by sizes <= kMaxLength
+  if (!in_limits || !(shape.inflation >= 0.0 && shape.inflation <= kMaxLength)) {
+    throw InputError("shape " + std::to_string(shapes_.size()) + " (" + to_string(type) + "): a size is out of range" +
+                     kLimits + " or, for a halfspace, the normal is not unit");
+  }
   shapes_.push_back(std::move(shape));
   try {  // the three arrays grow together: a failed allocation leaves the table as it was
     types_.push_back(type);
@@ -142,6 +200,9 @@ std::uint32_t ShapeTable::add(Shape shape) {
     throw;
   }
   mixed_ = shapes_.size() > 1 && (mixed_ || type != types_.front());  // a moved-from table starts afresh
+  if (shapes_.size() == 1) smallest_size_ = std::numeric_limits<double>::infinity(), largest_radius_ = 0.0;
+  smallest_size_ = std::min(smallest_size_, smallest);
+  if (type != ShapeType::halfspace) largest_radius_ = std::max(largest_radius_, radius);
   return static_cast<std::uint32_t>(shapes_.size() - 1);
 }
 

@@ -1,6 +1,9 @@
 #include "validate.hpp"
 
+#include "results_fill.hpp"
+
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace batchcol {
@@ -54,6 +57,24 @@ void validate_batch_layout(const PairBatchView& b) {
   if (!b.warm_start.empty()) vec3(b.warm_start, "warm_start");
 }
 
+void validate_shapes_for(const ShapeTable& shapes, const QueryOptions& options) {
+  if (options.precision != Precision::float32 || shapes.size() == 0) return;
+  if (shapes.smallest_size() >= kMinLengthFloat && shapes.largest_radius() <= kMaxLengthFloat) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "precision float32 answers shapes of sizes %g to %g m only (the table holds sizes down to %g m and "
+                "bounding radii up to %g m): use precision double",
+                kMinLengthFloat, kMaxLengthFloat, shapes.smallest_size(), shapes.largest_radius());
+  throw InputError(text);
+}
+
+void refuse_beyond_float_limits(const PairBatchView& batch, std::size_t begin, std::size_t end, PairResults& results) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const Eigen::Vector3d t = batch.translation_b[i] - batch.translation_a[i];
+    if (!((std::abs(t.x()) + std::abs(t.y())) + std::abs(t.z()) <= kMaxLengthFloat)) fill_pair_defaults(results, i);
+  }
+}
+
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
   if (!is_unit_quaternion(q)) return std::nullopt;
   return q.normalized();
@@ -69,10 +90,14 @@ void validate(const QueryOptions& o) {
   if (!std::isfinite(o.margin) || o.margin < 0.0) fail("margin must be a finite number >= 0");
   if (o.max_iterations < 1) fail("max_iterations must be >= 1");
   if (o.epa_max_iterations < 1) fail("epa_max_iterations must be >= 1");
-  if (o.threads < 0) fail("threads must be >= 0 (0 = all cores)");
+  if (o.threads < 0 || o.threads > kMaxThreads) {
+    fail("threads must be between 0 (all cores) and " + std::to_string(kMaxThreads) + ", got " +
+         std::to_string(o.threads));
+  }
   if (static_cast<int>(o.level) > static_cast<int>(QueryLevel::penetration)) fail("level is not a QueryLevel");
   if (static_cast<int>(o.solver) > static_cast<int>(Solver::automatic)) fail("solver is not a Solver");
   if (static_cast<int>(o.precision) > static_cast<int>(Precision::float32)) fail("precision is not a Precision");
+  if (static_cast<int>(o.isa) > static_cast<int>(InstructionSet::avx512)) fail("isa is not an InstructionSet");
 }
 
 }  // namespace batchcol

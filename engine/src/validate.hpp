@@ -13,6 +13,20 @@ void validate_batch_layout(const PairBatch& batch);
 /// Throws InputError when the arrays of `batch` have different lengths or a non-empty one has a null pointer.
 void validate_batch_layout(const PairBatchView& batch);
 
+/// Throws InputError when the table's shapes are beyond what `options.precision` can answer (float32: sizes and
+/// bounding radii within [kMinLengthFloat, kMaxLengthFloat]; double is guaranteed by the shape factories).
+void validate_shapes_for(const ShapeTable& shapes, const QueryOptions& options);
+
+/// The per-pair translation limit: |x| + |y| + |z| <= kMaxLength (NaN and infinite components fail), summed in
+/// this order as the SIMD kernels do (kernels/simd/wide_pairs.inl, load_pose).
+inline bool translation_in_range(const Eigen::Vector3d& t) {
+  return (std::abs(t.x()) + std::abs(t.y())) + std::abs(t.z()) <= kMaxLength;
+}
+
+/// Precision::float32: pairs [begin, end) whose relative translation exceeds kMaxLengthFloat (|x| + |y| + |z| of
+/// translation_b - translation_a) become invalid_input, whatever the float kernels computed for them.
+void refuse_beyond_float_limits(const PairBatchView& batch, std::size_t begin, std::size_t end, PairResults& results);
+
 /// The unit quaternion for `q`, or nothing when q is not finite or not unit within kUnitTolerance.
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q);
 

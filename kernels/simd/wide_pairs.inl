@@ -54,7 +54,7 @@ struct PairLanes {
   /// One side of W pairs: the world pose (q as given, with its norm) and the byte offset of the shape in the
   /// ShapeTable. `valid`: the executor's rule (detail::normalize_unit_quaternion in engine/src/validate.hpp, with
   /// the same norm): q finite with | |q| - 1 | <= kUnitTolerance (NaN and infinite components fail both
-  /// comparisons), t finite, shape index in range (out-of-range lanes read shape 0).
+  /// comparisons), t within the input limit, shape index in range (out-of-range lanes read shape 0).
   struct Pose {
     V3 t;
     real w, x, y, z, norm;
@@ -71,10 +71,11 @@ struct PairLanes {
     p.w = load<Consecutive>(q[0], idx), p.x = load<Consecutive>(q[1], idx), p.y = load<Consecutive>(q[2], idx),
     p.z = load<Consecutive>(q[3], idx);
     p.norm = wsqrt<double>(((p.w * p.w + p.x * p.x) + p.y * p.y) + p.z * p.z);
-    const real deviation = p.norm - splat(1.0), zero = splat(0.0);
-    // t - t is 0 for finite t and NaN otherwise, and a NaN makes the sum NaN: one comparison for three.
+    const real deviation = p.norm - splat(1.0);
+    // The translation limit (detail::translation_in_range): |x| + |y| + |z| <= kMaxLength, false for NaN and
+    // infinite components: one comparison for three.
     p.valid = (deviation <= splat(kUnitTolerance)) & (deviation >= splat(-kUnitTolerance)) &
-              (((p.t.x - p.t.x) + (p.t.y - p.t.y)) + (p.t.z - p.t.z) == zero);
+              (((abs(p.t.x) + abs(p.t.y)) + abs(p.t.z)) <= splat(kMaxLength));
     typedef std::uint32_t lanes32 __attribute__((vector_size(sizeof(std::uint32_t) * W)));
     lanes32 raw;
     if constexpr (Consecutive) {

@@ -93,12 +93,15 @@ TEST_F(StressCli, BadFlagsExitWithCode2AndAClearMessage) {
   } cases[] = {
       {"--objects 0", "--objects must be >= 1"},
       {"--objects -5", "--objects must be >= 1"},
-      {"--density nan", "--density must be a finite number > 0"},
-      {"--density -1", "--density must be a finite number > 0"},
-      {"--density 0", "--density must be a finite number > 0"},
+      {"--density nan", "--density must be a finite number >= 1e-6"},
+      {"--density -1", "--density must be a finite number >= 1e-6"},
+      {"--density 0", "--density must be a finite number >= 1e-6"},
+      {"--density 1e-300", "--density must be a finite number >= 1e-6 (got 1e-300)"},  // was an internal message
       {"--steps 0", "--steps must be >= 1"},
       {"--move -0.1", "--move must be a finite number in [0, 1]"},
-      {"--threads -2", "--threads must be >= 0"},
+      {"--threads -2", "--threads must be between 0 (all cores) and 1024"},
+      {"--threads 1025", "--threads must be between 0 (all cores) and 1024"},  // issue #16: 1e7 crashed TBB
+      {"--move 1e300", "--move must be a finite number in [0, 1] (got 1e+300)\n"},  // not 301 digits
       {"--distribution spiral", "--distribution spiral: unknown"},
       {"--query penetration", "--query penetration: unknown"},
       {"--objects ten", "--objects"},

@@ -167,7 +167,7 @@ Command add_accuracy_command(CLI::App& parent) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 28))
       ->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
+      ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
   app->add_option("--runs", s->runs, "Timed runs per configuration (the median is reported)")
       ->check(CLI::Range(3, 1000))

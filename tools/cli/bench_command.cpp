@@ -252,7 +252,7 @@ Command add_bench_command(CLI::App& parent) {
   app->add_option("--precision", s->precision, "double or float")->capture_default_str();
   app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean, else gjk)")->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
+      ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
   app->add_option("--pairs", s->pairs, "Pairs per case")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))

@@ -79,7 +79,7 @@ Command add_demo_command(CLI::App& parent) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))
       ->capture_default_str();
   app->add_option("--threads", settings->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
+      ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
   app->add_option("--query", settings->query, "boolean, distance, witness or penetration")->capture_default_str();
   app->add_option("--precision", settings->precision, "double or float")->capture_default_str();

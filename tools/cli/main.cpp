@@ -3,16 +3,21 @@
 
 #include <batchcol/errors.hpp>
 
+#include "printable.hpp"
+
 #include <algorithm>
 #include <exception>
+#include <new>
 #include <iostream>
 #include <string>
 #include <vector>
 
 namespace {
 
+// One line, whatever the message quotes (the parts quoting untrusted text already escape and shorten it; this is
+// the last guard): control characters escaped, at most 2000 bytes.
 int fail(const char* message) {
-  std::cerr << "batchcol: error: " << message << '\n';
+  std::cerr << "batchcol: error: " << batchcol::detail::printable(message, 2000) << '\n';
   return 2;
 }
 
@@ -32,7 +37,7 @@ int main(int argc, char** argv) {
     // CLI11 would only say "A subcommand is required" for a misspelt one.
     const auto named = [&](const batchcol::cli::Command& c) { return c.app->check_name(argv[1]); };
     if (argc > 1 && argv[1][0] != '-' && std::none_of(commands.begin(), commands.end(), named)) {
-      return fail((std::string("unknown subcommand '") + argv[1] + "' (valid: demo, query, bench, accuracy, stress, rays)").c_str());
+      return fail((std::string("unknown subcommand '") + batchcol::detail::printable(argv[1], 64) + "' (valid: demo, query, bench, accuracy, stress, descent, rays)").c_str());
     }
     try {
       app.parse(argc, argv);
@@ -46,6 +51,9 @@ int main(int argc, char** argv) {
     return fail("no subcommand given");
   } catch (const batchcol::InputError& e) {
     return fail(e.what());
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory: the input needs more memory than this machine can give (see \"Input limits\" in "
+                "the README for the sizes batchcol accepts)");
   } catch (const std::exception& e) {
     return fail(e.what());
   } catch (...) {

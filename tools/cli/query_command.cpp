@@ -112,7 +112,7 @@ Command add_query_command(CLI::App& parent) {
   s->margin_flag = app->add_option("--margin", s->margin, "Security margin in metres")
                         ->check(finite_non_negative());
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, std::numeric_limits<int>::max()));
+      ->check(CLI::Range(0, kMaxThreads));
   app->add_option("--derivatives", s->derivatives,
                   "Also differentiate w.r.t. the poses: analytic, smoothed0 or smoothed1 (needs --query witness or "
                   "penetration; adds the derivative columns)");

@@ -24,6 +24,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,13 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+// %g: std::to_string(1e300) prints 301 digits, to_string(1e-300) prints 0.000000.
+std::string shortest(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
 void check(bool ok, const std::string& message) {
   if (!ok) throw InputError(message);
 }
@@ -73,11 +81,14 @@ void validate(const StressSettings& s) {
   check(s.objects >= 1, "--objects must be >= 1 (got " + std::to_string(s.objects) + ")");
   check(s.objects < (std::int64_t{1} << 31), "--objects must be < 2^31");
   check(s.steps >= 1, "--steps must be >= 1 (got " + std::to_string(s.steps) + ")");
-  check(std::isfinite(s.density) && s.density > 0, "--density must be a finite number > 0 (got " +
-                                                        std::to_string(s.density) + ")");
+  // Below 1e-6 overlaps per object the scene's world grows without bound (1e-300 placed objects beyond the 1e30 m
+  // the scene accepts); such a scene has no pairs to measure anyway.
+  check(std::isfinite(s.density) && s.density >= 1e-6, "--density must be a finite number >= 1e-6 (got " +
+                                                           shortest(s.density) + ")");
   check(std::isfinite(s.move) && s.move >= 0 && s.move <= 1, "--move must be a finite number in [0, 1] (got " +
-                                                                  std::to_string(s.move) + ")");
-  check(s.threads >= 0, "--threads must be >= 0 (0 = all cores)");
+                                                                  shortest(s.move) + ")");
+  check(s.threads >= 0 && s.threads <= kMaxThreads,
+        "--threads must be between 0 (all cores) and " + std::to_string(kMaxThreads));
   check(s.query == "boolean" || s.query == "witness", "--query " + s.query + ": unknown (valid: boolean, witness)");
 }
 
@@ -187,7 +198,12 @@ int run_stress(const StressSettings& s) {
   const int threads = s.threads > 0 ? s.threads : tbb::info::default_concurrency();
 
   StressScene scene;
-  const double setup_ms = time_ms([&] { scene = make_stress_scene(spec); });
+  double setup_ms = 0.0;
+  try {
+    setup_ms = time_ms([&] { scene = make_stress_scene(spec); });
+  } catch (const std::bad_alloc&) {
+    throw InputError("--objects " + std::to_string(s.objects) + ": not enough memory for a scene of that many objects");
+  }
   SceneResults results;
   StageSamples warm, first;
   const Progress progress(s.steps);
@@ -304,7 +320,7 @@ Command add_stress_command(CLI::App& parent) {
       "stress", "Step a large scene of mixed shapes through broad + narrow phase and report per-stage times");
   app->add_option("--objects", s->objects, "Number of objects (>= 1)")->capture_default_str();
   app->add_option("--distribution", s->distribution, "uniform, clustered or layered")->capture_default_str();
-  app->add_option("--density", s->density, "Expected AABB overlaps per object (> 0)")->capture_default_str();
+  app->add_option("--density", s->density, "Expected AABB overlaps per object (>= 1e-6)")->capture_default_str();
   app->add_option("--steps", s->steps, "Steps (>= 1); the medians skip the first step when there are several")
       ->capture_default_str();
   app->add_option("--move", s->move, "Per step: translation as a fraction of the object size, rotation in radians")

@@ -68,6 +68,12 @@ const char* to_string(InstructionSet isa);
 /// What `requested` runs as on this machine (never `automatic`); throws InputError for a set the CPU lacks.
 InstructionSet resolve_instruction_set(InstructionSet requested = InstructionSet::automatic);
 
+/// Upper bound on QueryOptions::threads (validate() rejects more). Fixed rather than derived from the machine so a
+/// setting that validates on one machine validates on every other; 1024 is above the hardware threads of today's
+/// largest two-socket servers (oversubscribing beyond them cannot speed anything up), while oneTBB allocates a slot
+/// per requested thread at arena creation (~0.6 KB each: 10^6 threads took 619 MB, 10^7 crashed inside TBB).
+constexpr int kMaxThreads = 1024;
+
 struct QueryOptions {
   QueryLevel level = QueryLevel::witness;
   Solver solver = Solver::automatic;
@@ -79,13 +85,16 @@ struct QueryOptions {
   double tolerance = 1e-8;
   double relative_tolerance = 0.0;
   /// Security margin: a pair collides when its distance is <= margin (boolean queries stop once that is decided).
-  /// collide is conservative: false only when a separating plane beyond the margin is certified.
+  /// collide is conservative: false only when a separating plane beyond the margin is certified (GJK's lower bound
+  /// > margin), while `distance` is GJK's upper estimate. A converged pair may therefore report collide = 1 with a
+  /// distance above the margin by at most the effective tolerance max(tolerance, relative_tolerance * distance,
+  /// precision floor); collide = 0 always comes with a distance above the margin.
   double margin = 0.0;
   int max_iterations = 128;       // GJK iterations per pair
   int epa_max_iterations = 1000;  // EPA expansions per pair (near-concentric curved pairs need hundreds)
   bool closed_forms = true;       // analytic kernels for sphere/capsule pairs, sphere-box, box-box boolean
                                   // (halfspace pairs always use their closed form: they have no support function)
-  int threads = 0;                // 0 = all cores
+  int threads = 0;                // 0 = all cores, else 1..kMaxThreads
   InstructionSet isa = InstructionSet::automatic;
 };
 /// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic: in SIMD lanes straight
