@@ -105,32 +105,6 @@ template <class T> struct WideGjk {
     return gather_bytes(origin, start + i * Int(sizeof(Eigen::Vector3d)) + Int(c * sizeof(double)));
   }
 
-  // Float lanes in halves of Wide<double>::W lanes (one double register each): the offsets of a double gather and
-  // the converted values. Sized from the double width so that every type is a valid vector in every build.
-  static constexpr int Wd = Wide<double>::W;
-  using HalfIndex = wmask<double>;
-  typedef float HalfReal __attribute__((vector_size(4 * Wd)));
-  /// Vertex i[l] of lane l's hull (vertices start start[l] bytes after `origin`; lanes 0 .. W/2 in `lo`), float lanes.
-  static V3 vertex_f(const double* origin, HalfIndex lo, HalfIndex hi, mask i) {
-    return vertex_f(origin, lo, hi, i, std::make_index_sequence<std::size_t(W / 2)>{});
-  }
-  template <std::size_t... I>
-  static V3 vertex_f(const double* origin, HalfIndex lo, HalfIndex hi, mask i, std::index_sequence<I...>) {
-    constexpr std::size_t H = sizeof...(I);
-    const HalfIndex at_lo = lo + __builtin_convertvector(__builtin_shufflevector(i, i, I...), HalfIndex) *
-                                     std::int64_t(sizeof(Eigen::Vector3d));
-    const HalfIndex at_hi = hi + __builtin_convertvector(__builtin_shufflevector(i, i, (H + I)...), HalfIndex) *
-                                     std::int64_t(sizeof(Eigen::Vector3d));
-    real c[3];
-    for (int k = 0; k < 3; ++k) {
-      const std::int64_t component = std::int64_t(k * sizeof(double));
-      const HalfReal a = __builtin_convertvector(gather_bytes<double>(origin, at_lo + component), HalfReal);
-      const HalfReal b = __builtin_convertvector(gather_bytes<double>(origin, at_hi + component), HalfReal);
-      c[k] = __builtin_shufflevector(a, b, I..., (H + I)...);
-    }
-    return {c[0], c[1], c[2]};
-  }
-
   /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
   /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
   /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
@@ -179,32 +153,6 @@ template <class T> struct WideGjk {
         best_index = select(better, i_vec, best_index);
       }
       return {vertex_component(base[0], start, best_index, 0), vertex_component(base[0], start, best_index, 1), vertex_component(base[0], start, best_index, 2)};
-    } else if constexpr (sizeof(T) == 4 && W > 1) {
-      // Float lanes: each half of the lanes is one gather of doubles with 64-bit byte offsets (the vertices are
-      // stored in double), converted to float as gather<T>() converts (round to nearest): 6 gathers per vertex
-      // instead of 3 W scalar loads, conversions and lane inserts.
-      HalfIndex start_lo{}, start_hi{};
-      mask final_index{};
-      const auto origin = reinterpret_cast<std::uintptr_t>(base[0]);
-      for (int l = 0; l < W; ++l) {
-        const auto offset = std::int64_t(reinterpret_cast<std::uintptr_t>(base[l]) - origin);
-        if (l < W / 2) start_lo[l] = offset;
-        else start_hi[l - W / 2] = offset;
-        final_index[l] = Int(last[l]);
-      }
-      mask i_vec = splat_mask(0);
-      V3 v = vertex_f(base[0], start_lo, start_hi, i_vec);
-      real best = (v.x * d.x + v.y * d.y) + v.z * d.z;
-      mask best_index = i_vec;
-      for (std::uint32_t i = 1; i < most; ++i) {
-        i_vec = wmin(splat_mask(Int(i)), final_index);  // a repeated vertex never wins a strict '>'
-        v = vertex_f(base[0], start_lo, start_hi, i_vec);
-        const real di = (v.x * d.x + v.y * d.y) + v.z * d.z;
-        const mask better = di > best;
-        best = select(better, di, best);
-        best_index = select(better, i_vec, best_index);
-      }
-      return vertex_f(base[0], start_lo, start_hi, best_index);
     } else {
       real best = dot_at(base, index, d);
       mask best_index = splat_mask(0);
