@@ -57,8 +57,11 @@ void build_start_vertices(ConvexHull& hull) {
         d[(axis + 1) % 3] = -1.0 + (cu + 0.5) * step;
         d[(axis + 2) % 3] = -1.0 + (cv + 0.5) * step;
         std::uint32_t best = 0;
-        for (std::uint32_t i = 1; i < hull.vertices.size(); ++i)
-          if (hull.vertices[i].dot(d) > hull.vertices[best].dot(d)) best = i;
+        double best_dot = hull.vertices[0].dot(d);
+        for (std::uint32_t i = 1; i < hull.vertices.size(); ++i) {
+          const double di = hull.vertices[i].dot(d);
+          if (di > best_dot) best = i, best_dot = di;
+        }
         hull.start_vertices[(face * kHullStartGrid + cu) * kHullStartGrid + cv] = best;
       }
   }

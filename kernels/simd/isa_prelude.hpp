@@ -15,4 +15,3 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
-#include <utility>
