@@ -1,5 +1,5 @@
 // The wide-type layer: W lanes of float or double as GCC/Clang vector extensions (one register on AVX2 / AVX-512,
-// W = 1 for the scalar build), with the masks, select, min/max, sqrt, fused multiply-add and gathers the kernels
+// W = 1 for the scalar build), with the masks, select, min/max, sqrt and gathers the kernels
 // need. Kernels are written once against these types and compiled once per instruction set (see isa_*.cpp).
 //
 // No include guard on purpose: each instruction-set translation unit includes this file once, inside its own
@@ -38,21 +38,6 @@ template <class T> inline wreal<T> wsqrt(wreal<T> a) {
   }
 }
 
-/// a * b + c with one rounding. The GJK path does not use it: the scalar reference is compiled without
-/// contraction and the wide kernels must repeat its roundings exactly.
-template <class T> inline wreal<T> fmadd(wreal<T> a, wreal<T> b, wreal<T> c) {
-  constexpr int bytes = int(sizeof(wreal<T>));
-  if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 8) return _mm256_fmadd_pd(a, b, c);
-  else if constexpr (BATCHCOL_SIMD_BYTES == 32 && bytes == 32 && sizeof(T) == 4) return _mm256_fmadd_ps(a, b, c);
-  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 8) return _mm512_fmadd_pd(a, b, c);
-  else if constexpr (BATCHCOL_SIMD_BYTES == 64 && bytes == 64 && sizeof(T) == 4) return _mm512_fmadd_ps(a, b, c);
-  else {
-    wreal<T> r = a;
-    for (int l = 0; l < Wide<T>::W; ++l) r[l] = std::fma(a[l], b[l], c[l]);
-    return r;
-  }
-}
-
 /// Bit l set when lane l of m is true.
 template <class M> inline std::uint32_t lane_bits(M m) {
   constexpr int W = int(sizeof(M) / sizeof(m[0]));
@@ -87,14 +72,6 @@ template <class M> inline M mul_u32(M a, std::uint32_t b) {
 
 /// Lane-wise integer -> real.
 template <class T> inline wreal<T> to_real(wmask<T> i) { return __builtin_convertvector(i, wreal<T>); }
-
-/// r[l] = base[index[l] * stride + offset], converted to T: per-lane loads the compiler may turn into a gather.
-template <class T, class S> inline wreal<T> gather(const S* const* base, const std::uint32_t* index, int stride,
-                                                   int offset) {
-  wreal<T> r{};
-  for (int l = 0; l < Wide<T>::W; ++l) r[l] = T(base[l][std::size_t(index[l]) * stride + offset]);
-  return r;
-}
 
 /// r[l] = *(base + byte_offset[l]) for double lanes: one hardware gather on AVX2 / AVX-512 (offsets are byte
 /// distances from `base`, computed through uintptr_t, so lanes may read from different allocations).

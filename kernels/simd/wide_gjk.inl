@@ -43,16 +43,22 @@ template <class T> struct WideGjk {
   }
 
   // ---- Support functions of the cores, W lanes of one shape type (kernels/support.hpp) ----
+  /// Rows of the small-hull table: hulls below kHillClimbMinVertices fit.
+  static constexpr int kSmallRows = int(kHillClimbMinVertices) - 1;
   struct Side {
     ShapeType type = ShapeType::sphere;
     real s0{}, s1{}, s2{};                 // ShapeCore::size
     real tri[9]{};                         // triangle vertices
     const ConvexHull* hull[W] = {};
     SupportHint hint[W] = {};
-    // Per-lane hull facts cached at refill (a support call reads them instead of chasing each lane's hull).
-    const double* first_vertex[W] = {};  // hull->vertices.front().data()
-    std::uint32_t vertex_count[W] = {};
     std::uint32_t small = 0;  // lanes whose hull has fewer than kHillClimbMinVertices vertices (linear scan)
+    // Small hulls, lane-interleaved: row i holds vertex i of every lane's hull (as T), so a support scans its
+    // rows with one wide load per coordinate instead of W gathers. A lane's rows past its own vertex count
+    // repeat its last vertex (never a strict improvement: the reference's first-maximum rule is kept). `rows`
+    // only grows within a run; lanes are padded up to it when it grows.
+    int rows = 0;
+    std::uint32_t lane_vertices[W] = {};  // vertex count of the lane's current hull (0: never loaded a hull)
+    real vx[kSmallRows], vy[kSmallRows], vz[kSmallRows];  // written before read: rows [0, rows) of loaded lanes
   };
 
   static V3 support(Side& s, const V3& d, std::uint32_t live) {
@@ -94,21 +100,10 @@ template <class T> struct WideGjk {
     return {zero, zero, zero};
   }
 
-  // (Helpers taking or returning vectors are member functions, not lambdas: GCC does not give lambdas the
-  // `#pragma GCC target` of their region, which would compile them without AVX.)
-  static real dot_at(const double* const* base, const std::uint32_t* at, const V3& d) {
-    return (gather<T>(base, at, 3, 0) * d.x + gather<T>(base, at, 3, 1) * d.y) + gather<T>(base, at, 3, 2) * d.z;
-  }
-
-  /// Component c of vertex i[l] of lane l's hull, whose vertices start `start[l]` bytes after `origin` (double).
-  static real vertex_component(const double* origin, mask start, mask i, int c) {
-    return gather_bytes(origin, start + i * Int(sizeof(Eigen::Vector3d)) + Int(c * sizeof(double)));
-  }
-
-  /// Hull support for W lanes. When every live lane's hull is small, all lanes scan their vertices together
-  /// (vertex i of each lane's hull loaded per lane, dot products and the running argmax in SIMD); otherwise each lane
-  /// runs the scalar hull_support (linear scan or hill climbing with its hint). Both keep the reference's rule: the
-  /// first vertex with the largest dot product wins.
+  /// Hull support for W lanes. When every live lane's hull is small, the lanes scan the lane-interleaved rows
+  /// together (dot products and the running argmax in SIMD, no gathers); otherwise each lane runs the scalar
+  /// hull_support (hill climbing with its hint). Both keep the reference's rule: the first vertex with the
+  /// largest dot product wins, with the reference's dot product (dot3's association, in T).
   static V3 hull_support_lanes(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
     V3 r{zero, zero, zero};
@@ -123,49 +118,44 @@ template <class T> struct WideGjk {
       }
       return r;
     }
-    std::uint32_t most = 0;
-    const double* base[W];
-    std::uint32_t last[W], index[W];
-    const int first_live = __builtin_ctz(live);
-    for (int l = 0; l < W; ++l) {
-      const int from = (live >> l & 1u) ? l : first_live;  // idle lanes scan a live lane's hull
-      base[l] = s.first_vertex[from];
-      last[l] = s.vertex_count[from] - 1;
-      most = std::max(most, s.vertex_count[from]);
-      index[l] = 0;
+    r = {s.vx[0], s.vy[0], s.vz[0]};
+    real best = (r.x * d.x + r.y * d.y) + r.z * d.z;
+    for (int i = 1; i < s.rows; ++i) {
+      const real x = s.vx[i], y = s.vy[i], z = s.vz[i];
+      const real di = (x * d.x + y * d.y) + z * d.z;
+      const mask better = di > best;
+      best = select(better, di, best);
+      r = pick(better, V3{x, y, z}, r);
     }
-    if constexpr (sizeof(T) == 8 && W > 1) {
-      // Double lanes: vertex i of every lane's hull in three hardware gathers (byte offsets from lane 0's hull).
-      mask start{}, final_index{};
-      const auto origin = reinterpret_cast<std::uintptr_t>(base[0]);
-      for (int l = 0; l < W; ++l) {
-        start[l] = Int(reinterpret_cast<std::uintptr_t>(base[l]) - origin);
-        final_index[l] = Int(last[l]);
+    return r;
+  }
+
+  /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
+  /// more vertices than `rows`, the other lanes are padded up to the new row count first.
+  static void load_small_hull(Side& s, int l, const ConvexHull& hull) {
+    const int count = int(hull.vertices.size());
+    // Lane l of row i is element i * W + l of each coordinate array (rows are W contiguous lanes).
+    T* x = reinterpret_cast<T*>(s.vx);
+    T* y = reinterpret_cast<T*>(s.vy);
+    T* z = reinterpret_cast<T*>(s.vz);
+    if (count > s.rows) {
+      for (int o = 0; o < W; ++o) {
+        if (o == l) continue;
+        const int last = int(s.lane_vertices[o]) - 1;
+        const int from = last >= 0 ? s.rows : 0;  // a never-loaded lane gets zero rows
+        const T px = last >= 0 ? x[last * W + o] : T(0), py = last >= 0 ? y[last * W + o] : T(0),
+                pz = last >= 0 ? z[last * W + o] : T(0);
+        for (int i = from; i < count; ++i) x[i * W + o] = px, y[i * W + o] = py, z[i * W + o] = pz;
       }
-      mask i_vec = splat_mask(0);
-      real best = (vertex_component(base[0], start, i_vec, 0) * d.x + vertex_component(base[0], start, i_vec, 1) * d.y) + vertex_component(base[0], start, i_vec, 2) * d.z;
-      mask best_index = i_vec;
-      for (std::uint32_t i = 1; i < most; ++i) {
-        i_vec = wmin(splat_mask(Int(i)), final_index);  // a repeated vertex never wins a strict '>'
-        const real di = (vertex_component(base[0], start, i_vec, 0) * d.x + vertex_component(base[0], start, i_vec, 1) * d.y) + vertex_component(base[0], start, i_vec, 2) * d.z;
-        const mask better = di > best;
-        best = select(better, di, best);
-        best_index = select(better, i_vec, best_index);
-      }
-      return {vertex_component(base[0], start, best_index, 0), vertex_component(base[0], start, best_index, 1), vertex_component(base[0], start, best_index, 2)};
-    } else {
-      real best = dot_at(base, index, d);
-      mask best_index = splat_mask(0);
-      for (std::uint32_t i = 1; i < most; ++i) {
-        for (int l = 0; l < W; ++l) index[l] = std::min(i, last[l]);  // a repeated vertex never wins a strict '>'
-        const real di = dot_at(base, index, d);
-        const mask better = di > best;
-        best = select(better, di, best);
-        best_index = select(better, splat_mask(Int(i)), best_index);
-      }
-      for (int l = 0; l < W; ++l) index[l] = std::uint32_t(best_index[l]);
-      return {gather<T>(base, index, 3, 0), gather<T>(base, index, 3, 1), gather<T>(base, index, 3, 2)};
+      s.rows = count;
     }
+    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "vertices are packed xyz triples");
+    const double* v = hull.vertices.front().data();
+    for (int i = 0; i < count; ++i) x[i * W + l] = T(v[3 * i]), y[i * W + l] = T(v[3 * i + 1]), z[i * W + l] = T(v[3 * i + 2]);
+    const int last = count - 1;
+    for (int i = count; i < s.rows; ++i)
+      x[i * W + l] = x[last * W + l], y[i * W + l] = y[last * W + l], z[i * W + l] = z[last * W + l];
+    s.lane_vertices[l] = std::uint32_t(count);
   }
 
   // ---- Projection of the origin on a simplex (kernels/simplex_projection.hpp) ----
@@ -418,10 +408,10 @@ template <class T> struct WideGjk {
     if (s.type == ShapeType::convex) {
       s.hull[l] = c.hull;
       s.hint[l] = SupportHint{};
-      s.first_vertex[l] = c.hull->vertices.front().data();
-      s.vertex_count[l] = std::uint32_t(c.hull->vertices.size());
       const std::uint32_t bit = 1u << l;
-      s.small = c.hull->vertices.size() < kHillClimbMinVertices ? s.small | bit : s.small & ~bit;
+      const bool small = c.hull->vertices.size() < kHillClimbMinVertices;
+      s.small = small ? s.small | bit : s.small & ~bit;
+      if (small) load_small_hull(s, l, *c.hull);
     }
   }
 
