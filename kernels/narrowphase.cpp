@@ -4,11 +4,20 @@
 #include "kernels/epa.hpp"
 #include "kernels/gjk.hpp"
 #include "kernels/point_depth.hpp"
+#include "kernels/simd/wide_gjk.hpp"
 
 #include <type_traits>
 
 namespace batchcol::kernels {
 namespace {
+
+/// GJK on one setup: the production wide kernel at width 1 (the scalar instruction set's build), so a pair that
+/// comes through here gets the same algorithm, and the same bits, as a lane of the SIMD batches.
+template <class T> GjkResult<T> run_gjk(const PairSetup<T>& s) {
+  GjkResult<T> g;
+  simd::gjk_lanes<T>(InstructionSet::scalar, &s, 1, &g, s.params.solver, true);
+  return g;
+}
 
 bool is_point_or_segment(ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; }
 
@@ -261,7 +270,8 @@ PairOutput<float> redo_in_double(const PairSetup<float>& s, const GjkResult<floa
   p.boolean_only = s.params.boolean_only;
   p.core_margin = s.params.core_margin;
   p.touch_tolerance = d.floor;
-  const GjkResult<double> gd = gjk(d.difference(), Vec3<double>(g.x.cast<double>()), p);
+  d.initial_direction = g.x.cast<double>();
+  const GjkResult<double> gd = run_gjk(d);
   PairOutput<double> o = complete_pair(d, gd, opt);
   // Its stall is judged by what float promises (2 float floors), not by double's own limits.
   const double float_limit = std::max(double(s.params.tolerance), kStallFloors * double(s.floor));
@@ -286,7 +296,7 @@ PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_i
                          const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
   const PairSetup<T> s = setup_pair<T>(a, b, b_in_a, warm_direction, opt);
   if (s.done) return s.out;
-  return complete_pair(s, gjk(s.difference(), s.initial_direction, s.params), opt);
+  return complete_pair(s, run_gjk(s), opt);
 }
 
 template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const RelativePose&,

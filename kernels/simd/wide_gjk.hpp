@@ -19,7 +19,7 @@ bool cpu_has(InstructionSet isa);
 int lane_count(InstructionSet isa, Precision precision);
 
 /// Runs GJK on setups[0 .. n) with results in out[0 .. n): every setup must need GJK (done == false) and all must
-/// have the same shape types. Each result is bitwise the scalar gjk()'s on the same setup. With `points` false
+/// have the same shape types. Each result is bitwise the test reference's (tests/support/reference_gjk.hpp) on the same setup. With `points` false
 /// the simplex keeps only w = a - b (enough below QueryLevel::witness, and cheaper): its a and b come back NaN.
 /// `solver` is the one the setups were made with (resolve_solver's answer; `automatic` throws).
 template <class T>

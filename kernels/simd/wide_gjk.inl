@@ -1,9 +1,10 @@
 // GJK / Nesterov / Polyak across SIMD lanes: one pair per lane, W pairs at once, lanes refilled with the next pair
 // as soon as theirs finishes (iteration counts differ from pair to pair).
 //   Gilbert, Johnson, Keerthi 1988 (GJK); Montanari, Petrinic, Barbieri 2017 (signed-volume projection);
-//   Montaut et al., RSS 2022 (Nesterov-accelerated GJK). The algorithm is kernels/gjk.hpp, line for line: every
-//   branch of the reference becomes a lane mask, and every arithmetic operation is repeated in the same order, so
-//   each lane's result is bitwise the reference's (tested lane by lane in tests/kernels/wide_gjk_test.cpp).
+//   Montaut et al., RSS 2022 (Nesterov-accelerated GJK). This is batchcol's only production GJK (the scalar
+//   instruction set runs it at width 1). tests/support/reference_gjk.hpp is a plain scalar transcription of it:
+//   every branch there is a lane mask here, every arithmetic operation is in the same order, so each lane's result
+//   is bitwise the reference's (tested lane by lane in tests/kernels/wide_gjk_test.cpp).
 //
 // No include guard: included once per instruction set by isa_*.cpp after wide.hpp, inside the ISA namespace.
 
@@ -158,7 +159,7 @@ template <class T> struct WideGjk {
     s.lane_vertices[l] = std::uint32_t(count);
   }
 
-  // ---- Projection of the origin on a simplex (kernels/simplex_projection.hpp) ----
+  // ---- Projection of the origin on a simplex (tests/support/reference_simplex_projection.hpp) ----
   struct Proj {
     V3 x;
     mask count;
@@ -497,7 +498,7 @@ template <class T> struct WideGjk {
     r.lower_bound = L.lower[l];
   }
 
-  /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp).
+  /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp's MinkowskiDifference::support).
   AI static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
     a = support(L.A, dir, live);
     const V3 m = neg(dir);

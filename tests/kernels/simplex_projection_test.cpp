@@ -2,14 +2,14 @@
 // minimum-norm point solved in long double, kept when its weights are non-negative. The step only considers
 // sub-simplices that keep the newest vertex p[n-1]: it must find the true closest point whenever that point's
 // support set contains p[n-1], and otherwise return a point of the simplex (or no candidate for a tetrahedron).
-#include "kernels/simplex_projection.hpp"
+#include "support/reference_simplex_projection.hpp"
 #include "support/generators.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 
-namespace batchcol::kernels {
+namespace batchcol::test_reference {
 namespace {
 
 using LVec = Eigen::Matrix<long double, 3, 1>;
@@ -138,4 +138,4 @@ TEST(SimplexProjection, FloatVersionStaysWithinFloatRounding) {
 }
 
 }  // namespace
-}  // namespace batchcol::kernels
+}  // namespace batchcol::test_reference

@@ -3,6 +3,7 @@
 // reference gjk()'s (status, iterations, simplex, x, lower bound, direction).
 #include "kernels/simd/wide_gjk.hpp"
 #include "support/generators.hpp"
+#include "support/reference_gjk.hpp"
 
 #include <gtest/gtest.h>
 
@@ -85,7 +86,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
       std::vector<kernels::GjkResult<T>> want;
       int lo = 1 << 30, hi = 0;
       for (const auto& s : setups) {
-        want.push_back(kernels::gjk(s.difference(), s.initial_direction, s.params));
+        want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
         lo = std::min(lo, want.back().iterations);
         hi = std::max(hi, want.back().iterations);
       }

@@ -1,4 +1,4 @@
-// Projection of the origin onto the convex hull of 1-4 points: the "fully corrective" step of GJK seen as
+// Reference for the tests (with reference_gjk.hpp). Projection of the origin onto the convex hull of 1-4 points: the "fully corrective" step of GJK seen as
 // Frank-Wolfe. Signed-volume sub-algorithm after Montanari, Petrinic, Barbieri, "Improving the GJK algorithm for
 // faster and more reliable distance queries between convex objects", ACM TOG 36(3), 2017: barycentric coordinates
 // are ratios of signed sub-volumes (sub-areas projected on the best-conditioned plane), so whenever the origin is
@@ -14,7 +14,9 @@
 
 #include <array>
 
-namespace batchcol::kernels {
+namespace batchcol::test_reference {
+
+using namespace batchcol::kernels;
 
 /// Closest point of a simplex to the origin as a convex combination of a subset of its vertices.
 template <class T> struct SimplexProjection {
@@ -145,4 +147,4 @@ template <class T> SimplexProjection<T> project_origin(const Vec3<T>* p, int n) 
   }
 }
 
-}  // namespace batchcol::kernels
+}  // namespace batchcol::test_reference
