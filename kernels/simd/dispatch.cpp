@@ -1,10 +1,12 @@
 // Run-time choice of the instruction set: the CPU's best (cpuid through __builtin_cpu_supports), lowered by the
-// environment variable BATCHCOL_ISA, or an explicit request checked against the CPU.
+// environment variable BATCHCOL_ISA, or an explicit request checked against the CPU; and the table of each set's
+// entry points.
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
+#include "batchcol/errors.hpp"
+
 #include <cstdlib>
-#include <stdexcept>
 #include <string>
 
 namespace batchcol::kernels::simd {
@@ -51,69 +53,84 @@ int lane_count(InstructionSet isa, Precision precision) {
   return precision == Precision::float32 ? bytes / 4 : bytes / 8;
 }
 
+namespace {
+
+/// The entry points of one instruction set's build. One table per set, filled at compile time; a call indexes it
+/// with the already resolved set (no per-call switch, no cpuid).
+struct IsaKernels {
+  decltype(&scalar::gjk_lanes_double) gjk_lanes_double;
+  decltype(&scalar::gjk_lanes_float) gjk_lanes_float;
+  decltype(&scalar::segment_pairs) segment_pairs;
+  decltype(&scalar::box_pairs_boolean) box_pairs_boolean;
+  decltype(&scalar::gjk_pairs_double) gjk_pairs_double;
+  decltype(&scalar::gjk_pairs_float) gjk_pairs_float;
+};
+#define BATCHCOL_ISA_TABLE(ns)                                                                               \
+  IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
+               &ns::gjk_pairs_double, &ns::gjk_pairs_float }
+// Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
+// same bits), scalar, avx2, avx512.
+constexpr IsaKernels kIsaKernels[] = {BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(avx2),
+                                      BATCHCOL_ISA_TABLE(avx512)};
+#undef BATCHCOL_ISA_TABLE
+static_assert(int(InstructionSet::avx512) == 3, "kIsaKernels is indexed by InstructionSet");
+
+const IsaKernels& kernels_of(InstructionSet isa) { return kIsaKernels[static_cast<int>(isa) & 3]; }
+
+void require_resolved(Solver solver) {
+  if (solver == Solver::automatic)
+    throw InputError("QueryOptions::solver: 'automatic' reached the GJK kernels unresolved (resolve_solver() first)");
+}
+
+}  // namespace
+
 template <>
 void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size_t n, GjkResult<double>* out,
                        Solver solver, bool points) {
-  if (solver == Solver::automatic) throw std::invalid_argument("gjk_lanes: resolve the solver first (resolve_solver)");
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_lanes_double(s, n, out, solver, points);
-    case InstructionSet::avx2: return avx2::gjk_lanes_double(s, n, out, solver, points);
-    default: return scalar::gjk_lanes_double(s, n, out, solver, points);
-  }
+  require_resolved(solver);
+  kernels_of(isa).gjk_lanes_double(s, n, out, solver, points);
 }
 
 template <>
 void gjk_lanes<float>(InstructionSet isa, const PairSetup<float>* s, std::size_t n, GjkResult<float>* out,
                       Solver solver, bool points) {
-  if (solver == Solver::automatic) throw std::invalid_argument("gjk_lanes: resolve the solver first (resolve_solver)");
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_lanes_float(s, n, out, solver, points);
-    case InstructionSet::avx2: return avx2::gjk_lanes_float(s, n, out, solver, points);
-    default: return scalar::gjk_lanes_float(s, n, out, solver, points);
-  }
+  require_resolved(solver);
+  kernels_of(isa).gjk_lanes_float(s, n, out, solver, points);
 }
 
 std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a, bool capsule_b,
                           const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                           const ResultView& out, std::uint32_t* fallback) {
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
-    case InstructionSet::avx2: return avx2::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
-    default: return scalar::segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
-  }
+  return kernels_of(isa).segment_pairs(in, capsule_a, capsule_b, pairs, n, query, out, fallback);
 }
 
 std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
                               const ResultView& out, std::uint32_t* fallback) {
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::box_pairs_boolean(in, pairs, n, out, fallback);
-    case InstructionSet::avx2: return avx2::box_pairs_boolean(in, pairs, n, out, fallback);
-    default: return scalar::box_pairs_boolean(in, pairs, n, out, fallback);
-  }
+  return kernels_of(isa).box_pairs_boolean(in, pairs, n, out, fallback);
 }
 
 template <>
 std::size_t gjk_pairs<double>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                               const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                               const ResultView& out, std::uint32_t* fallback) {
-  if (options.solver == Solver::automatic) throw std::invalid_argument("gjk_pairs: resolve the solver first (resolve_solver)");
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
-    default: return scalar::gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
-  }
+  require_resolved(options.solver);
+  return kernels_of(isa).gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
 }
 
 template <>
 std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a, ShapeType b,
                              const std::uint32_t* pairs, std::size_t n, const QueryOptions& options,
                              const ResultView& out, std::uint32_t* fallback) {
-  if (options.solver == Solver::automatic) throw std::invalid_argument("gjk_pairs: resolve the solver first (resolve_solver)");
-  switch (isa) {
-    case InstructionSet::avx512: return avx512::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
-    case InstructionSet::avx2: return avx2::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
-    default: return scalar::gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
-  }
+  require_resolved(options.solver);
+  return kernels_of(isa).gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
+}
+
+InstructionSet capped_instruction_set(InstructionSet best, const char* cap) {
+  if (cap == nullptr || *cap == '\0') return best;
+  for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512})
+    if (std::string(cap) == to_string(isa)) return static_cast<int>(isa) < static_cast<int>(best) ? isa : best;
+  throw InputError("environment variable BATCHCOL_ISA='" + std::string(cap) +
+                   "' names no instruction set (valid: scalar, avx2, avx512)");
 }
 
 }  // namespace batchcol::kernels::simd
@@ -122,22 +139,15 @@ namespace batchcol {
 
 InstructionSet resolve_instruction_set(InstructionSet requested) {
   using kernels::simd::cpu_has;
+  // The CPU and the environment are read once per process (the first call), not on every collide().
+  static const InstructionSet detected = kernels::simd::detected_instruction_set();
   if (requested == InstructionSet::automatic) {
-    InstructionSet best = kernels::simd::detected_instruction_set();
-    if (const char* env = std::getenv("BATCHCOL_ISA"); env != nullptr && *env != '\0') {
-      InstructionSet cap = InstructionSet::automatic;
-      for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512})
-        if (std::string(env) == to_string(isa)) cap = isa;
-      if (cap == InstructionSet::automatic)
-        throw InputError("environment variable BATCHCOL_ISA='" + std::string(env) +
-                         "' names no instruction set (valid: scalar, avx2, avx512)");
-      if (static_cast<int>(cap) < static_cast<int>(best)) best = cap;
-    }
-    return best;
+    static const InstructionSet chosen = kernels::simd::capped_instruction_set(detected, std::getenv("BATCHCOL_ISA"));
+    return chosen;
   }
-  if (!cpu_has(requested))
+  if (static_cast<int>(requested) > static_cast<int>(detected))
     throw InputError(std::string("instruction set ") + to_string(requested) + " is not supported by this CPU (best: " +
-                     to_string(kernels::simd::detected_instruction_set()) + ")");
+                     to_string(detected) + ")");
   return requested;
 }
 

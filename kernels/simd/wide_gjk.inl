@@ -661,7 +661,7 @@ template <class T> struct WideGjk {
         ends_stall_overlap = stall & (xn <= T(2) * L.touch);
         ends_stall = stall & ~ends_stall_overlap;
         const mask moves = live & ~no_decrease;  // includes ends_contains: S = next, x = proj.x
-        const mask lagging = (xn - wsqrt<T>(next_xx) <= tol) | (L.stale >= splat_mask(4));
+        const mask lagging = (xn - wsqrt<T>(next_xx) <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
         L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
         for (int m = 0; m < 4; ++m) {
           mask from_q[4];

@@ -1,5 +1,6 @@
 // The batch executor: results in input order, bitwise identical for any thread count, per-pair statuses for bad
 // pairs, exceptions only for a malformed call, warm start.
+#include "kernels/simd/wide_gjk.hpp"
 #include "support/generators.hpp"
 #include "support/same_results.hpp"
 
@@ -86,21 +87,21 @@ TEST(Executor, BitwiseIdenticalForEveryInstructionSetThisCpuRuns) {
     }
 }
 
-// BATCHCOL_ISA lowers the automatic choice; a value naming no set is an input error.
+// BATCHCOL_ISA lowers the automatic choice; a value naming no set is an input error. The environment is read
+// once per process (resolve_instruction_set), so the rule is tested on the function that applies it.
 TEST(Executor, EnvironmentVariableLowersTheInstructionSet) {
-  const char* saved = std::getenv("BATCHCOL_ISA");
-  const std::string keep = saved ? saved : "";
-  unsetenv("BATCHCOL_ISA");
+  using kernels::simd::capped_instruction_set;
   const InstructionSet best = resolve_instruction_set();
   EXPECT_NE(best, InstructionSet::automatic);
-  setenv("BATCHCOL_ISA", "scalar", 1);
-  EXPECT_EQ(resolve_instruction_set(), InstructionSet::scalar);
-  setenv("BATCHCOL_ISA", "avx512", 1);  // a cap above the CPU's best leaves the best
-  EXPECT_EQ(resolve_instruction_set(), best);
-  setenv("BATCHCOL_ISA", "sse9", 1);
-  EXPECT_THROW(resolve_instruction_set(), InputError);
-  if (saved) setenv("BATCHCOL_ISA", keep.c_str(), 1);
-  else unsetenv("BATCHCOL_ISA");
+  EXPECT_EQ(capped_instruction_set(best, std::getenv("BATCHCOL_ISA")), best);  // what the first call applied
+  EXPECT_EQ(capped_instruction_set(InstructionSet::avx512, nullptr), InstructionSet::avx512);
+  EXPECT_EQ(capped_instruction_set(InstructionSet::avx512, ""), InstructionSet::avx512);
+  EXPECT_EQ(capped_instruction_set(InstructionSet::avx512, "scalar"), InstructionSet::scalar);
+  EXPECT_EQ(capped_instruction_set(InstructionSet::avx512, "avx2"), InstructionSet::avx2);
+  EXPECT_EQ(capped_instruction_set(InstructionSet::avx2, "avx512"), InstructionSet::avx2);  // a cap above the best
+  EXPECT_EQ(capped_instruction_set(InstructionSet::scalar, "avx2"), InstructionSet::scalar);
+  EXPECT_THROW(capped_instruction_set(InstructionSet::avx512, "sse9"), InputError);
+  EXPECT_THROW(capped_instruction_set(InstructionSet::avx512, "AVX2"), InputError);
 }
 
 TEST(Executor, ResultsComeBackInInputOrder) {

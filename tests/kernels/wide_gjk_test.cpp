@@ -137,7 +137,7 @@ TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   std::vector<kernels::GjkResult<double>> got(setups.size());
   EXPECT_THROW(kernels::simd::gjk_lanes<double>(InstructionSet::scalar, setups.data(), setups.size(), got.data(),
                                                 Solver::automatic),
-               std::invalid_argument);
+               InputError);
   // The batch-array entry point too: collide() resolves the solver once for every kernel.
   ShapeTable table;
   table.add(Shape::cylinder(0.1, 0.2));
@@ -150,7 +150,7 @@ TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   EXPECT_THROW(kernels::simd::gjk_pairs<double>(InstructionSet::scalar, kernels::simd::PairView::of(table, batch),
                                                 ShapeType::cylinder, ShapeType::cylinder, &pair, 1, options,
                                                 kernels::simd::ResultView::of(results), &fallback),
-               std::invalid_argument);
+               InputError);
 }
 
 TEST(WideGjk, RunsEverySetThisCpuHas) {
