@@ -1,6 +1,9 @@
 // Convex hulls through qhull's reentrant C library (Barber, Dobkin, Huhdanpaa, "The Quickhull algorithm for
 // convex hulls", ACM TOMS 1996). Option Qt triangulates the facets so every face is a triangle.
 #include "batchcol/shapes.hpp"
+#include "convex_hull_search.hpp"
+
+#include "batchcol/errors.hpp"
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -127,6 +130,41 @@ std::string describe_flat_points(const std::vector<Eigen::Vector3d>& points) {
 }
 
 }  // namespace
+
+std::shared_ptr<const ConvexHull> with_search_structures(std::shared_ptr<const ConvexHull> hull) {
+  const std::size_t nv = hull->vertices.size();
+  for (const auto& f : hull->faces)
+    for (const std::uint32_t i : f)
+      if (i >= nv) throw InputError("hull faces: vertex index " + std::to_string(i) + " of " + std::to_string(nv) + " vertices");
+  // The adjacency the supports climb on must be the faces' (a wrong edge makes hill climbing stop at a vertex that
+  // is not the maximiser): derived from them here, and a given one must be the same.
+  ConvexHull derived;
+  derived.faces = hull->faces;
+  derived.vertices.resize(nv);
+  build_adjacency(derived);
+  const bool has_adjacency = !hull->neighbor_offsets.empty() || !hull->neighbors.empty();
+  if (has_adjacency && (hull->neighbor_offsets != derived.neighbor_offsets || hull->neighbors != derived.neighbors))
+    throw InputError("hull neighbors: the vertex adjacency does not match the faces' edges");
+  bool complete = has_adjacency && hull->start_vertices.size() == kHullStartCells;
+  for (const std::uint32_t v : hull->start_vertices) complete = complete && v < nv;
+  if (complete) {  // the blocks must be the adjacency's, in build_neighbor_blocks' layout
+    ConvexHull blocks;
+    blocks.vertices = hull->vertices;
+    blocks.neighbor_offsets = hull->neighbor_offsets;
+    blocks.neighbors = hull->neighbors;
+    build_neighbor_blocks(blocks);
+    complete = blocks.neighbor_block_offsets == hull->neighbor_block_offsets &&
+               blocks.neighbor_block_index == hull->neighbor_block_index &&
+               blocks.neighbor_block_xyz == hull->neighbor_block_xyz;
+  }
+  if (complete) return hull;
+  auto full = std::make_shared<ConvexHull>(*hull);
+  full->neighbor_offsets = std::move(derived.neighbor_offsets);
+  full->neighbors = std::move(derived.neighbors);
+  build_neighbor_blocks(*full);
+  build_start_vertices(*full);
+  return full;
+}
 
 std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
                                                       const std::string& what) {

@@ -1,4 +1,5 @@
 #include "batchcol/shapes.hpp"
+#include "convex_hull_search.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -88,7 +89,7 @@ Shape Shape::convex(std::shared_ptr<const ConvexHull> hull) {
   }
   Shape s;
   s.type = ShapeType::convex;
-  s.hull = std::move(hull);
+  s.hull = with_search_structures(std::move(hull));
   return s;
 }
 

@@ -4,6 +4,7 @@
 namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 
 #include "kernels/simd/wide.hpp"
+#include "kernels/hull_support.inl"
 #include "kernels/simd/wide_gjk.inl"
 #include "kernels/simd/wide_pairs.inl"
 #include "kernels/simd/wide_segments.inl"

@@ -112,7 +112,8 @@ template <class T> struct WideGjk {
     if (live & ~s.small) {
       for (int l = 0; l < W; ++l) {
         if (!(live >> l & 1u)) continue;
-        const Vec3<T> p = hull_support(*s.hull[l], Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
+        const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support(*s.hull[l],  // this set's build, not ADL's kernels::
+                                                       Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
         r.x[l] = p.x();
         r.y[l] = p.y();
         r.z[l] = p.z();

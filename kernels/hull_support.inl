@@ -1,0 +1,115 @@
+// Support of a convex hull: a linear scan for small hulls, hill climbing over the vertex adjacency for large ones.
+//
+// No include guard: kernels/support.hpp includes it in namespace batchcol::kernels (the scalar paths: EPA, the
+// tests' reference GJK) and kernels/simd/isa_body.inl once more inside each instruction set's namespace, where the
+// wide GJK's large-hull lanes call it compiled for that set. Both copies are this text, so they compute the same
+// bits. No lambdas here: GCC does not give a lambda the `#pragma GCC target` of its region.
+
+/// The cell of the hull's direction table (ConvexHull::start_vertices) that direction d falls in, or kNoHullVertex
+/// when d has no direction (zero, NaN). The table is a cube map: d's largest component picks one of 6 faces, the
+/// other two divided by it pick one of kHullStartGrid^2 cells. A climb started from the support vertex of the
+/// cell's centre direction is a few moves from the answer; started from vertex 0 it crossed half the hull.
+template <class T> inline std::uint32_t start_cell_index(T c, T k, T half) {
+  // c / major in [-1, 1] -> [0, kHullStartGrid); NaN -> 0
+  const T f = c * k + half;
+  return f >= T(1) ? (f < T(kHullStartGrid) ? std::uint32_t(f) : kHullStartGrid - 1) : 0u;
+}
+template <class T> inline std::uint32_t start_cell(const Vec3<T>& d) {
+  const T x = d.x(), y = d.y(), z = d.z();
+  const T ax = std::abs(x), ay = std::abs(y), az = std::abs(z);
+  // The face: the largest |component| (first of equals), its sign; u, v: the next two components cyclically.
+  std::uint32_t face = ay > ax ? 2u : 0u;
+  T major = ay > ax ? ay : ax, u = ay > ax ? z : y, v = ay > ax ? x : z;
+  if (az > major) face = 4u, major = az, u = x, v = y;
+  if (!(major > T(0))) return kNoHullVertex;  // zero, or NaN (every comparison false)
+  face += (face == 0u ? x : face == 2u ? y : z) < T(0) ? 1u : 0u;
+  const T k = T(0.5 * kHullStartGrid) / major, half = T(0.5 * kHullStartGrid);
+  return (face * kHullStartGrid + start_cell_index(u, k, half)) * kHullStartGrid + start_cell_index(v, k, half);
+}
+
+/// Four neighbours' dot products with d at once (a block of ConvexHull::neighbor_block_xyz): GCC vector types, one
+/// register on AVX2 / AVX-512, two SSE registers on the baseline; each lane is dot3's arithmetic in T.
+template <class T> struct HullBlock;
+template <> struct HullBlock<double> {
+  typedef double V __attribute__((vector_size(32)));
+  static void load(const double* p, V& v) { std::memcpy(&v, p, sizeof v); }
+};
+template <> struct HullBlock<float> {
+  typedef float V __attribute__((vector_size(16)));
+  typedef double D __attribute__((vector_size(32)));
+  static void load(const double* p, V& v) {  // (by reference: a vector return value would change the ABI)
+    D w;
+    std::memcpy(&w, p, sizeof w);
+    v = __builtin_convertvector(w, V);  // T(p[j]), rounded to nearest as the scalar conversion
+  }
+};
+
+template <class T> inline T hull_dot(const ConvexHull& hull, std::uint32_t i, const Vec3<T>& d) {
+  const double* p = hull.vertices[i].data();
+  return (T(p[0]) * d.x() + T(p[1]) * d.y()) + T(p[2]) * d.z();
+}
+
+template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d, SupportHint& hint) {
+  const auto& v = hull.vertices;
+  std::uint32_t best = 0;
+  constexpr std::uint32_t B = ConvexHull::kNeighborBlock;
+  static_assert(B == 4, "HullBlock computes four dot products at once");
+  // Small hulls, and a hull without its blocks (Shape::convex builds them for every hull it accepts), are scanned.
+  if (v.size() < kHillClimbMinVertices || hull.neighbor_block_offsets.size() != v.size() + 1) {
+    T best_dot = hull_dot(hull, 0, d);
+    for (std::uint32_t i = 1; i < v.size(); ++i) {
+      const T di = hull_dot(hull, i, d);
+      if (di > best_dot) { best_dot = di; best = i; }
+    }
+    return v[best].template cast<T>();
+  }
+  // Hill climbing: on a convex polytope a vertex no neighbour improves on is a global maximiser. The strict '>'
+  // guarantees termination (the dot product increases at every move).
+  // Start from the better of the previous support vertex and the direction table's vertex: GJK's directions
+  // swing by up to 180 degrees in the first iterations, and a climb from the previous vertex then crosses the
+  // hull, while the table's vertex is within a cell (~14 degrees) of the answer.
+  best = hint.vertex < v.size() ? hint.vertex : 0;
+  T best_dot = hull_dot(hull, best, d);
+  if (hull.start_vertices.size() == kHullStartCells) {
+    const std::uint32_t c = start_cell(d);
+    if (c != kNoHullVertex && hull.start_vertices[c] < v.size()) {
+      const std::uint32_t t = hull.start_vertices[c];
+      const T dt = hull_dot(hull, t, d);
+      if (hint.vertex >= v.size() || dt > best_dot) best = t, best_dot = dt;
+    }
+  }
+  // Steepest ascent a block of neighbours at a time: the first neighbour with the largest dot product, taken when
+  // it beats the current vertex strictly. The block's four dot products are one vector expression; only a block
+  // with a neighbour above the current vertex (the rare case: most blocks visited do not improve) is looked at
+  // lane by lane, with the sequential first-maximum rule.
+  using Block = HullBlock<T>;
+  const typename Block::V dx = {d.x(), d.x(), d.x(), d.x()}, dy = {d.y(), d.y(), d.y(), d.y()},
+                          dz = {d.z(), d.z(), d.z(), d.z()};
+  const std::uint32_t* offsets = hull.neighbor_block_offsets.data();
+  const std::uint32_t* index = hull.neighbor_block_index.data();
+  const double* xyz = hull.neighbor_block_xyz.data();
+  for (bool moved = true; moved;) {
+    moved = false;
+    const std::uint32_t from = best;
+    for (std::uint32_t b = offsets[from]; b < offsets[from + 1]; ++b) {
+      const double* p = xyz + 3 * B * b;
+      typename Block::V x, y, z;
+      Block::load(p, x);
+      Block::load(p + B, y);
+      Block::load(p + 2 * B, z);
+      const typename Block::V dots = (x * dx + y * dy) + z * dz;
+      const auto above = dots > best_dot;
+      if (!(above[0] | above[1] | above[2] | above[3])) continue;
+      T top = dots[0];
+      for (std::uint32_t j = 1; j < B; ++j) top = dots[j] > top ? dots[j] : top;
+      if (!(top > best_dot)) continue;  // dots[0] is NaN: the sequential rule never moves
+      std::uint32_t j = 0;
+      while (!(dots[j] == top)) ++j;  // top is one of dots[] and not NaN (it beat best_dot)
+      best_dot = top;
+      best = index[B * b + j];
+      moved = true;
+    }
+  }
+  hint.vertex = best;
+  return v[best].template cast<T>();
+}
