@@ -1,5 +1,6 @@
 // Support functions against the extent formula h(d) = max <x, d> written from the shape definitions
 // (tests/support/generators.cpp), and hill climbing on large hulls against a linear scan.
+#include "batchcol/errors.hpp"
 #include "kernels/support.hpp"
 #include "support/generators.hpp"
 
@@ -7,7 +8,9 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <set>
+#include <string>
 
 namespace batchcol::kernels {
 namespace {
@@ -63,6 +66,42 @@ TEST(Support, ClimbsFromTheDirectionTableEqualALinearScan) {
       EXPECT_NE(hint.vertex, kNoHullVertex);
     }
   }
+}
+
+TEST(Support, HandBuiltHullsGetTheirSearchStructures) {
+  // A hull built by hand (vertices and faces only, as a user or an unpickled Python table gives it) gets its
+  // adjacency, neighbour blocks and direction table from Shape::convex, so its supports climb like a qhull hull's;
+  // an adjacency that contradicts the faces is refused, naming the field.
+  batchcol::testing::Rng rng(35);
+  const Shape full = Shape::convex(batchcol::testing::random_hull_points(rng, 300, 0.05, 0.4));
+  auto bare = std::make_shared<ConvexHull>();
+  bare->vertices = full.hull->vertices;
+  bare->faces = full.hull->faces;
+  bare->face_normals = full.hull->face_normals;
+  bare->centroid = full.hull->centroid;
+  bare->radius = full.hull->radius;
+  const Shape rebuilt = Shape::convex(bare);
+  EXPECT_EQ(rebuilt.hull->neighbors, full.hull->neighbors);
+  EXPECT_EQ(rebuilt.hull->neighbor_block_xyz, full.hull->neighbor_block_xyz);
+  EXPECT_EQ(rebuilt.hull->start_vertices, full.hull->start_vertices);
+  EXPECT_EQ(Shape::convex(full.hull).hull, full.hull);  // a complete hull is shared, not copied
+  const ShapeCore<double> a = make_core<double>(full), b = make_core<double>(rebuilt);
+  for (int q = 0; q < 500; ++q) {
+    const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+    SupportHint ha, hb;
+    EXPECT_EQ(support(a, d, ha), support(b, d, hb)) << "query " << q;
+  }
+  auto wrong = std::make_shared<ConvexHull>(*full.hull);
+  std::swap(wrong->neighbors.front(), wrong->neighbors.back());
+  try {
+    Shape::convex(wrong);
+    ADD_FAILURE() << "an adjacency that contradicts the faces was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hull neighbors"), std::string::npos) << e.what();
+  }
+  auto out_of_range = std::make_shared<ConvexHull>(*bare);
+  out_of_range->faces.front()[1] = std::uint32_t(bare->vertices.size());
+  EXPECT_THROW(Shape::convex(out_of_range), InputError);
 }
 
 TEST(Support, StartCellIsDefinedForEveryDirectionAndRefusesNone) {
