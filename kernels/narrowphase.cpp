@@ -4,6 +4,7 @@
 #include "kernels/epa.hpp"
 #include "kernels/gjk.hpp"
 #include "kernels/point_depth.hpp"
+#include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
 #include <type_traits>
@@ -327,6 +328,7 @@ namespace batchcol {
 const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
   kernels::RelativePose apart;
   apart.t = Eigen::Vector3d(1e3, 0, 0);  // the kernel depends on the types and options only, not on the pose
+  if (options.closed_forms && kernels::simd::is_point_solid_pair(a.type, b.type)) return "closed form";  // SIMD only
   const auto setup = kernels::setup_pair<double>(a, b, apart, Eigen::Vector3d::Zero(), options);
   return setup.done ? "closed form" : "gjk";
 }

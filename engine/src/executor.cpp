@@ -107,11 +107,13 @@ ShapeType type_a(std::size_t group) { return static_cast<ShapeType>(group / kSha
 ShapeType type_b(std::size_t group) { return static_cast<ShapeType>(group % kShapeTypeCount); }
 
 /// Which SIMD closed form answers a group of this shape-pair type, if any.
-enum class WideClosedForm { none, segments, boxes };
+enum class WideClosedForm { none, segments, boxes, point_solids };
 WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) {
   if (!options.closed_forms) return WideClosedForm::none;
   const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
   if (segment(type_a(group)) && segment(type_b(group))) return WideClosedForm::segments;
+  // A sphere's centre against a cylinder or cone: a 2D distance in the solid's section (wide_point_solids.inl).
+  if (kernels::simd::is_point_solid_pair(type_a(group), type_b(group))) return WideClosedForm::point_solids;
   // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
   if (type_a(group) == ShapeType::box && type_b(group) == ShapeType::box && options.level == QueryLevel::boolean &&
       options.margin == 0.0)
@@ -288,6 +290,10 @@ void run_tile(const ShapeTable& shapes, const PairBatchView& batch, const QueryO
     } else if (kind == WideClosedForm::segments) {
       fallbacks += kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule,
                                                 type_b(g) == ShapeType::capsule, pairs, count, query, results, left_out);
+    } else if (kind == WideClosedForm::point_solids) {
+      const bool sphere_a = type_a(g) == ShapeType::sphere;
+      const bool cone = (sphere_a ? type_b(g) : type_a(g)) == ShapeType::cone;
+      fallbacks += kernels::simd::point_solid_pairs(isa, view, sphere_a, cone, pairs, count, query, results, left_out);
     } else {
       fallbacks += kernels::simd::box_pairs_boolean(isa, view, pairs, count, results, left_out);
     }

@@ -20,6 +20,8 @@ namespace batchcol::kernels::simd {
                             const ClosedFormQuery&, const ResultView&, std::uint32_t*);                          \
   std::size_t box_pairs_boolean(const PairView&, const std::uint32_t*, std::size_t, const ResultView&,             \
                                 std::uint32_t*);                                                                 \
+  std::size_t point_solid_pairs(const PairView&, bool, bool, const std::uint32_t*, std::size_t,                    \
+                                const ClosedFormQuery&, const ResultView&, std::uint32_t*);                      \
   std::size_t gjk_pairs_double(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,           \
                                const QueryOptions&, const ResultView&, std::uint32_t*);                            \
   std::size_t gjk_pairs_float(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,            \
@@ -62,12 +64,13 @@ struct IsaKernels {
   decltype(&scalar::gjk_lanes_float) gjk_lanes_float;
   decltype(&scalar::segment_pairs) segment_pairs;
   decltype(&scalar::box_pairs_boolean) box_pairs_boolean;
+  decltype(&scalar::point_solid_pairs) point_solid_pairs;
   decltype(&scalar::gjk_pairs_double) gjk_pairs_double;
   decltype(&scalar::gjk_pairs_float) gjk_pairs_float;
 };
 #define BATCHCOL_ISA_TABLE(ns)                                                                               \
   IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
-               &ns::gjk_pairs_double, &ns::gjk_pairs_float }
+               &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float }
 // Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
 // same bits), scalar, avx2, avx512.
 constexpr IsaKernels kIsaKernels[] = {BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(avx2),
@@ -107,6 +110,12 @@ std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a
 std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
                               const ResultView& out, std::uint32_t* fallback) {
   return kernels_of(isa).box_pairs_boolean(in, pairs, n, out, fallback);
+}
+
+std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, bool cone,
+                              const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
+                              const ResultView& out, std::uint32_t* fallback) {
+  return kernels_of(isa).point_solid_pairs(in, sphere_a, cone, pairs, n, query, out, fallback);
 }
 
 template <>

@@ -9,6 +9,7 @@ namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 #include "kernels/simd/wide_pairs.inl"
 #include "kernels/simd/wide_segments.inl"
 #include "kernels/simd/wide_boxes.inl"
+#include "kernels/simd/wide_point_solids.inl"
 #include "kernels/simd/wide_gjk_pairs.inl"
 
 void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
@@ -36,6 +37,16 @@ std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, co
   if (capsule_a) return WideSegments::run<true, false>(in, pairs, n, query, out, fallback);
   if (capsule_b) return WideSegments::run<false, true>(in, pairs, n, query, out, fallback);
   return WideSegments::run<false, false>(in, pairs, n, query, out, fallback);
+}
+
+std::size_t point_solid_pairs(const PairView& in, bool sphere_a, bool cone, const std::uint32_t* pairs, std::size_t n,
+                              const ClosedFormQuery& query, const ResultView& out, std::uint32_t* fallback) {
+  if (sphere_a) {
+    return cone ? WidePointSolids::run<true, true>(in, pairs, n, query, out, fallback)
+                : WidePointSolids::run<true, false>(in, pairs, n, query, out, fallback);
+  }
+  return cone ? WidePointSolids::run<false, true>(in, pairs, n, query, out, fallback)
+              : WidePointSolids::run<false, false>(in, pairs, n, query, out, fallback);
 }
 
 std::size_t box_pairs_boolean(const PairView& in, const std::uint32_t* pairs, std::size_t n, const ResultView& out,

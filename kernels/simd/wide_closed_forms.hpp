@@ -25,4 +25,18 @@ std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a
 std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
                               const ResultView& out, std::uint32_t* fallback);
 
+/// Whether point_solid_pairs() answers pairs of these types: a sphere and a cylinder or cone, either order.
+inline bool is_point_solid_pair(ShapeType a, ShapeType b) {
+  const auto revolution = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; };
+  return (a == ShapeType::sphere && revolution(b)) || (b == ShapeType::sphere && revolution(a));
+}
+
+/// Sphere-cylinder and sphere-cone pairs (A is the sphere when `sphere_a`, the other side a cone when `cone`, else
+/// a cylinder; `pairs` ascending), at every query level: the sphere's centre against the solid of revolution in
+/// closed form (wide_point_solids.inl). Writes what segment_pairs writes; returns how many it left to the scalar
+/// path (invalid input, a centre on the solid's boundary to rounding), their indices in fallback[0 .. count).
+std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, bool cone,
+                              const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
+                              const ResultView& out, std::uint32_t* fallback);
+
 }  // namespace batchcol::kernels::simd

@@ -3,6 +3,7 @@
 // mapped to the world frame. Invalid pairs get invalid_input and NaN / 0 everywhere else.
 #include "kernels/math.hpp"
 #include "kernels/narrowphase.hpp"
+#include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 #include "support/generators.hpp"
 #include "support/same_results.hpp"
@@ -66,12 +67,13 @@ bool unit(double q[4]) {
 }
 
 /// Pairs the executor answers by a closed form when closed forms are on and that a scalar solve_pair() does not
-/// reproduce bit for bit (the SIMD closed forms work in the world frame): sphere/capsule pairs, and box-box at
-/// boolean level (the SAT kernel leaves the direction NaN).
+/// reproduce bit for bit (the SIMD closed forms work in the world frame): sphere/capsule pairs, sphere against
+/// cylinder or cone, and box-box at boolean level (the SAT kernel leaves the direction NaN).
 bool simd_closed_form(ShapeType a, ShapeType b, const QueryOptions& o) {
   const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
   if (!o.closed_forms) return false;
-  return (segment(a) && segment(b)) || (a == ShapeType::box && b == ShapeType::box && o.level == QueryLevel::boolean);
+  return (segment(a) && segment(b)) || (a == ShapeType::box && b == ShapeType::box && o.level == QueryLevel::boolean) ||
+         kernels::simd::is_point_solid_pair(a, b);  // sphere-cylinder, sphere-cone: tests/engine/point_solids_test.cpp
 }
 
 /// Entry i of a result array, NaN when the level left the array empty.
