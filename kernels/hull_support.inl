@@ -67,7 +67,7 @@ template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d
   // guarantees termination (the dot product increases at every move).
   // Start from the better of the previous support vertex and the direction table's vertex: GJK's directions
   // swing by up to 180 degrees in the first iterations, and a climb from the previous vertex then crosses the
-  // hull, while the table's vertex is within a cell (~14 degrees) of the answer.
+  // hull, while the table's vertex is within a cell (~7 degrees) of the answer.
   best = hint.vertex < v.size() ? hint.vertex : 0;
   T best_dot = hull_dot(hull, best, d);
   if (hull.start_vertices.size() == kHullStartCells) {

@@ -41,7 +41,7 @@ constexpr int kShapeTypeCount = 9;
 const char* to_string(ShapeType type);
 
 /// Cells per cube-face side of ConvexHull::start_vertices (kernels/support.hpp, start_cell).
-constexpr std::uint32_t kHullStartGrid = 8;
+constexpr std::uint32_t kHullStartGrid = 16;
 constexpr std::uint32_t kHullStartCells = 6 * kHullStartGrid * kHullStartGrid;
 constexpr std::uint32_t kNoHullVertex = 0xffffffffu;
 
