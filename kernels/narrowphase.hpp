@@ -68,24 +68,48 @@ PairOutput<T> complete_pair(const PairSetup<T>& setup, const GjkResult<T>& gjk, 
 /// tolerance is raised to this floor, since support values and |x| are only known to a few ulps of the scale.
 template <class T> T tolerance_floor(T scale) { return T(16) * machine_epsilon<T>() * scale; }
 
-/// The rest of a GJK setup once its cores and relative pose X are set: swept radii, scale (bounding radii of A
-/// and B plus |t|, in double), precision floor, parameters and first direction (`warm` when finite and non-zero,
-/// else the centre difference). Shared by setup_pair_into() and the batch-array GJK (simd/wide_gjk_pairs.inl).
+/// A pair's GJK numbers from plain values: swept radii, scale (bounding radii of A and B plus |t|, in double),
+/// precision floor, tolerances, margin. The one place they are computed: set_gjk_parameters() (the per-pair
+/// setup) and the batch-array GJK's lean lane setup (simd/wide_gjk_pairs.inl) both call it, so their bits agree.
+template <class T> struct GjkLimits {
+  T radii, scale, floor, tolerance, relative, core_margin, touch;
+  int max_iterations;
+  bool boolean_only;
+};
+template <class T>
+GjkLimits<T> gjk_limits(T radius_a, T radius_b, double bounding_a, double bounding_b, double t_norm,
+                        const QueryOptions& opt) {
+  GjkLimits<T> g;
+  g.radii = radius_a + radius_b;
+  g.scale = T(bounding_a + bounding_b + t_norm);
+  g.floor = tolerance_floor(g.scale);
+  g.tolerance = std::max(T(opt.tolerance), g.floor);
+  g.relative = T(opt.relative_tolerance);
+  g.max_iterations = opt.max_iterations;
+  g.boolean_only = opt.level == QueryLevel::boolean;
+  g.core_margin = T(opt.margin) + g.radii;
+  g.touch = g.floor;  // 16 ulps of the problem size
+  return g;
+}
+
+/// The rest of a GJK setup once its cores and relative pose X are set: gjk_limits(), the solver, the momentum
+/// normalisation and the first direction (`warm` when finite and non-zero, else the centre difference).
 template <class T>
 void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, double t_norm,
                         const Vec3<T>& warm, const QueryOptions& opt) {
-  s.radii = s.A.radius + s.B.radius;
-  s.scale = T(bounding_a + bounding_b + t_norm);
-  s.floor = tolerance_floor(s.scale);
+  const GjkLimits<T> g = gjk_limits(s.A.radius, s.B.radius, bounding_a, bounding_b, t_norm, opt);
+  s.radii = g.radii;
+  s.scale = g.scale;
+  s.floor = g.floor;
   GjkParams<T>& params = s.params;
   params.solver = resolve_solver(opt.solver, opt.level);
-  params.tolerance = std::max(T(opt.tolerance), s.floor);
-  params.relative_tolerance = T(opt.relative_tolerance);
-  params.max_iterations = opt.max_iterations;
-  params.boolean_only = opt.level == QueryLevel::boolean;
-  params.core_margin = T(opt.margin) + s.radii;
+  params.tolerance = g.tolerance;
+  params.relative_tolerance = g.relative;
+  params.max_iterations = g.max_iterations;
+  params.boolean_only = g.boolean_only;
+  params.core_margin = g.core_margin;
   params.normalize_momentum = !(s.A.strictly_convex() && s.B.strictly_convex());
-  params.touch_tolerance = s.floor;  // 16 ulps of the problem size
+  params.touch_tolerance = g.touch;
   const bool use_warm = warm.allFinite() && warm.squaredNorm() > T(0);
   s.initial_direction = use_warm ? warm : s.difference().center();
 }

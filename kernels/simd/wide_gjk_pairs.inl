@@ -119,8 +119,8 @@ template <class T> struct WideGjkPairs {
       return c.hull ? Vec3<T>(c.hull->centroid.template cast<T>()) : Vec3<T>::Zero();
     }
 
-    /// setup_pair_into() and set_gjk_parameters() for a pair without closed form or warm start, with their
-    /// arithmetic in their order, then WideGjk's start_lane().
+    /// setup_pair_into() and set_gjk_parameters() for a pair without closed form or warm start (the same
+    /// gjk_limits(), make_core's radii and centre arithmetic), then WideGjk's start_lane().
     bool load(Lanes& L, int l) {
       while (next == chunk.count) {
         if (read == n) return false;
@@ -135,17 +135,17 @@ template <class T> struct WideGjkPairs {
       for (int e = 0; e < 9; ++e) q.R[e] = T(chunk.R[e][s]);
       const double tx = chunk.t[0][s], ty = chunk.t[1][s], tz = chunk.t[2][s];
       q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
-      const T radii = radius_a + radius_b;
-      const T scale = T(in.bounding_radii[ia] + in.bounding_radii[ib] + std::sqrt((tx * tx + ty * ty) + tz * tz));
-      const T floor = tolerance_floor(scale);
-      q.tolerance = std::max(T(options.tolerance), floor);
-      q.relative = T(options.relative_tolerance);
-      q.max_iterations = options.max_iterations;
+      // |t| as norm3() computes it in setup_pair_into().
+      const GjkLimits<T> g = gjk_limits<T>(radius_a, radius_b, in.bounding_radii[ia], in.bounding_radii[ib],
+                                           std::sqrt((tx * tx + ty * ty) + tz * tz), options);
+      q.tolerance = g.tolerance;
+      q.relative = g.relative;
+      q.max_iterations = g.max_iterations;
       q.momentum = options.solver != Solver::gjk;
       q.normalize = normalize;
-      q.boolean_only = options.level == QueryLevel::boolean;
-      q.core_margin = T(options.margin) + radii;
-      q.touch = floor;
+      q.boolean_only = g.boolean_only;
+      q.core_margin = g.core_margin;
+      q.touch = g.touch;
       // MinkowskiDifference::center(): A's centre minus B's centre mapped into A's frame (mul()'s association).
       const Vec3<T> cb = center(q.B);
       const T* R = q.R;
@@ -161,7 +161,7 @@ template <class T> struct WideGjkPairs {
         for (int j = 0; j < 3; ++j) lp.Ra(i, j) = chunk.Ra[3 * i + j][s];
         lp.ta[i] = chunk.ta[i][s];
       }
-      lp.completion = {radius_a, radius_b, radii, scale, floor, q.tolerance, q.core_margin};
+      lp.completion = {radius_a, radius_b, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
       return true;
     }
 
