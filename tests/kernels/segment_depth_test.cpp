@@ -106,14 +106,15 @@ LD reference_core_depth(const Config& c, testing::Rng& rng) {
   return best;
 }
 
-/// Random segment through a random point inside A (so the cores overlap), partly or wholly inside.
-Config random_config(testing::Rng& rng, bool cone) {
+/// Random segment through a random point inside A (so the cores overlap), partly or wholly inside; `along_axis`:
+/// parallel to the axis, off it, short and wholly inside (the depth is then on the curved side or a cap).
+Config random_config(testing::Rng& rng, bool cone, bool along_axis = false) {
   Config c;
   c.cone = cone;
   c.R = testing::uniform(rng, 0.1, 1.0);
   c.h = testing::uniform(rng, 0.1, 1.0);
   c.radius = testing::uniform(rng, 0.01, 0.3);
-  const double z = testing::uniform(rng, -c.h + 1e-3, c.h - 1e-3);
+  const double z = testing::uniform(rng, -c.h + 1e-3, c.h - 1e-3) * (along_axis ? 0.8 : 1.0);
   const double max_rho = std::max(1e-4, (cone ? c.R * (c.h - z) / (2 * c.h) : c.R) - 1e-3);
   const double rho = testing::uniform(rng, 0.0, max_rho), phi = testing::uniform(rng, 0.0, 2 * M_PI);
   const Eigen::Vector3d centre(rho * std::cos(phi), rho * std::sin(phi), z);
@@ -122,8 +123,9 @@ Config random_config(testing::Rng& rng, bool cone) {
   const int kind = static_cast<int>(testing::uniform(rng, 0, 10));
   if (kind == 0) u = Eigen::Vector3d::UnitZ();
   if (kind == 1) u = Eigen::Vector3d(u.x(), u.y(), 0).normalized();
-  const double half = testing::uniform(rng, 0.01, 1.0);
-  const double t = testing::uniform(rng, -1.0, 1.0) * half;  // the centre's position along the segment
+  double half = testing::uniform(rng, 0.01, 1.0);
+  double t = testing::uniform(rng, -1.0, 1.0) * half;  // the centre's position along the segment
+  if (along_axis) u = Eigen::Vector3d::UnitZ(), half = 0.1 * c.h * testing::uniform(rng, 0.01, 1.0), t = 0;
   c.p0 = centre + (t - half) * u;
   c.p1 = centre + (t + half) * u;
   return c;
@@ -169,12 +171,12 @@ double boundary_offset(const Config& c, const Eigen::Vector3d& x) {
   return std::max(-c.h - x.z(), (2 * c.h * rho - c.R * (c.h - x.z())) / L);
 }
 
-TEST(SegmentDepth, CapsuleOverlappingCylinderOrConeConvergesToTheReference) {
-  testing::Rng rng(16);
+void check_capsules(std::uint64_t seed, bool along_axis, const char* what) {
+  testing::Rng rng(seed);
   double worst[2] = {0, 0}, worst_ahead = 0;
   for (bool cone : {false, true})
     for (int i = 0; i < 60; ++i) {
-      const Config c = random_config(rng, cone);
+      const Config c = random_config(rng, cone, along_axis);
       const double depth = double(reference_core_depth(c, rng)) + c.radius;
       for (Precision precision : {Precision::float64, Precision::float32})
         for (bool capsule_first : {false, true}) {
@@ -204,9 +206,17 @@ TEST(SegmentDepth, CapsuleOverlappingCylinderOrConeConvergesToTheReference) {
           EXPECT_LT((gap - r.r.distance * r.r.normal).norm(), bound);
         }
     }
-  std::printf("[measured] capsule in cylinder/cone, |depth - search| double %.3g m (engine ahead by up to %.3g m), "
-              "float %.3g m\n",
+  std::printf("[measured] %s, |depth - search| double %.3g m (engine ahead by up to %.3g m), float %.3g m\n", what,
               worst[0], worst_ahead, worst[1]);
+}
+
+
+TEST(SegmentDepth, CapsuleOverlappingCylinderOrConeConvergesToTheReference) {
+  check_capsules(16, false, "capsule overlapping cylinder/cone");
+}
+
+TEST(SegmentDepth, CapsuleInsideAlongTheAxisConvergesToTheReference) {
+  check_capsules(17, true, "capsule inside cylinder/cone along its axis");
 }
 
 }  // namespace
