@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace batchcol::kernels {
 
@@ -124,7 +125,8 @@ bool segment_depth_in_core(const ShapeCore<T>& core, const Vec3<T>& p0, const Ve
   const T d_len = d.norm();
   if (d_len > T(0)) {
     const Vec3<T> u = d / d_len;
-    // e1 is orthogonal to the axis and to d, e2 = u x e1 is z's projection on the plane orthogonal to d.
+    // e1 is orthogonal to the axis and to d, e2 = u x e1 is z's projection on the plane orthogonal to d (d along
+    // the axis: any e1, the rims are seen as circles).
     Vec3<T> e1 = z.cross(u);
     const T e1_len = e1.norm();
     e1 = e1_len > T(0) ? Vec3<T>(e1 / e1_len) : Vec3<T>::UnitX();
