@@ -4,6 +4,8 @@
 #include "kernels/epa.hpp"
 #include "kernels/gjk.hpp"
 #include "kernels/point_depth.hpp"
+#include "kernels/same_frame_depth.hpp"
+#include "kernels/segment_depth.hpp"
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
@@ -190,29 +192,99 @@ bool complete_from_gjk(const GjkCompletion<T>& c, const GjkResult<T>& g, const Q
   // distance estimate decides.
   if (g.status == GjkStatus::stalled) finish(out, opt, false, false);
   else finish(out, opt, true, !(g.lower_bound > c.core_margin));
-  return true;
+  // A degenerate stall is returned filled but unfinished: complete_pair() may answer it exactly (issue #16).
+  return out.status != Status::degenerate;
 }
 
 namespace {
 
-/// EPA's answer, in closed form, when one core is a point (a sphere) inside the other, a cylinder or cone core:
-/// the depth is the point's distance to that core's boundary. False for every other pair.
+/// point_depth_in_core(), or for a point on or a hair outside the core (GJK's overlap within its touch tolerance:
+/// 16 float ulps of the size in float), a negative depth: minus that distance (EPA would run on an origin on the
+/// boundary of D: it ended degenerate on sphere centres 1e-12 m outside a cylinder in float).
+template <class T> bool point_depth_in_core_or_on_it(const ShapeCore<T>& core, const Vec3<T>& p, PointDepth<T>& d) {
+  if (point_depth_in_core(core, p, d)) return true;
+  PointDistance<T> outside;
+  if (!point_distance_to_core(core, p, outside)) return false;
+  d.depth = -outside.distance;  // witness_a - witness_b = closest - p = depth * normal still holds
+  d.normal = outside.normal;
+  return true;
+}
+
+/// A sphere whose centre is a hair outside a cylinder or cone core: GJK stalls with an exact |x| but a certificate
+/// spoilt by x's direction (kernels/point_depth.hpp), measured up to 3.6e-5 m above the tolerance for centres 1e-12
+/// to 1e-10 m from the core, under every solver; the point's distance to the core, in closed form, replaces it.
+template <class T>
+bool point_core_distance(const PairSetup<T>& s, const GjkResult<T>& g, const QueryOptions& opt, PairOutput<T>& out) {
+  PointDistance<T> d;
+  Vec3<T> normal, on_a, on_b;  // unit from A to B; the cores' closest points (A's frame)
+  if (s.B.type == ShapeType::sphere) {
+    if (!point_distance_to_core(s.A, s.X.t, d)) return false;
+    normal = d.normal;
+    on_a = d.closest;
+    on_b = s.X.t;
+  } else if (s.A.type == ShapeType::sphere) {
+    if (!point_distance_to_core(s.B, mul_transposed(s.X.R, Vec3<T>(-s.X.t)), d)) return false;
+    normal = -mul(s.X.R, d.normal);
+    on_a = Vec3<T>::Zero();
+    on_b = s.X.apply(d.closest);
+  } else {
+    return false;
+  }
+  out = PairOutput<T>{};
+  out.status = Status::converged;
+  out.iterations = g.iterations;
+  out.direction = g.direction;
+  out.distance = d.distance - s.radii;
+  out.normal = normal;
+  out.witness_a = on_a + s.A.radius * normal;
+  out.witness_b = on_b - s.B.radius * normal;
+  finish(out, opt, false, false);
+  return true;
+}
+
+/// The same for a segment core (a capsule) and a cylinder or cone core.
+template <class T> bool segment_core_depth(const PairSetup<T>& s, EpaResult<T>& e) {
+  SegmentDepth<T> d;
+  if (s.B.type == ShapeType::capsule) {
+    const Vec3<T> end(T(0), T(0), s.B.size.y());  // B's segment, in A's frame
+    if (!segment_depth_in_core(s.A, s.X.apply(Vec3<T>(-end)), s.X.apply(end), d)) return false;
+    e.normal = d.normal;
+    e.witness_a = d.on_a;
+  } else if (s.A.type == ShapeType::capsule) {
+    const Vec3<T> end(T(0), T(0), s.A.size.y());  // A's segment, in B's frame
+    const auto to_b = [&](const Vec3<T>& x) { return mul_transposed(s.X.R, Vec3<T>(x - s.X.t)); };
+    if (!segment_depth_in_core(s.B, to_b(Vec3<T>(-end)), to_b(end), d)) return false;
+    e.normal = -mul(s.X.R, d.normal);
+    e.witness_a = s.X.apply(Vec3<T>(d.on_a - d.depth * d.normal));
+  } else {
+    return false;
+  }
+  e.depth = d.depth;
+  e.witness_b = e.witness_a - d.depth * e.normal;
+  e.status = EpaStatus::converged;
+  e.iterations = 0;
+  return true;
+}
+
+/// EPA's answer, in closed form, when one core is a point (a sphere) or a segment (a capsule) overlapping the
+/// other, a cylinder or cone core (kernels/point_depth.hpp, kernels/segment_depth.hpp), or for two ellipsoids in
+/// the same frame (kernels/same_frame_depth.hpp). False for every other pair.
 template <class T> bool point_core_depth(const PairSetup<T>& s, EpaResult<T>& e) {
   PointDepth<T> d;
   if (s.B.type == ShapeType::sphere) {
     const Vec3<T> p = s.X.t;  // B's point core, in A's frame
-    if (!point_depth_in_core(s.A, p, d)) return false;
+    if (!point_depth_in_core_or_on_it(s.A, p, d)) return false;
     e.normal = d.normal;  // from A to B: B leaves A through A's boundary
     e.witness_b = p;
     e.witness_a = p + d.depth * d.normal;
   } else if (s.A.type == ShapeType::sphere) {
     const Vec3<T> p = mul_transposed(s.X.R, Vec3<T>(-s.X.t));  // A's point core, in B's frame
-    if (!point_depth_in_core(s.B, p, d)) return false;
+    if (!point_depth_in_core_or_on_it(s.B, p, d)) return false;
     e.normal = -mul(s.X.R, d.normal);  // A leaves B through B's boundary: from A to B is against B's outward normal
     e.witness_a = Vec3<T>::Zero();
     e.witness_b = s.X.apply(Vec3<T>(p + d.depth * d.normal));
   } else {
-    return false;
+    return segment_core_depth(s, e) || same_frame_ellipsoids_depth(s.A, s.B, s.X, s.params.tolerance, e);
   }
   e.depth = d.depth;  // witness_a - witness_b = depth * normal, as EPA's
   e.status = EpaStatus::converged;
@@ -228,11 +300,14 @@ PairOutput<T> complete_pair(const PairSetup<T>& s, const GjkResult<T>& g, const 
                            s.params.core_margin};
   PairOutput<T> out;
   if (complete_from_gjk(c, g, opt, out)) return out;
+  if (g.status == GjkStatus::stalled && point_core_distance(s, g, opt, out)) return out;
   if (g.status != GjkStatus::overlap) {
     if constexpr (std::is_same_v<T, float>) return redo_in_double(s, g, opt);
+    else return out;  // a double stall above what the arithmetic certifies: degenerate (complete_from_gjk)
   }
   // Overlapping cores at QueryLevel::penetration: depth and witnesses by EPA, or in closed form for a sphere
-  // centred inside a cylinder or cone (where EPA converges too slowly: kernels/point_depth.hpp).
+  // centred inside, or a capsule overlapping, a cylinder or cone (where EPA converges too slowly:
+  // kernels/point_depth.hpp, kernels/segment_depth.hpp).
   EpaResult<T> e;
   if (!point_core_depth(s, e)) e = epa(s.difference(), g.simplex, s.params.tolerance, s.scale, opt.epa_max_iterations);
   out = PairOutput<T>{};

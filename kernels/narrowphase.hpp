@@ -52,9 +52,10 @@ template <class T> struct GjkCompletion {
   T radii = T(0), scale = T(0), floor = T(0), tolerance = T(0), core_margin = T(0);  // as in PairSetup
 };
 /// complete_pair() for every GJK ending that needs no cores, written into `out`; returns false (and the caller
-/// runs complete_pair on the full setup) for overlapping cores at QueryLevel::penetration (EPA) and for a float
-/// stall above 2 precision floors (redone in double). complete_pair() itself starts with this function, so both
-/// give the same bits.
+/// runs complete_pair on the full setup) for overlapping cores at QueryLevel::penetration (EPA), for a float
+/// stall above 2 precision floors (redone in double) and for a double stall above what the arithmetic certifies
+/// (`out` is then the degenerate answer, which complete_pair() replaces by a closed form where one applies).
+/// complete_pair() itself starts with this function, so both give the same bits.
 template <class T>
 bool complete_from_gjk(const GjkCompletion<T>& c, const GjkResult<T>& g, const QueryOptions& options,
                        PairOutput<T>& out);

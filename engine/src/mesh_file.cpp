@@ -4,7 +4,7 @@
 // Assimp is lenient with broken files and some of its readers crash or hang on them (found by tools/fuzz), so:
 // the path must be a readable, non-empty regular file with a supported extension; a binary STL must have exactly
 // 84 + 50 * count bytes and finite coordinates; a PLY file must hold exactly what its header declares (mesh_ply.cpp);
-// assimp opens files (an OBJ's material libraries) only when they are regular files; only the readers of the
+// assimp reads the mesh from memory and opens no file (not an OBJ's material libraries); only the readers of the
 // supported formats are registered; a COLLADA file's declared counts and index lists must fit its size
 // (check_collada); no assimp post-processing runs (its steps trust the file's face indices); every vertex must be
 // finite. Each problem is one InputError naming the file.
@@ -40,6 +40,7 @@
 #include <assimp/DefaultIOStream.h>
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/importerdesc.h>
 #include <assimp/scene.h>
 #endif
@@ -243,34 +244,31 @@ void keep_only_supported_readers(Assimp::Importer& importer) {
   }
 }
 
-/// Assimp opens more files than the one it is given (an OBJ's `mtllib` material libraries): one naming a FIFO blocked
-/// the load forever, a device could be read without end. This file system opens regular files only, for reading:
-/// open() with O_NONBLOCK cannot block on a FIFO, and fstat() on the open descriptor decides (no race with a rename).
+/// Assimp opens more files than the one it is given (an OBJ's `mtllib` material libraries, and `<mesh>.mtl` when
+/// one is missing): one naming a FIFO blocked the load forever, a device could be read without end, and assimp
+/// 5.2.5's material reader writes through a null pointer on a library whose first statement is a texture map before
+/// any `newmtl` (found by fuzzing; seed tools/fuzz/corpus/mesh/obj_mtl_texture_before_newmtl), also when the OBJ
+/// names itself as its library. Only points are used here, so assimp reads the mesh from our memory buffer under
+/// one reserved name, and this file system opens nothing else (assimp's own ReadFileFromMemory would not do: its
+/// file system answers every name that starts with its magic one, and the OBJ reader's fallback `<mesh>.mtl` does).
 /// A refused material library is a missing one to assimp's OBJ reader, which then uses its default material.
-class RegularFilesOnly final : public Assimp::DefaultIOSystem {
+class MeshInMemory final : public Assimp::DefaultIOSystem {
  public:
-  bool Exists(const char* file) const override {
-    struct stat info{};
-    return ::stat(file, &info) == 0 && S_ISREG(info.st_mode);
-  }
+  MeshInMemory(std::string name, const std::string& bytes) : name_(std::move(name)), bytes_(bytes) {}
+  bool Exists(const char* file) const override { return file != nullptr && name_ == file; }
   Assimp::IOStream* Open(const char* file, const char* mode) override {
-    if (mode == nullptr || mode[0] != 'r' || std::strchr(mode, '+') != nullptr) return nullptr;
-    const int fd = ::open(file, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) return nullptr;
-    struct stat info{};
-    FILE* stream = ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) ? ::fdopen(fd, "rb") : nullptr;
-    if (stream == nullptr) {
-      ::close(fd);
-      return nullptr;
-    }
-    return new Stream(stream, file);
+    if (file == nullptr || name_ != file || mode == nullptr || mode[0] != 'r') return nullptr;
+    return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(bytes_.data()), bytes_.size());
   }
 
  private:
-  struct Stream final : Assimp::DefaultIOStream {  // its FILE* constructor is protected
-    Stream(FILE* file, const std::string& name) : Assimp::DefaultIOStream(file, name) {}
-  };
+  std::string name_;
+  const std::string& bytes_;
 };
+
+/// The reserved name (plus the extension) the mesh is read under: a file that contains it is refused, so no
+/// `mtllib` can name the mesh itself.
+constexpr const char* kMemoryMeshName = "batchcol_mesh_in_memory";
 
 /// Every vertex of every mesh a node refers to, in the file's world frame (the node transforms composed from the
 /// root: COLLADA places meshes and carries its unit scale there), duplicates removed. Iterative: a deep node
@@ -333,12 +331,22 @@ std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path) {
 #ifdef BATCHCOL_HAVE_ASSIMP
   Assimp::Importer importer;
   keep_only_supported_readers(importer);
-  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
+  std::string bytes;
+  try {
+    bytes = read_bytes(path, size, what);
+  } catch (const std::bad_alloc&) {
+    throw InputError(what + ": the file (" + std::to_string(size) + " bytes) does not fit in memory");
+  }
+  if (bytes.find(kMemoryMeshName) != std::string::npos) {
+    throw InputError(what + ": the file contains the reserved name " + kMemoryMeshName);
+  }
+  const std::string name = kMemoryMeshName + extension;
+  importer.SetIOHandler(new MeshInMemory(name, bytes));  // the importer owns and deletes it
   // No post-processing: assimp's steps trust the face indices a broken file gives them (found by fuzzing). The node
   // transforms are applied below and duplicate points are removed before the hull.
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFile(path, 0);
+    scene = importer.ReadFile(name, 0);
   } catch (const std::exception& e) {  // e.g. std::bad_alloc on a header declaring billions of elements
     throw InputError(what + ": cannot read the mesh: " + e.what());
   }

@@ -144,10 +144,22 @@ TEST_F(MeshLimits, ObjMaterialLibraryThatIsAFifoIsNotOpened) {
     if (fd >= 0) ::close(fd);
   }
   EXPECT_EQ(load.get(), 4u);
-  // A regular material library next to it is still read (and does not change the points).
+  // A regular material library next to it is not read either (assimp reads no file but the mesh, from memory).
   fs::remove(dir_ / "materials.mtl");
   write("materials.mtl", "newmtl red\nKd 1 0 0\n");
   EXPECT_EQ(load_mesh_points(obj.string()).size(), 4u);
+}
+
+// Found by fuzzing (tools/fuzz, fuzz_mesh_file): assimp 5.2.5's material reader wrote through a null pointer (SEGV)
+// on a library whose first statement is a texture map, before any `newmtl`; also with the OBJ as its own library.
+TEST_F(MeshLimits, ObjMaterialLibrariesAreNeverReadByAssimp) {
+  const std::string body = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl red\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  write("material.mtl", "map_Kd texture.png\n");
+  EXPECT_EQ(load_mesh_points(write("tetra.obj", "mtllib material.mtl\n" + body).string()).size(), 4u);
+  EXPECT_EQ(load_mesh_points(write("self.obj", "mtllib self.obj\nmap_Kd t.png\n" + body).string()).size(), 4u);
+  // The name assimp reads the mesh under (from memory) is reserved: a mesh naming it is refused.
+  EXPECT_THAT(rejection(write("named.obj", "mtllib batchcol_mesh_in_memory.obj\nmap_Kd t.png\n" + body)),
+              HasSubstr("reserved name"));
 }
 
 }  // namespace
