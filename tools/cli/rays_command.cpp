@@ -1,7 +1,7 @@
 // `batchcol rays`: times ray queries. Scene mode: builds a scene (hulls or mixed primitives), times the LBVH build,
 // its refit after every object moved, and the rays per second of the query; with --peers, the same scene and rays in
 // Embree 3 (build and rays/s) and the agreement of the closest hits. Shape mode: rays against one posed shape each
-// (sphere, box, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
+// (sphere, box, capsule, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
 #include "cli/atomic_output.hpp"
 #include "cli/commands.hpp"
 #include "cli/portable_random.hpp"
@@ -189,11 +189,11 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < s.scene.hull_vertices; ++i) points.push_back(0.5 * rng.unit_vector());
   ShapeTable table;
-  const std::uint32_t ids[3] = {table.add(Shape::sphere(0.5)), table.add(Shape::box(0.4, 0.3, 0.2)),
-                                table.add(Shape::convex(points))};
-  const char* names[3] = {"sphere", "box", "hull"};
+  const std::uint32_t ids[4] = {table.add(Shape::sphere(0.5)), table.add(Shape::box(0.4, 0.3, 0.2)),
+                                table.add(Shape::capsule(0.25, 0.25)), table.add(Shape::convex(points))};
+  const char* names[4] = {"sphere", "box", "capsule", "hull"};
   nlohmann::json j = {{"mode", "shape"}, {"rays", s.rays}, {"threads", s.threads}, {"hull_vertices", s.scene.hull_vertices}};
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
     ShapeRayBatch batch;
     for (std::int64_t i = 0; i < s.rays; ++i) {
       const Pose pose{Eigen::Vector3d(rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)), rng.rotation()};
@@ -241,7 +241,7 @@ void print_text(const nlohmann::json& j) {
     return;
   }
   if (j["mode"] == "shape") {
-    for (const char* n : {"sphere", "box", "hull"})
+    for (const char* n : {"sphere", "box", "capsule", "hull"})
       for (const char* p : {"double", "float"})
         std::cout << n << ' ' << p << ": " << j[n][p]["rays_per_s"].get<double>() / 1e6 << " M rays/s (hit fraction "
                   << j[n][p]["hit_fraction"].get<double>() << ")\n";
@@ -285,7 +285,7 @@ int run_rays(const RaysSettings& s) {
 Command add_rays_command(CLI::App& parent) {
   auto s = std::make_shared<RaysSettings>();
   CLI::App* app = parent.add_subcommand("rays", "Time batched ray queries against a scene or posed shapes (Embree with --peers)");
-  app->add_option("--mode", s->mode, "scene or shape (rays against one posed sphere/box/hull each)")->capture_default_str();
+  app->add_option("--mode", s->mode, "scene or shape (rays against one posed sphere/box/capsule/hull each)")->capture_default_str();
   app->add_option("--objects", s->scene.objects, "Scene objects (>= 1)")->capture_default_str();
   app->add_option("--rays", s->rays, "Rays (>= 1)")->capture_default_str();
   app->add_option("--shapes", s->scene.shapes, "hull or mixed (spheres, capsules, boxes, cylinders)")->capture_default_str();
