@@ -34,12 +34,18 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
   // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
-  stack[top++] = {0u, 0.0f};
-  while (top > 0) {
-    const Entry e = stack[--top];
-    if (e.t > limit) continue;  // a closer hit was found since it was pushed
+  Entry e{0u, 0.0f};  // the root
+  // The next entry still within reach (a closer hit may have been found since it was pushed); false when none.
+  const auto pop = [&] {
+    do {
+      if (top == 0) return false;
+      e = stack[--top];
+    } while (e.t > limit);
+    return true;
+  };
+  for (;;) {
     if (e.ref & kLeafBit) {
-      if (!visit(context, e.ref & ~kLeafBit, limit)) return;
+      if (!visit(context, e.ref & ~kLeafBit, limit) || !pop()) return;
       continue;
     }
     const WideNode* n = nodes + e.ref;
@@ -53,9 +59,12 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     tf = min_into((load_at(n, r.far_offset[2]) - ofz) * iz, tf);
     tf = tf * scale + slack;
     std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
-    if (bits == 0) continue;
-    // Hit children sorted by entry, then pushed farthest first so the nearest is popped next. Ties keep the slot
-    // order (the sort is stable), so the order is a function of the node and the ray only.
+    if (bits == 0) {
+      if (!pop()) return;
+      continue;
+    }
+    // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
+    // keep the slot order (the sort is stable), so the order is a function of the node and the ray only.
     Entry hit[kWideArity];
     int count = 0;
     while (bits != 0) {
@@ -66,6 +75,7 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
       hit[j] = x;
     }
-    for (int j = count - 1; j >= 0; --j) stack[top++] = hit[j];
+    for (int j = count - 1; j >= 1; --j) stack[top++] = hit[j];
+    e = hit[0];  // the nearest child next, without a trip through the stack
   }
 }

@@ -96,16 +96,18 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
   RaysScene world = make_rays_scene(s.scene);
   const RayBatch rays = make_crossing_rays(s.rays, world.half_extent, s.scene.seed);
   RaySceneIndex index;
-  std::vector<double> build, boxes, refit;
+  std::vector<double> build, boxes, refit, collapse, wide_refit;
   for (int r = 0; r < s.runs; ++r) {
     index.update(*world.scene, s.threads, true);
     build.push_back(index.timings().total_ms);
     boxes.push_back(index.timings().boxes_ms);
+    collapse.push_back(index.timings().wide_ms);
   }
   for (int f = 0; f < s.frames; ++f) {
     move_objects(world, 0.01, s.scene.seed + 100 + f);
     index.update(*world.scene, s.threads);
     refit.push_back(index.timings().total_ms);
+    wide_refit.push_back(index.timings().wide_ms);
   }
   RayOptions options;
   options.query = query;
@@ -125,7 +127,9 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
                       {"batchcol",
                        {{"build_ms", median(build)},
                         {"build_boxes_ms", median(boxes)},
+                        {"build_wide_collapse_ms", median(collapse)},
                         {"refit_ms", median(refit)},
+                        {"refit_wide_ms", median(wide_refit)},
                         {"cast_ms", cast_ms},
                         {"rays_per_s", double(s.rays) / (cast_ms * 1e-3)}}}};
   if (query == RayQuery::all) j["all_hit_rows"] = all_rows;
