@@ -98,7 +98,9 @@ TEST(RayWideBvh, CollapseAndRefitKeepEveryLeafOnceInsideExactUnions) {
     bvh.build(b);
     WideBvh wide;
     wide.collapse(bvh, b);
-    if (n > 8) EXPECT_LE(wide.nodes().size() * 4, n);  // mostly full nodes (a binary tree has n - 1)
+    if (n > 8) {
+      EXPECT_LE(wide.nodes().size() * 4, n);  // mostly full nodes (a binary tree has n - 1)
+    }
     check_structure(wide, bvh, b);
     // Move every box, refit both trees: same topology, the new unions.
     const broadphase::AabbSoa moved = random_boxes(rng, n, 50.0, 2.0);
@@ -233,13 +235,17 @@ TEST(RayWideBvh, FloatTestIsTightAndTheSameOnEveryInstructionSet) {
       const double pad = 1e-5 * 100.0;
       const double wlo[3] = {lo[0] - pad, lo[1] - pad, lo[2] - pad}, whi[3] = {hi[0] + pad, hi[1] + pad, hi[2] + pad};
       const double nlo[3] = {lo[0] + pad, lo[1] + pad, lo[2] + pad}, nhi[3] = {hi[0] - pad, hi[1] - pad, hi[2] - pad};
-      if (in[leaf]) EXPECT_TRUE(slab_hits(wlo, whi, o, d, t_max * (1 + 1e-5))) << "leaf " << leaf;
-      else if (nlo[0] <= nhi[0] && nlo[1] <= nhi[1] && nlo[2] <= nhi[2])
+      if (in[leaf]) {
+        EXPECT_TRUE(slab_hits(wlo, whi, o, d, t_max * (1 + 1e-5))) << "leaf " << leaf;
+      } else if (nlo[0] <= nhi[0] && nlo[1] <= nhi[1] && nlo[2] <= nhi[2]) {
         EXPECT_FALSE(slab_hits(nlo, nhi, o, d, t_max * (1 - 1e-5))) << "leaf " << leaf;
+      }
     }
   }
   EXPECT_GT(visited, 1000u);  // rays do reach boxes
-  if (__builtin_cpu_supports("avx2")) EXPECT_GT(isa_runs, 0u);
+  if (__builtin_cpu_supports("avx2")) {
+    EXPECT_GT(isa_runs, 0u);
+  }
 }
 
 TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {

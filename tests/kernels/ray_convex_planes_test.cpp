@@ -67,7 +67,9 @@ TEST(RayConvexPlanes, EveryInstructionSetGivesTheSameBits) {
     check_hull<double>(h, rng, 2000, compared, entered, parallel);
     check_hull<float>(h, rng, 2000, compared, entered, parallel);
   }
-  if (__builtin_cpu_supports("avx2")) EXPECT_GT(compared, 10000);
+  if (__builtin_cpu_supports("avx2")) {
+    EXPECT_GT(compared, 10000);
+  }
   EXPECT_GT(entered, 5000);  // the rays do cross the hulls
   EXPECT_GT(parallel, 50);   // and the parallel-outside branch is exercised
 }

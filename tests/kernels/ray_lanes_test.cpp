@@ -122,7 +122,9 @@ TEST(RayLanes, EveryInstructionSetGivesTheScalarBits) {
       EXPECT_TRUE(same_bits(out.nx, ref.nx) && same_bits(out.ny, ref.ny) && same_bits(out.nz, ref.nz)) << "isa " << isa;
     }
   }
-  if (__builtin_cpu_supports("avx2")) EXPECT_GT(sets, 0);
+  if (__builtin_cpu_supports("avx2")) {
+    EXPECT_GT(sets, 0);
+  }
 }
 
 TEST(RayLanes, CastRaysIsTheSameAloneOrInARegisterAndMatchesTheGeneralKernels) {
@@ -179,8 +181,10 @@ TEST(RayLanes, CastRaysIsTheSameAloneOrInARegisterAndMatchesTheGeneralKernels) {
       ++hits;
       EXPECT_NEAR(full.t[i], h.t, tol * scale) << "ray " << i;
       const Eigen::Vector3d n = R * h.normal;
-      // Edges and corners have a cone of normals: compare only where the kernels' t is clearly on one face.
-      if (shape.type != ShapeType::box) EXPECT_LT((full.normal[i] - n).norm(), 1e3 * tol) << "ray " << i;
+      // Box edges and corners have a cone of normals (the kernels may pick different faces at a tie): not compared.
+      if (shape.type != ShapeType::box) {
+        EXPECT_LT((full.normal[i] - n).norm(), 1e3 * tol) << "ray " << i;
+      }
       EXPECT_NEAR(full.normal[i].norm(), 1.0, 10 * tol);
     }
     EXPECT_GT(compared, 2900);
