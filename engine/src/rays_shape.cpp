@@ -1,5 +1,6 @@
-// cast_rays(): rays against one posed shape each. Spheres, boxes and capsules run W rays per register straight from
-// the batch's arrays (kernels/rays/ray_lanes.hpp); a group of W rays that are not all valid and of one of those
+// cast_rays(): rays against one posed shape each. Spheres, boxes, capsules and (uninflated) hulls run W rays per
+// register straight from the batch's arrays (kernels/rays/ray_lanes.hpp; hulls only for the pose, then one lane at a
+// time through the scalar hull kernel); a group of W rays that are not all valid and of one of those
 // kinds goes ray by ray: through the same lane kernel with one lane (same bits), or, for the other shapes (and
 // invalid rays), moved into the shape's local frame (x_local = R^T (x - t)), intersected by the kernel of
 // kernels/rays/ray_shape.hpp, and its normal rotated back.
@@ -26,8 +27,10 @@ template <class T> using PreparedShapes = detail::PreparedRayShapes<T>;
 
 namespace kr = kernels::rays;
 
-kr::LaneShapeTable lane_shapes(const ShapeTable& table) {
+template <class T> kr::LaneShapeTable lane_shapes(const ShapeTable& table, const PreparedShapes<T>& prepared) {
   kr::LaneShapeTable t;
+  t.hull_d.assign(table.size(), nullptr);
+  t.hull_f.assign(table.size(), nullptr);
   for (std::size_t s = 0; s < table.size(); ++s) {
     const Shape& shape = table[s];
     const kernels::ShapeCore<double> core = kernels::make_core<double>(shape);
@@ -37,6 +40,11 @@ kr::LaneShapeTable lane_shapes(const ShapeTable& table) {
     if (shape.type == ShapeType::capsule) kind = kr::LaneKind::capsule, a = core.radius, b = core.size.y();
     if (shape.type == ShapeType::box && shape.inflation == 0.0)
       kind = kr::LaneKind::box, a = core.size.x(), b = core.size.y(), c = core.size.z();
+    if (shape.type == ShapeType::convex && shape.inflation == 0.0) {
+      kind = kr::LaneKind::hull, a = shape.bounding_radius();
+      if constexpr (std::is_same_v<T, double>) t.hull_d[s] = &prepared.planes[s];
+      else t.hull_f[s] = &prepared.planes[s];
+    }
     t.kind.push_back(kind), t.a.push_back(a), t.b.push_back(b), t.c.push_back(c);
   }
   return t;
@@ -88,7 +96,7 @@ template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& 
   const kernels::rays::RayGjkSettings gjk{o.tolerance, o.max_iterations};
   const kr::LaneCasts wide = kr::select_lane_casts(), single = kr::lane_casts_for(0);
   const bool dbl = std::is_same_v<T, double>;
-  const LaneContext lanes{lane_shapes(shapes),
+  const LaneContext lanes{lane_shapes(shapes, prepared),
                           {b.rays.origin.x.data(), b.rays.origin.y.data(), b.rays.origin.z.data(),
                            b.rays.direction.x.data(), b.rays.direction.y.data(), b.rays.direction.z.data(),
                            b.rays.t_max.data(), b.translation.x.data(), b.translation.y.data(),

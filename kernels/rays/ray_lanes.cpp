@@ -1,6 +1,7 @@
 // The lane kernels (ray_lanes.inl) compiled for AVX-512 (8 lanes of double; float lanes are the same 8 rays in half
 // a register, converted from the batch's double arrays), AVX2 (4 lanes) and scalar (1 lane).
 #include "kernels/rays/ray_lanes.hpp"
+#include "kernels/rays/ray_quadrics.hpp"
 
 #include <immintrin.h>
 
@@ -13,6 +14,28 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace batchcol::kernels::rays {
+namespace {
+
+// One hull lane in its local frame, exactly as ray_local() does it for an uninflated hull (bounding ball, polar
+// walk, all-plane clipping when the walk gives up). Compiled once, outside the instruction-set regions, and called
+// by every build: the same bits on every set.
+template <class T>
+__attribute__((noinline)) void hull_lane(const HullPlanes<T>& planes, double bound, const T o[3], const T d[3], T t_max,
+                                         T& enter, T nl[3]) {
+  const Vec3<T> vo(o[0], o[1], o[2]), vd(d[0], d[1], d[2]);
+  enter = infinity<T>();
+  const RayInterval<T> ball = ray_sphere(vo, vd, T(bound) * (T(1) + T(64) * machine_epsilon<T>()));
+  if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return;
+  LocalHit<T> h;
+  bool ok = false;
+  if (planes.walk.planes() > 0) h = ray_hull_walk(planes.walk, vo, vd, t_max, ok);
+  if (!ok) h = finish(ray_convex(vo, vd, planes), vd, t_max);
+  if (!h.hit) return;
+  enter = h.t;
+  nl[0] = h.normal.x(), nl[1] = h.normal.y(), nl[2] = h.normal.z();
+}
+
+}  // namespace
 
 // Helpers shared by the vector builds (templates: instantiated inside each target region, for its own set).
 #define BATCHCOL_LANE_VECTOR_HELPERS                                                                  \
@@ -25,6 +48,9 @@ namespace batchcol::kernels::rays {
   inline VF to_float(VD x) { return __builtin_convertvector(x, VF); }                                 \
   inline VD to_double(VF x) { return __builtin_convertvector(x, VD); }                                \
   inline void lane_set(VD& v, int l, double x) { v[l] = x; }                                          \
+  inline void lane_set(VF& v, int l, float x) { v[l] = x; }                                           \
+  inline double lane_get(VD v, int l) { return v[l]; }                                                \
+  inline float lane_get(VF v, int l) { return v[l]; }                                                 \
   inline VF float_up(VD t) {                                                                          \
     VF f = to_float(t);                                                                               \
     for (int l = 0; l < W; ++l) {                                                                     \
@@ -88,6 +114,9 @@ inline void stored(double* p, double v) { *p = v; }
 inline float to_float(double x) { return static_cast<float>(x); }
 inline double to_double(float x) { return x; }
 inline void lane_set(double& v, int, double x) { v = x; }
+inline void lane_set(float& v, int, float x) { v = x; }
+inline double lane_get(double v, int) { return v; }
+inline float lane_get(float v, int) { return v; }
 inline double lsqrt(double a) { return std::sqrt(a); }
 inline float lsqrt(float a) { return std::sqrt(a); }
 inline float float_up(double t) {

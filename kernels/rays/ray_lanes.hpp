@@ -1,4 +1,4 @@
-// Rays against posed spheres, boxes and capsules, W rays per register (the shape form of batchcol/rays.hpp, one pose
+// Rays against posed spheres, boxes, capsules and hulls, W rays per register (the shape form of batchcol/rays.hpp, one pose
 // per ray): the pose is read, validated and applied lane-wise straight from the batch's arrays, the exact
 // intersection (the same closed forms as ray_quadrics.hpp / ray_polytopes.hpp: closest-point quadratic, slabs,
 // capsule as the union of its balls and body) runs on whole registers, and the world-frame results are stored as
@@ -7,19 +7,26 @@
 // sqrt), so a ray's answer does not depend on which of them ran it or on its neighbours.
 #pragma once
 
+#include "kernels/rays/ray_polytopes.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 namespace batchcol::kernels::rays {
 
-enum class LaneKind : std::uint8_t { none = 0, sphere, box, capsule };
+enum class LaneKind : std::uint8_t { none = 0, sphere, box, capsule, hull };
 
-/// Per shape: its lane kind (none = not handled here: other types and inflated boxes) and its sizes: sphere (a =
-/// radius with inflation), box (a, b, c = half extents), capsule (a = radius with inflation, b = half length).
+/// Per shape: its lane kind (none = not handled here: other types, inflated boxes and hulls) and its sizes: sphere
+/// (a = radius with inflation), box (a, b, c = half extents), capsule (a = radius with inflation, b = half length),
+/// hull (a = bounding radius; its planes in the precision cast: hull_d or hull_f, owned by the caller). Hulls get
+/// the pose handling in registers and then, lane by lane, the scalar kernel of ray_shape.hpp (ball test, polar walk,
+/// clipping fallback).
 struct LaneShapeTable {
   std::vector<LaneKind> kind;
   std::vector<double> a, b, c;
+  std::vector<const HullPlanes<double>*> hull_d;
+  std::vector<const HullPlanes<float>*> hull_f;
 };
 
 /// The batch's arrays (SoA), read from ray index i on.

@@ -120,12 +120,16 @@ template <class T> bool cast(const LaneShapeTable& shapes, const LaneRays& r, st
   const std::size_t count = shapes.kind.size();
   LaneKind kind = LaneKind::none;
   double sa[W], sb[W], sc[W];
+  const HullPlanes<T>* hull[W];
   for (int l = 0; l < W; ++l) {
     const std::uint32_t s = r.shape[i + l];
     if (s >= count) return false;
     const LaneKind k = shapes.kind[s];
     if (k == LaneKind::none || (l > 0 && k != kind)) return false;
     kind = k, sa[l] = shapes.a[s], sb[l] = shapes.b[s], sc[l] = shapes.c[s];
+    if constexpr (std::is_same_v<T, double>) hull[l] = k == LaneKind::hull ? shapes.hull_d[s] : nullptr;
+    else hull[l] = k == LaneKind::hull ? shapes.hull_f[s] : nullptr;
+    if (k == LaneKind::hull && hull[l] == nullptr) return false;
   }
   // Validity (batchcol/rays.hpp), in double as the general path checks it.
   const VD ox = loadd(r.ox + i), oy = loadd(r.oy + i), oz = loadd(r.oz + i);
@@ -172,9 +176,25 @@ template <class T> bool cast(const LaneShapeTable& shapes, const LaneRays& r, st
             ldz = (m[6] * wx + m[7] * wy) + m[8] * wz;
     if (kind == LaneKind::box) {
       in = box(lox, loy, loz, ldx, ldy, ldz, A, B, C);
-    } else {
+    } else if (kind == LaneKind::capsule) {
       const V la = (ldx * ldx + ldy * ldy) + ldz * ldz;
       in = capsule(lox, loy, loz, ldx, ldy, ldz, la, A, B);
+    } else {
+      // Hulls: lane by lane through the scalar kernel; a hit becomes the interval [t, inf) (t = 0 from inside).
+      in.enter = splat<V>(INFINITY);
+      in.exit = -in.enter;  // empty unless the lane hits
+      in.nx = in.ny = in.nz = splat<V>(0.0);
+      for (int l = 0; l < W; ++l) {
+        const T o[3] = {lane_get(lox, l), lane_get(loy, l), lane_get(loz, l)};
+        const T d[3] = {lane_get(ldx, l), lane_get(ldy, l), lane_get(ldz, l)};
+        T enter, nl[3];
+        hull_lane<T>(*hull[l], sa[l], o, d, lane_get(t_max, l), enter, nl);
+        lane_set(in.enter, l, enter);
+        if (enter < infinity<T>()) {
+          lane_set(in.exit, l, infinity<T>());
+          lane_set(in.nx, l, nl[0]), lane_set(in.ny, l, nl[1]), lane_set(in.nz, l, nl[2]);
+        }
+      }
     }
     // Back to the world frame: R n.
     const V nx = (m[0] * in.nx + m[3] * in.ny) + m[6] * in.nz, ny = (m[1] * in.nx + m[4] * in.ny) + m[7] * in.nz,

@@ -1,4 +1,4 @@
-// The lane kernels of the shape form (kernels/rays/ray_lanes.*): every instruction set gives the scalar build's bits
+// The lane kernels of the shape form (kernels/rays/ray_lanes.*: spheres, boxes, capsules, hulls): every instruction set gives the scalar build's bits
 // for every ray, cast_rays gives the same bits whether a ray ran in a full register or alone (next to invalid
 // rays), and the answers agree with the general per-shape kernels (ray_local in the shape's frame), which the
 // sphere-tracing tests check against the shape definitions.
@@ -25,6 +25,15 @@ namespace kr = kernels::rays;
 struct World {
   ShapeTable table;
   ShapeRayBatch batch;
+  std::vector<kr::HullPlanes<double>> planes_d;  // per shape (empty for non-hulls)
+  std::vector<kr::HullPlanes<float>> planes_f;
+  void prepare() {
+    for (std::size_t s = 0; s < table.size(); ++s) {
+      const bool hull = table[s].type == ShapeType::convex;
+      planes_d.push_back(hull ? kr::make_hull_planes<double>(*table[s].hull) : kr::HullPlanes<double>{});
+      planes_f.push_back(hull ? kr::make_hull_planes<float>(*table[s].hull) : kr::HullPlanes<float>{});
+    }
+  }
 };
 
 // Spheres, boxes and capsules (plain and inflated spheres / capsules), posed at random, with rays from all around:
@@ -38,6 +47,7 @@ World make_world(Rng& rng, int n) {
     w.table.add(Shape::box(uniform(rng, 0.1, 1.0), uniform(rng, 0.1, 1.0), uniform(rng, 0.1, 1.0)));
     w.table.add(Shape::capsule(uniform(rng, 0.1, 0.6), uniform(rng, 0.1, 1.0)));
     w.table.add(Shape::capsule(uniform(rng, 0.1, 0.6), uniform(rng, 0.1, 1.0)).inflated(0.05));
+    w.table.add(Shape::convex(testing::random_hull_points(rng, k == 0 ? 12 : 250, 0.3, 1.0)));  // clip / walk
   }
   for (int i = 0; i < n; ++i) {
     // Runs of 8 rays on one shape so that full registers form; the shape changes between runs.
@@ -56,18 +66,26 @@ World make_world(Rng& rng, int n) {
     const double t_max = i % 4 == 0 ? uniform(rng, 0.2, 1.5) : std::numeric_limits<double>::infinity();
     w.batch.add(s, pose, o, d, t_max);
   }
+  w.prepare();
   return w;
 }
 
-kr::LaneShapeTable lane_table(const ShapeTable& table) {
+kr::LaneShapeTable lane_table(const World& w) {
   kr::LaneShapeTable t;
-  for (std::size_t s = 0; s < table.size(); ++s) {
-    const Shape& shape = table[s];
+  for (std::size_t s = 0; s < w.table.size(); ++s) {
+    const Shape& shape = w.table[s];
     const double r = shape.size.x() + shape.inflation;
-    if (shape.type == ShapeType::sphere) t.kind.push_back(kr::LaneKind::sphere), t.a.push_back(r), t.b.push_back(0);
-    else if (shape.type == ShapeType::capsule)
+    t.hull_d.push_back(nullptr), t.hull_f.push_back(nullptr);
+    if (shape.type == ShapeType::sphere) {
+      t.kind.push_back(kr::LaneKind::sphere), t.a.push_back(r), t.b.push_back(0);
+    } else if (shape.type == ShapeType::capsule) {
       t.kind.push_back(kr::LaneKind::capsule), t.a.push_back(r), t.b.push_back(shape.size.y());
-    else t.kind.push_back(kr::LaneKind::box), t.a.push_back(shape.size.x()), t.b.push_back(shape.size.y());
+    } else if (shape.type == ShapeType::convex) {
+      t.kind.push_back(kr::LaneKind::hull), t.a.push_back(shape.bounding_radius()), t.b.push_back(0);
+      t.hull_d.back() = &w.planes_d[s], t.hull_f.back() = &w.planes_f[s];
+    } else {
+      t.kind.push_back(kr::LaneKind::box), t.a.push_back(shape.size.x()), t.b.push_back(shape.size.y());
+    }
     t.c.push_back(shape.type == ShapeType::box ? shape.size.z() : 0.0);
   }
   return t;
@@ -88,7 +106,7 @@ TEST(RayLanes, EveryInstructionSetGivesTheScalarBits) {
   Rng rng(3);
   const World w = make_world(rng, 4096);
   const ShapeRayBatch& b = w.batch;
-  const kr::LaneShapeTable table = lane_table(w.table);
+  const kr::LaneShapeTable table = lane_table(w);
   const kr::LaneRays rays{b.rays.origin.x.data(), b.rays.origin.y.data(), b.rays.origin.z.data(),
                           b.rays.direction.x.data(), b.rays.direction.y.data(), b.rays.direction.z.data(),
                           b.rays.t_max.data(), b.translation.x.data(), b.translation.y.data(),
@@ -165,13 +183,15 @@ TEST(RayLanes, CastRaysIsTheSameAloneOrInARegisterAndMatchesTheGeneralKernels) {
       const Eigen::Matrix3d R = q.toRotationMatrix();
       const Eigen::Vector3d ol = R.transpose() * (b.rays.origin[i] - b.translation[i]);
       const Eigen::Vector3d dl = R.transpose() * b.rays.direction[i];
-      const kr::RayShape<double> rs = kr::make_ray_shape<double>(shape, nullptr);
+      const kr::RayShape<double> rs = kr::make_ray_shape<double>(shape, &w.planes_d[b.shape[i]]);
       const kr::LocalHit<double> h = kr::ray_local(rs, ol, dl, b.rays.t_max[i], kr::RayGjkSettings{1e-9, 64});
       const double scale = 1.0 + (b.rays.origin[i] - b.translation[i]).norm() / b.rays.direction[i].norm();
       if (h.hit != bool(full.hit[i])) {
         // Only a tangent ray or one ending at the surface (t = t_max within the tolerance) may disagree.
         const double t_any = h.hit ? h.t : full.t[i];
         const Eigen::Vector3d n = h.hit ? Eigen::Vector3d(R * h.normal) : full.normal[i];
+        ASSERT_TRUE(std::isfinite(t_any)) << "ray " << i;
+        ASSERT_NEAR(n.norm(), 1.0, 1e-5) << "ray " << i;
         const bool tangent = std::abs(n.dot(b.rays.direction[i].normalized())) < 1e-3;
         EXPECT_TRUE(tangent || std::abs(t_any - b.rays.t_max[i]) <= tol * scale) << "ray " << i;
         continue;
@@ -181,8 +201,9 @@ TEST(RayLanes, CastRaysIsTheSameAloneOrInARegisterAndMatchesTheGeneralKernels) {
       ++hits;
       EXPECT_NEAR(full.t[i], h.t, tol * scale) << "ray " << i;
       const Eigen::Vector3d n = R * h.normal;
-      // Box edges and corners have a cone of normals (the kernels may pick different faces at a tie): not compared.
-      if (shape.type != ShapeType::box) {
+      // Box and hull edges and corners have a cone of normals (the kernels may pick different faces at a tie):
+      // not compared.
+      if (shape.type != ShapeType::box && shape.type != ShapeType::convex) {
         EXPECT_LT((full.normal[i] - n).norm(), 1e3 * tol) << "ray " << i;
       }
       EXPECT_NEAR(full.normal[i].norm(), 1.0, 10 * tol);
