@@ -1,5 +1,5 @@
 // RaySceneIndex::update(): snapshot of the scene's objects, world boxes (the scene's own vectorised AABB pass) and
-// the LBVH, rebuilt when the set of objects changed and refitted otherwise.
+// the LBVH and its 8-wide collapse, rebuilt when the set of objects changed and refitted otherwise.
 #include "ray_scene_state.hpp"
 #include "rays_common.hpp"
 
@@ -60,10 +60,16 @@ void RaySceneIndex::update(const Scene& scene, int threads, bool force_rebuild) 
     const auto build_start = std::chrono::steady_clock::now();
     if (rebuild) {
       s.bvh.build(s.boxes);
+      const auto wide_start = std::chrono::steady_clock::now();
+      s.wide.collapse(s.bvh, s.boxes);
+      s.timings.wide_ms = ms_since(wide_start);
       s.timings.build_ms = ms_since(build_start);
       s.timings.refit_ms = 0.0;  // build() includes its refit
     } else {
       s.bvh.refit(s.boxes);
+      const auto wide_start = std::chrono::steady_clock::now();
+      s.wide.refit(s.bvh, s.boxes);
+      s.timings.wide_ms = ms_since(wide_start);
       s.timings.build_ms = 0.0;
       s.timings.refit_ms = ms_since(build_start);
     }

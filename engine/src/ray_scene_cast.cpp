@@ -1,9 +1,11 @@
-// RaySceneIndex::cast(): each ray walks the LBVH depth first, nearer child first, and intersects the objects of the
-// leaves it reaches with the exact kernels (kernels/rays/); halfspaces (unbounded) are tested first for every ray.
+// RaySceneIndex::cast(): each ray walks the 8-wide BVH (ray_wide_traverse.hpp; rays outside float's range walk the
+// binary LBVH in double) depth first, nearest child first, and intersects the objects of the leaves it reaches with
+// the exact kernels (kernels/rays/); halfspaces (unbounded) are tested first for every ray.
 // Closest-hit pruning: a subtree is skipped when its box starts beyond the best hit so far. Ties in t go to the lower
 // object slot, so the answer does not depend on the traversal order. Rays are split into fixed chunks; all-hit rows
 // are collected per chunk and concatenated in ray order: bitwise the same for any thread count.
 #include "ray_scene_state.hpp"
+#include "ray_wide_traverse.hpp"
 #include "rays_common.hpp"
 
 #include <tbb/blocked_range.h>
@@ -28,7 +30,9 @@ bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.o
 
 struct RayContext {
   Vec3<double> o, d, inv;
-  double t_max;
+  double t_max, d2;  // d2 = |d|^2
+  bool wide_ok;  // the float test of the wide tree is safe for this ray (else: the binary tree in double)
+  WideRay wide;
 };
 
 // Slab test of a float box (outward-rounded, so it contains the object with room to spare for this double
@@ -48,10 +52,12 @@ double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
 
 class Caster {
  public:
-  Caster(const RaySceneIndex::State& s, const RayOptions& o) : s_(s), gjk_{o.tolerance, o.max_iterations} {}
+  Caster(const RaySceneIndex::State& s, const RayOptions& o)
+      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse()) {}
 
   // Intersects one object; true on a hit with t <= t_max.
   bool test(const RayObject& obj, const RayContext& r, double t_max, Hit& hit, bool& capped) const {
+    if (ball_misses(obj, r, t_max)) return false;
     const Vec3<double> o = kernels::mul_transposed(obj.R, Vec3<double>(r.o - obj.t));
     const Vec3<double> d = kernels::mul_transposed(obj.R, r.d);
     const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_);
@@ -61,8 +67,41 @@ class Caster {
     return true;
   }
 
+  // The object's bounding ball, in the world frame: most leaves a ray reaches miss their object, and this rejects
+  // them before the transform to the local frame and the kernel. Only a filter: the radius is widened by 1e-12 of
+  // (|o - centre| + radius), a thousand times the rounding of the closest-point form here and of the local-frame
+  // transform (a few 1e-16 of the same lengths), so a ray the exact kernel hits is never rejected.
+  bool ball_misses(const RayObject& obj, const RayContext& r, double t_max) const {
+    const double bound = s_.prepared.shapes[obj.shape].bound;
+    if (!(bound > 0.0)) return false;  // halfspaces
+    const Vec3<double> oc = r.o - obj.t;
+    const double tc = -oc.dot(r.d) / r.d2;
+    const Vec3<double> p = oc + tc * r.d;
+    const double R = bound + 1e-12 * (oc.cwiseAbs().maxCoeff() + bound), h2 = R * R - p.squaredNorm();
+    if (!(h2 >= 0.0)) return true;
+    const double half = std::sqrt(h2 / r.d2);
+    return tc + half < 0.0 || tc - half > t_max;
+  }
+
   // Visits the leaves whose boxes the ray segment [0, limit()] reaches; visit(leaf) returns false to stop.
   template <class Visit, class Limit> void traverse(const RayContext& r, const Limit& limit, const Visit& visit) const {
+    if (r.wide_ok && !s_.wide.nodes().empty()) {
+      auto leaf = [&](std::uint32_t k, float& lim) {
+        if (!visit(k)) return false;
+        lim = wide_limit(limit());
+        return true;
+      };
+      using Leaf = decltype(leaf);
+      wide_(s_.wide.nodes().data(), r.wide, wide_limit(limit()),
+            [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
+      return;
+    }
+    binary_traverse(r, limit, visit);
+  }
+
+  // The binary tree in double (rays outside the float test's range, and scenes of one object).
+  template <class Visit, class Limit>
+  void binary_traverse(const RayContext& r, const Limit& limit, const Visit& visit) const {
     const RayBvh& bvh = s_.bvh;
     if (bvh.leaf_count() == 0) return;
     if (bvh.leaf_count() == 1) {
@@ -151,6 +190,7 @@ class Caster {
  private:
   const RaySceneIndex::State& s_;
   kr::RayGjkSettings gjk_;
+  WideTraverse wide_;
 };
 
 RayContext context(const RayBatch& rays, std::size_t i) {
@@ -159,6 +199,9 @@ RayContext context(const RayBatch& rays, std::size_t i) {
   r.d = Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]);
   r.inv = Vec3<double>(1.0 / r.d.x(), 1.0 / r.d.y(), 1.0 / r.d.z());
   r.t_max = rays.t_max[i];
+  r.d2 = r.d.squaredNorm();
+  r.wide_ok = wide_ray_supported(r.o.data(), r.d.data());
+  if (r.wide_ok) r.wide = make_wide_ray(r.o.data(), r.d.data());
   return r;
 }
 

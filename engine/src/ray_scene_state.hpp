@@ -1,4 +1,5 @@
-// Private state of batchcol::RaySceneIndex: a snapshot of the scene's objects in BVH leaf order and the LBVH.
+// Private state of batchcol::RaySceneIndex: a snapshot of the scene's objects in BVH leaf order, the LBVH and its
+// 8-wide collapse.
 #pragma once
 
 #include "batchcol/rays.hpp"
@@ -6,6 +7,7 @@
 #include "kernels/math.hpp"
 #include "ray_bvh.hpp"
 #include "ray_prepared.hpp"
+#include "ray_wide_bvh.hpp"
 #include "scene_state.hpp"
 
 #include <memory>
@@ -32,7 +34,8 @@ struct RaySceneIndex::State {
 
   broadphase::AabbSoa boxes;  // by scene object index
   std::vector<PoseRecord> poses;
-  RayBvh bvh;
+  RayBvh bvh;       // binary LBVH: built, refitted, and traversed (in double) by rays the float test cannot take
+  WideBvh wide;     // its 8-wide collapse, traversed by every other ray
   std::vector<RayObject> leaves;      // leaf k = object bvh.leaf_object()[k]
   std::vector<RayObject> halfspaces;  // tested against every ray
   RaySceneTimings timings;

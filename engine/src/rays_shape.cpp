@@ -1,7 +1,12 @@
-// cast_rays(): rays against one posed shape each. Each ray is moved into its shape's local frame (x_local =
-// R^T (x - t)), intersected by the kernel of kernels/rays/ray_shape.hpp, and its normal rotated back.
+// cast_rays(): rays against one posed shape each. Spheres, boxes, capsules and (uninflated) hulls run W rays per
+// register straight from the batch's arrays (kernels/rays/ray_lanes.hpp; hulls only for the pose, then one lane at a
+// time through the scalar hull kernel); a group of W rays that are not all valid and of one of those
+// kinds goes ray by ray: through the same lane kernel with one lane (same bits), or, for the other shapes (and
+// invalid rays), moved into the shape's local frame (x_local = R^T (x - t)), intersected by the kernel of
+// kernels/rays/ray_shape.hpp, and its normal rotated back.
 #include "rays_common.hpp"
 
+#include "kernels/rays/ray_lanes.hpp"
 #include "ray_prepared.hpp"
 
 #include <tbb/blocked_range.h>
@@ -9,6 +14,7 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace batchcol {
@@ -19,11 +25,51 @@ using kernels::Vec3;
 
 template <class T> using PreparedShapes = detail::PreparedRayShapes<T>;
 
+namespace kr = kernels::rays;
+
+template <class T> kr::LaneShapeTable lane_shapes(const ShapeTable& table, const PreparedShapes<T>& prepared) {
+  kr::LaneShapeTable t;
+  t.hull_d.assign(table.size(), nullptr);
+  t.hull_f.assign(table.size(), nullptr);
+  for (std::size_t s = 0; s < table.size(); ++s) {
+    const Shape& shape = table[s];
+    const kernels::ShapeCore<double> core = kernels::make_core<double>(shape);
+    kr::LaneKind kind = kr::LaneKind::none;
+    double a = 0, b = 0, c = 0;
+    if (shape.type == ShapeType::sphere) kind = kr::LaneKind::sphere, a = core.radius;
+    if (shape.type == ShapeType::capsule) kind = kr::LaneKind::capsule, a = core.radius, b = core.size.y();
+    if (shape.type == ShapeType::box && shape.inflation == 0.0)
+      kind = kr::LaneKind::box, a = core.size.x(), b = core.size.y(), c = core.size.z();
+    if (shape.type == ShapeType::convex && shape.inflation == 0.0) {
+      kind = kr::LaneKind::hull, a = shape.bounding_radius();
+      if constexpr (std::is_same_v<T, double>) t.hull_d[s] = &prepared.planes[s];
+      else t.hull_f[s] = &prepared.planes[s];
+    }
+    t.kind.push_back(kind), t.a.push_back(a), t.b.push_back(b), t.c.push_back(c);
+  }
+  return t;
+}
+
+struct LaneContext {
+  kr::LaneShapeTable shapes;
+  kr::LaneRays rays;
+  kr::LaneCast wide, single;  // W lanes, 1 lane (same arithmetic)
+  int width;
+};
+
 template <class T>
 void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const kernels::rays::RayGjkSettings& gjk,
-                std::size_t begin, std::size_t end, RayResults& r) {
+                const LaneContext& lanes, std::size_t begin, std::size_t end, RayResults& r) {
   const RayBatch& rays = b.rays;
+  kr::LaneOut out{reinterpret_cast<std::uint8_t*>(r.status.data()), r.hit.data(), r.t.data(), r.normal.x.data(),
+                  r.normal.y.data(), r.normal.z.data()};
+  const std::size_t w = static_cast<std::size_t>(lanes.width);
   for (std::size_t i = begin; i < end; ++i) {
+    if (w > 1 && i + w <= end && lanes.wide(lanes.shapes, lanes.rays, i, out)) {
+      i += w - 1;
+      continue;
+    }
+    if (lanes.single(lanes.shapes, lanes.rays, i, out)) continue;
     if (!detail::ray_is_valid(rays, i) || b.shape[i] >= prepared.shapes.size()) continue;
     const Eigen::Quaterniond q(b.rotation.w[i], b.rotation.x[i], b.rotation.y[i], b.rotation.z[i]);
     const Eigen::Vector3d p(b.translation.x[i], b.translation.y[i], b.translation.z[i]);
@@ -48,12 +94,23 @@ void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const
 template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& b, const RayOptions& o, RayResults& r) {
   const PreparedShapes<T> prepared(shapes);
   const kernels::rays::RayGjkSettings gjk{o.tolerance, o.max_iterations};
+  const kr::LaneCasts wide = kr::select_lane_casts(), single = kr::lane_casts_for(0);
+  const bool dbl = std::is_same_v<T, double>;
+  const LaneContext lanes{lane_shapes(shapes, prepared),
+                          {b.rays.origin.x.data(), b.rays.origin.y.data(), b.rays.origin.z.data(),
+                           b.rays.direction.x.data(), b.rays.direction.y.data(), b.rays.direction.z.data(),
+                           b.rays.t_max.data(), b.translation.x.data(), b.translation.y.data(),
+                           b.translation.z.data(), b.rotation.w.data(), b.rotation.x.data(), b.rotation.y.data(),
+                           b.rotation.z.data(), b.shape.data()},
+                          dbl ? wide.cast_double : wide.cast_float,
+                          dbl ? single.cast_double : single.cast_float,
+                          wide.width};
   const std::size_t n = b.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
   detail::run_with_threads(o.threads, [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t c = range.begin(); c != range.end(); ++c) {
         const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
-        cast_range(prepared, b, gjk, begin, end, r);
+        cast_range(prepared, b, gjk, lanes, begin, end, r);
       }
     });
   });

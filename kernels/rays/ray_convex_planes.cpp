@@ -57,6 +57,16 @@ BATCHCOL_CLIP_TYPES(float, 32, int)
 
 #undef BATCHCOL_CLIP_TYPES
 
+ClipPlaneVariants clip_planes_for(int isa) {
+  ClipPlaneVariants v;
+  if (isa == 0) v.d = &clip_baseline::d::clip, v.f = &clip_baseline::f::clip;
+  if (isa == 1 && __builtin_cpu_supports("avx2")) v.d = &clip_avx2::d::clip, v.f = &clip_avx2::f::clip;
+  if (isa == 2 && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("avx512bw"))
+    v.d = &clip_avx512::d::clip, v.f = &clip_avx512::f::clip;
+  return v;
+}
+
 PlaneClip<double> clip_planes(const double* nx, const double* ny, const double* nz, const double* c, std::size_t n,
                               const double* o, const double* d) {
   if (__builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))

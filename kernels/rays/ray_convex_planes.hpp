@@ -1,7 +1,8 @@
 // The clipping loop of a ray against a hull's face planes (Cyrus-Beck), compiled for AVX-512, AVX2 and the baseline
-// with GCC function multi-versioning (target_clones; the loader picks the version once per process). Every version
+// (`#pragma GCC target` regions in ray_convex_planes.cpp, picked per call by __builtin_cpu_supports). Every version
 // keeps the same 8 independent lanes (face i goes to lane i mod 8) and does the same operations per lane in the same
-// order under -ffp-contract=off, so the result is bitwise the same on every instruction set.
+// order under -ffp-contract=off, so the result is bitwise the same on every instruction set (tested,
+// RayConvexPlanes.EveryInstructionSetGivesTheSameBits).
 #pragma once
 
 #include <cstddef>
@@ -21,5 +22,14 @@ PlaneClip<double> clip_planes(const double* nx, const double* ny, const double* 
                               const double* o, const double* d);
 PlaneClip<float> clip_planes(const float* nx, const float* ny, const float* nz, const float* c, std::size_t n,
                              const float* o, const float* d);
+
+/// One instruction set's loop, for the tests: isa 0 baseline, 1 AVX2, 2 AVX-512; null when the processor lacks it.
+struct ClipPlaneVariants {
+  PlaneClip<double> (*d)(const double*, const double*, const double*, const double*, std::size_t, const double*,
+                         const double*) = nullptr;
+  PlaneClip<float> (*f)(const float*, const float*, const float*, const float*, std::size_t, const float*,
+                        const float*) = nullptr;
+};
+ClipPlaneVariants clip_planes_for(int isa);
 
 }  // namespace batchcol::kernels::rays

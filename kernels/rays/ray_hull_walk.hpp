@@ -30,7 +30,10 @@ template <class T> struct HullWalk {
   std::vector<T> nx, ny, nz, c;  // one plane per facet
   std::vector<T> ux, uy, uz;     // polar vertices n / h
   std::vector<std::uint32_t> adjacency_begin, adjacency;  // facets sharing an edge (compressed rows)
-  std::vector<std::uint32_t> seeds;  // facets maximising 14 fixed directions on the polar: where climbs start
+  // Where climbs start: a cube map of directions (6 faces x kSeedGrid^2 cells) to the facet maximising the polar's
+  // linear function at the cell's centre direction, so a climb from the origin's direction starts next to its end.
+  static constexpr int kSeedGrid = 8;
+  std::vector<std::uint32_t> seeds;
   Vec3<T> p = Vec3<T>::Zero();       // interior point (the vertex mean)
   std::size_t planes() const { return nx.size(); }
 };
@@ -89,14 +92,19 @@ template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
     w.adjacency.insert(w.adjacency.end(), n.begin(), n.end());
     w.adjacency_begin.push_back(static_cast<std::uint32_t>(w.adjacency.size()));
   }
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
-        if (std::abs(dx) + std::abs(dy) + std::abs(dz) != 1 && std::abs(dx) + std::abs(dy) + std::abs(dz) != 3) continue;
+  const int n = HullWalk<T>::kSeedGrid;
+  for (int face = 0; face < 6; ++face)
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        double dir[3];
+        const int k = face / 2;
+        dir[k] = face % 2 ? -1.0 : 1.0;
+        dir[(k + 1) % 3] = -1.0 + (2.0 * a + 1.0) / n;
+        dir[(k + 2) % 3] = -1.0 + (2.0 * b + 1.0) / n;
         std::uint32_t best = 0;
         double best_value = -1e300;
         for (std::uint32_t i = 0; i < w.planes(); ++i) {
-          const double v = double(w.ux[i]) * dx + double(w.uy[i]) * dy + double(w.uz[i]) * dz;
+          const double v = double(w.ux[i]) * dir[0] + double(w.uy[i]) * dir[1] + double(w.uz[i]) * dir[2];
           if (v > best_value) best_value = v, best = i;
         }
         w.seeds.push_back(best);
@@ -112,12 +120,20 @@ template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>
   LocalHit<T> h;
   const auto value = [&](std::uint32_t i, const Vec3<T>& q) { return (w.ux[i] * q.x() + w.uy[i] * q.y()) + w.uz[i] * q.z(); };
   Vec3<T> q = o - w.p;  // x - p
+  // The cube-map cell of q's direction (the largest component picks the face).
+  const T aq[3] = {std::abs(q.x()), std::abs(q.y()), std::abs(q.z())};
+  const int k = aq[0] >= aq[1] ? (aq[0] >= aq[2] ? 0 : 2) : (aq[1] >= aq[2] ? 1 : 2);
   std::uint32_t f = w.seeds[0];
-  T best = value(f, q);
-  for (std::size_t s = 1; s < w.seeds.size(); ++s) {
-    const T v = value(w.seeds[s], q);
-    if (v > best) best = v, f = w.seeds[s];
+  if (aq[k] > T(0)) {
+    const int n = HullWalk<T>::kSeedGrid;
+    const auto cell = [&](T c) {  // c / |q_k| in [-1, 1] to [0, n)
+      const T x = (c / aq[k] + T(1)) * T(0.5 * n);
+      return x <= T(0) ? 0 : x >= T(n - 1) ? n - 1 : static_cast<int>(x);
+    };
+    const int face = 2 * k + (q[k] < T(0) ? 1 : 0);
+    f = w.seeds[static_cast<std::size_t>((face * n + cell(q[(k + 1) % 3])) * n + cell(q[(k + 2) % 3]))];
   }
+  T best = value(f, q);
   // Rounding of g near 1: a point within a few ulps of the active plane counts as on it.
   const T one = T(1) + T(16) * machine_epsilon<T>();
   const std::size_t budget = 4 * w.planes() + 64;

@@ -81,7 +81,7 @@ TEST_F(RaysCli, PeersCompareWithEmbreeOrRefuseCleanly) {
 
 TEST_F(RaysCli, ShapeModeReportsEveryShapeAndPrecision) {
   const json j = run_json("--mode shape --rays 5000 --runs 1 --hull-vertices 60");
-  for (const char* shape : {"sphere", "box", "hull"})
+  for (const char* shape : {"sphere", "box", "capsule", "hull"})
     for (const char* precision : {"double", "float"}) {
       SCOPED_TRACE(std::string(shape) + " " + precision);
       EXPECT_GT(j[shape][precision]["rays_per_s"].get<double>(), 0.0);

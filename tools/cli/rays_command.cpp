@@ -1,7 +1,7 @@
 // `batchcol rays`: times ray queries. Scene mode: builds a scene (hulls or mixed primitives), times the LBVH build,
 // its refit after every object moved, and the rays per second of the query; with --peers, the same scene and rays in
 // Embree 3 (build and rays/s) and the agreement of the closest hits. Shape mode: rays against one posed shape each
-// (sphere, box, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
+// (sphere, box, capsule, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
 #include "cli/atomic_output.hpp"
 #include "cli/commands.hpp"
 #include "cli/portable_random.hpp"
@@ -96,22 +96,46 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
   RaysScene world = make_rays_scene(s.scene);
   const RayBatch rays = make_crossing_rays(s.rays, world.half_extent, s.scene.seed);
   RaySceneIndex index;
-  std::vector<double> build, boxes, refit;
+  std::vector<double> build, boxes, refit, collapse, wide_refit;
   for (int r = 0; r < s.runs; ++r) {
     index.update(*world.scene, s.threads, true);
     build.push_back(index.timings().total_ms);
     boxes.push_back(index.timings().boxes_ms);
+    collapse.push_back(index.timings().wide_ms);
   }
   for (int f = 0; f < s.frames; ++f) {
     move_objects(world, 0.01, s.scene.seed + 100 + f);
     index.update(*world.scene, s.threads);
     refit.push_back(index.timings().total_ms);
+    wide_refit.push_back(index.timings().wide_ms);
   }
   RayOptions options;
   options.query = query;
   options.threads = s.threads;
+#ifdef BATCHCOL_HAVE_EMBREE
+  // Embree's scene is built before the timed casts, whose runs then alternate between the two libraries so that
+  // both see the same machine load (the ratio is what the report is for; the machine may be shared).
+  std::unique_ptr<peers::EmbreeRayScene> embree;
+  std::vector<double> commit, total, ecast;
+  peers::EmbreeHits theirs;
+  const bool any = query == RayQuery::any;
+  if (s.peers) {
+    std::vector<peers::EmbreeObject> objects;
+    for (ObjectHandle h : world.handles) objects.push_back({&(*world.table)[world.scene->shape(h)], world.scene->pose(h)});
+    embree = std::make_unique<peers::EmbreeRayScene>(s.threads);
+    for (int r = 0; r < s.runs; ++r) {
+      const auto t = embree->build(objects, {s.segments});
+      commit.push_back(t.commit_ms), total.push_back(t.total_ms);
+    }
+  }
+#endif
   std::vector<double> cast;
-  for (int r = 0; r < s.runs; ++r) cast.push_back(time_ms([&] { index.cast(rays, options, results); }));
+  for (int r = 0; r < s.runs; ++r) {
+    cast.push_back(time_ms([&] { index.cast(rays, options, results); }));
+#ifdef BATCHCOL_HAVE_EMBREE
+    if (embree) ecast.push_back(time_ms([&] { embree->cast(rays, any, s.threads, theirs); }));
+#endif
+  }
   std::size_t hits = 0, all_rows = results.all_t.size();
   for (std::uint8_t h : results.hit) hits += h;
   const double cast_ms = median(cast);
@@ -125,24 +149,14 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
                       {"batchcol",
                        {{"build_ms", median(build)},
                         {"build_boxes_ms", median(boxes)},
+                        {"build_wide_collapse_ms", median(collapse)},
                         {"refit_ms", median(refit)},
+                        {"refit_wide_ms", median(wide_refit)},
                         {"cast_ms", cast_ms},
                         {"rays_per_s", double(s.rays) / (cast_ms * 1e-3)}}}};
   if (query == RayQuery::all) j["all_hit_rows"] = all_rows;
 #ifdef BATCHCOL_HAVE_EMBREE
-  if (s.peers) {
-    std::vector<peers::EmbreeObject> objects;
-    for (ObjectHandle h : world.handles) objects.push_back({&(*world.table)[world.scene->shape(h)], world.scene->pose(h)});
-    peers::EmbreeRayScene embree(s.threads);
-    std::vector<double> commit, total;
-    for (int r = 0; r < s.runs; ++r) {
-      const auto t = embree.build(objects, {s.segments});
-      commit.push_back(t.commit_ms), total.push_back(t.total_ms);
-    }
-    peers::EmbreeHits theirs;
-    const bool any = query == RayQuery::any;
-    std::vector<double> ecast;
-    for (int r = 0; r < s.runs; ++r) ecast.push_back(time_ms([&] { embree.cast(rays, any, s.threads, theirs); }));
+  if (embree) {
     // Agreement on the closest hit: same hit/miss, same object (slots are the insertion order of a fresh scene),
     // t within 1e-6 relative.
     // Grazing rays (|cos| < 0.05 between the ray and our normal) turn Embree's float vertex rounding (~1e-7 of the
@@ -165,7 +179,7 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
       }
     }
     const double ems = median(ecast);
-    j["embree"] = {{"triangles", embree.triangle_count()},
+    j["embree"] = {{"triangles", embree->triangle_count()},
                    {"segments", s.segments},
                    {"build_ms", median(commit)},
                    {"build_with_tessellation_ms", median(total)},
@@ -189,11 +203,11 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < s.scene.hull_vertices; ++i) points.push_back(0.5 * rng.unit_vector());
   ShapeTable table;
-  const std::uint32_t ids[3] = {table.add(Shape::sphere(0.5)), table.add(Shape::box(0.4, 0.3, 0.2)),
-                                table.add(Shape::convex(points))};
-  const char* names[3] = {"sphere", "box", "hull"};
+  const std::uint32_t ids[4] = {table.add(Shape::sphere(0.5)), table.add(Shape::box(0.4, 0.3, 0.2)),
+                                table.add(Shape::capsule(0.25, 0.25)), table.add(Shape::convex(points))};
+  const char* names[4] = {"sphere", "box", "capsule", "hull"};
   nlohmann::json j = {{"mode", "shape"}, {"rays", s.rays}, {"threads", s.threads}, {"hull_vertices", s.scene.hull_vertices}};
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
     ShapeRayBatch batch;
     for (std::int64_t i = 0; i < s.rays; ++i) {
       const Pose pose{Eigen::Vector3d(rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)), rng.rotation()};
@@ -241,7 +255,7 @@ void print_text(const nlohmann::json& j) {
     return;
   }
   if (j["mode"] == "shape") {
-    for (const char* n : {"sphere", "box", "hull"})
+    for (const char* n : {"sphere", "box", "capsule", "hull"})
       for (const char* p : {"double", "float"})
         std::cout << n << ' ' << p << ": " << j[n][p]["rays_per_s"].get<double>() / 1e6 << " M rays/s (hit fraction "
                   << j[n][p]["hit_fraction"].get<double>() << ")\n";
@@ -285,7 +299,7 @@ int run_rays(const RaysSettings& s) {
 Command add_rays_command(CLI::App& parent) {
   auto s = std::make_shared<RaysSettings>();
   CLI::App* app = parent.add_subcommand("rays", "Time batched ray queries against a scene or posed shapes (Embree with --peers)");
-  app->add_option("--mode", s->mode, "scene or shape (rays against one posed sphere/box/hull each)")->capture_default_str();
+  app->add_option("--mode", s->mode, "scene or shape (rays against one posed sphere/box/capsule/hull each)")->capture_default_str();
   app->add_option("--objects", s->scene.objects, "Scene objects (>= 1)")->capture_default_str();
   app->add_option("--rays", s->rays, "Rays (>= 1)")->capture_default_str();
   app->add_option("--shapes", s->scene.shapes, "hull or mixed (spheres, capsules, boxes, cylinders)")->capture_default_str();

@@ -1,0 +1,46 @@
+// An 8-wide BVH collapsed from the binary LBVH (ray_bvh.hpp) for traversal: each node holds the boxes of up to 8
+// children in structure-of-arrays float form, so one SIMD pass tests a ray against all of them (ray_wide_traverse).
+// Collapse (the usual greedy rule, e.g. Wald et al., "Getting rid of packets", RT 2008 for 4-wide): a wide node
+// starts from a binary node's two children and repeatedly opens the internal child of largest surface area until it
+// has 8 children or only leaves. Fewer, fuller nodes mean fewer box tests per ray than the binary tree's pairs.
+// The topology depends only on the binary tree (built deterministically) and the boxes; every child slot remembers
+// its binary node so a refit is a parallel copy of the binary tree's refitted boxes (exact float min/max).
+#pragma once
+
+#include "broadphase/aabb_soa.hpp"
+#include "ray_bvh.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace batchcol {
+
+constexpr int kWideArity = 8;
+/// Child reference of an empty slot; its box is empty (lo = +inf, hi = -inf) and never hit.
+constexpr std::uint32_t kWideEmpty = 0xffffffffu;
+
+/// One node: child k's box is [lo_x[k], hi_x[k]] x ... ; child[k] is kLeafBit | leaf index (Morton rank), a node
+/// index, or kWideEmpty. 224 bytes of data, aligned to whole cache lines.
+struct alignas(64) WideNode {
+  float lo_x[kWideArity], lo_y[kWideArity], lo_z[kWideArity];
+  float hi_x[kWideArity], hi_y[kWideArity], hi_z[kWideArity];
+  std::uint32_t child[kWideArity];
+};
+static_assert(sizeof(WideNode) == 256, "WideNode layout");
+
+class WideBvh {
+ public:
+  /// Collapses `bvh` (which must have at least 2 leaves; with fewer there is nothing to collapse).
+  void collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
+  /// Copies the boxes of a refitted `bvh` (same topology as at collapse()) into the wide nodes, in parallel.
+  void refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
+
+  const std::vector<WideNode>& nodes() const { return nodes_; }
+  void clear() { nodes_.clear(), source_.clear(); }
+
+ private:
+  std::vector<WideNode> nodes_;        // node 0 is the root
+  std::vector<std::uint32_t> source_;  // per node and slot: the binary reference whose box fills the slot
+};
+
+}  // namespace batchcol

@@ -1,0 +1,108 @@
+// The wide traversal compiled for three instruction sets (the loop is ray_wide_traverse.inl) and the ray setup.
+#include "ray_wide_traverse.hpp"
+
+#include <immintrin.h>
+
+#include <cmath>
+#include <cstddef>
+
+// The vector types cross no call boundary between instruction sets (each set's functions call only their own).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace batchcol {
+
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
+namespace wide_avx512 {
+#define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
+#include "ray_wide_traverse.inl"
+#undef BATCHCOL_WIDE_BITS
+}  // namespace wide_avx512
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace wide_avx2 {
+#define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
+#include "ray_wide_traverse.inl"
+#undef BATCHCOL_WIDE_BITS
+}  // namespace wide_avx2
+#pragma GCC pop_options
+
+namespace wide_baseline {
+template <class Mask> inline std::uint32_t lane_bits(Mask m) {
+  std::uint32_t bits = 0;
+  for (int l = 0; l < 8; ++l) bits |= (m[l] != 0 ? 1u : 0u) << l;
+  return bits;
+}
+#define BATCHCOL_WIDE_BITS(m) lane_bits(m)
+#include "ray_wide_traverse.inl"
+#undef BATCHCOL_WIDE_BITS
+}  // namespace wide_baseline
+
+namespace {
+
+bool in_range(double x) { return x == 0.0 || (std::fabs(x) >= 0x1p-60 && std::fabs(x) <= 0x1p60); }
+
+// The next float above / below a finite f (libm's nextafterf costs ~50 instructions; this is the per-ray setup).
+float next_up(float f) {
+  if (f == 0.0f) return 0x1p-149f;
+  std::uint32_t u;
+  __builtin_memcpy(&u, &f, sizeof u);
+  u = f > 0.0f ? u + 1 : u - 1;
+  __builtin_memcpy(&f, &u, sizeof u);
+  return f;
+}
+
+float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) < x ? next_up(f) : f;  // double(f) < x: f is finite (or -inf, not reached: |x| <= 2^60 here)
+}
+
+float round_down(double x) { return -round_up(-x); }
+
+}  // namespace
+
+bool wide_ray_supported(const double o[3], const double d[3]) {
+  for (int k = 0; k < 3; ++k)
+    if (!(std::fabs(o[k]) <= 0x1p60) || !in_range(d[k])) return false;
+  return true;
+}
+
+WideRay make_wide_ray(const double o[3], const double d[3]) {
+  constexpr std::uint32_t lo[3] = {offsetof(WideNode, lo_x), offsetof(WideNode, lo_y), offsetof(WideNode, lo_z)};
+  constexpr std::uint32_t hi[3] = {offsetof(WideNode, hi_x), offsetof(WideNode, hi_y), offsetof(WideNode, hi_z)};
+  WideRay r;
+  for (int k = 0; k < 3; ++k) {
+    const bool negative = std::signbit(d[k]);  // -0 counts as negative: 1 / -0 = -inf pairs with the hi plane
+    r.inv[k] = static_cast<float>(1.0 / d[k]);
+    r.near_offset[k] = negative ? hi[k] : lo[k];
+    r.far_offset[k] = negative ? lo[k] : hi[k];
+    r.o_near[k] = negative ? round_down(o[k]) : round_up(o[k]);
+    r.o_far[k] = negative ? round_up(o[k]) : round_down(o[k]);
+  }
+  return r;
+}
+
+float wide_limit(double t) { return round_up(t * double(kFarScale)); }
+
+WideTraverse wide_traverse_for(int isa) {
+  switch (isa) {
+    case 0: return &wide_baseline::traverse;
+    case 1: return __builtin_cpu_supports("avx2") ? &wide_avx2::traverse : nullptr;
+    case 2:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                     __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
+                 ? &wide_avx512::traverse
+                 : nullptr;
+    default: return nullptr;
+  }
+}
+
+WideTraverse select_wide_traverse() {
+  for (int isa = 2; isa > 0; --isa)
+    if (WideTraverse f = wide_traverse_for(isa)) return f;
+  return wide_traverse_for(0);
+}
+
+}  // namespace batchcol

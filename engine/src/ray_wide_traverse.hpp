@@ -1,0 +1,53 @@
+// Closest-first traversal of the 8-wide BVH (ray_wide_bvh.hpp) for one ray, with one float SIMD slab test per node
+// (all 8 child boxes at once). The loop is compiled for AVX-512, AVX2 and the baseline (ray_wide_traverse.cpp) and
+// picked by select_wide_traverse(); every version does the same IEEE operations lane by lane, so the visiting order,
+// and hence every answer, is the same on every instruction set.
+//
+// Conservative float test (no box the exact ray segment reaches is ever rejected), after Ize, "Robust BVH ray
+// traversal", JCGT 2013, adapted to a double ray: per axis the slab plane the ray enters through ("near": lo when
+// the direction component is >= 0, else hi) and the one it leaves through ("far") are fixed by the sign, and the
+// ray's origin is rounded to float towards the side that makes the computed near parameter smaller and the far one
+// larger (o_near, o_far). What remains are three roundings per parameter (the subtraction, the product, the float
+// reciprocal), a relative error below 3 * 2^-24 each way when no value is subnormal, so
+//   near_computed <= near (1 + d) <= far (1 + d) <= far_computed (1 + d) / (1 - d),
+// and scaling the far side by kFarScale = 1 + 2^-20 (> (1 + d) / (1 - d) plus the product's own rounding) keeps every
+// box the exact ray reaches; kFarSlack = 2^-120 covers subnormal parameters (absolute errors below 2^-149). The
+// limit (best hit so far, or t_max) is compared after the same widening. A direction component of exactly 0 gives
+// an infinite reciprocal: (plane - origin) * inf is +-inf (outside / inside the slab) or NaN when the origin lies on
+// the plane; NaN lanes lose the ordered max/min below, which treats the slab as containing the ray (conservative).
+// Rays with a component outside [2^-60, 2^60] (or an origin beyond 2^60) would leave float's range: the caller
+// traverses those in double with the binary tree (wide_ray_supported()).
+#pragma once
+
+#include "ray_wide_bvh.hpp"
+
+#include <cstdint>
+
+namespace batchcol {
+
+constexpr float kFarScale = 1.0f + 0x1p-20f;
+constexpr float kFarSlack = 0x1p-120f;
+
+struct WideRay {
+  float o_near[3], o_far[3], inv[3];
+  std::uint32_t near_offset[3], far_offset[3];  // byte offsets of the near / far plane arrays inside WideNode
+};
+
+/// True when the float test is safe for this ray (see above); o and d are the ray's origin and direction.
+bool wide_ray_supported(const double o[3], const double d[3]);
+WideRay make_wide_ray(const double o[3], const double d[3]);
+/// The float limit the traversal compares with for a double limit t: t (1 + 2^-20) rounded up to float.
+float wide_limit(double t);
+
+/// Called for every leaf (Morton rank) whose box the ray reaches, nearest box first; returns false to stop the
+/// traversal, and may lower `limit` (a wide_limit()).
+using WideLeafVisit = bool (*)(void* context, std::uint32_t leaf, float& limit);
+using WideTraverse = void (*)(const WideNode* nodes, const WideRay& ray, float limit, WideLeafVisit visit,
+                              void* context);
+/// The traversal for this processor (reads the CPU's features; no state is kept).
+WideTraverse select_wide_traverse();
+/// The traversal of one instruction set, for the tests: 0 baseline, 1 AVX2, 2 AVX-512; nullptr when the processor
+/// lacks it.
+WideTraverse wide_traverse_for(int isa);
+
+}  // namespace batchcol

@@ -1,0 +1,81 @@
+// The body of the wide traversal (see ray_wide_traverse.hpp), included once per instruction set inside a
+// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_BITS(m): the 8 lane bits of a mask.
+
+namespace {
+
+typedef float V __attribute__((vector_size(32)));
+typedef int M __attribute__((vector_size(32)));
+
+inline V splat(float x) { return V{x, x, x, x, x, x, x, x}; }
+
+inline V load_at(const WideNode* node, std::uint32_t byte_offset) {
+  V v;
+  __builtin_memcpy(&v, reinterpret_cast<const char*>(node) + byte_offset, sizeof v);
+  return v;
+}
+
+// Ordered max / min: a NaN lane of x keeps acc (see the header).
+inline V max_into(V x, V acc) { return x > acc ? x : acc; }
+inline V min_into(V x, V acc) { return x < acc ? x : acc; }
+
+struct Entry {
+  std::uint32_t ref;
+  float t;
+};
+
+}  // namespace
+
+void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+  const V onx = splat(r.o_near[0]), ony = splat(r.o_near[1]), onz = splat(r.o_near[2]);
+  const V ofx = splat(r.o_far[0]), ofy = splat(r.o_far[1]), ofz = splat(r.o_far[2]);
+  const V ix = splat(r.inv[0]), iy = splat(r.inv[1]), iz = splat(r.inv[2]);
+  const V zero = splat(0.0f), scale = splat(kFarScale), slack = splat(kFarSlack);
+  // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
+  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
+  Entry stack[64 * (kWideArity - 1) + 2];
+  int top = 0;
+  Entry e{0u, 0.0f};  // the root
+  // The next entry still within reach (a closer hit may have been found since it was pushed); false when none.
+  const auto pop = [&] {
+    do {
+      if (top == 0) return false;
+      e = stack[--top];
+    } while (e.t > limit);
+    return true;
+  };
+  for (;;) {
+    if (e.ref & kLeafBit) {
+      if (!visit(context, e.ref & ~kLeafBit, limit) || !pop()) return;
+      continue;
+    }
+    const WideNode* n = nodes + e.ref;
+    V tn = zero;
+    tn = max_into((load_at(n, r.near_offset[0]) - onx) * ix, tn);
+    tn = max_into((load_at(n, r.near_offset[1]) - ony) * iy, tn);
+    tn = max_into((load_at(n, r.near_offset[2]) - onz) * iz, tn);
+    V tf = splat(limit);
+    tf = min_into((load_at(n, r.far_offset[0]) - ofx) * ix, tf);
+    tf = min_into((load_at(n, r.far_offset[1]) - ofy) * iy, tf);
+    tf = min_into((load_at(n, r.far_offset[2]) - ofz) * iz, tf);
+    tf = tf * scale + slack;
+    std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
+    if (bits == 0) {
+      if (!pop()) return;
+      continue;
+    }
+    // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
+    // keep the slot order (the sort is stable), so the order is a function of the node and the ray only.
+    Entry hit[kWideArity];
+    int count = 0;
+    while (bits != 0) {
+      const int k = __builtin_ctz(bits);
+      bits &= bits - 1;
+      Entry x{n->child[k], tn[k]};
+      int j = count++;
+      for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
+      hit[j] = x;
+    }
+    for (int j = count - 1; j >= 1; --j) stack[top++] = hit[j];
+    e = hit[0];  // the nearest child next, without a trip through the stack
+  }
+}
