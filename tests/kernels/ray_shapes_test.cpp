@@ -194,7 +194,7 @@ TEST(RayShapesClosedForm, FloatKernelsAgreeWithDouble) {
       ++total;
       if (hd.hit != hf.hit) continue;  // grazing rays may flip in float
       ++agree;
-      if (hd.hit) EXPECT_NEAR(hf.t, hd.t, 2e-5 * (1 + hd.t)) << to_string(type);
+      if (hd.hit) { EXPECT_NEAR(hf.t, hd.t, 2e-5 * (1 + hd.t)) << to_string(type); }
     }
     EXPECT_GE(agree, total - 5) << to_string(type);
   }
@@ -233,7 +233,7 @@ TEST(RayHullWalk, MatchesClippingEveryPlaneAndSphereTracing) {
       if (!walk.hit) continue;
       ++hits;
       EXPECT_NEAR(walk.t, clip.t, 1e-12 * (1 + clip.t));
-      if (walk.t > 0) EXPECT_GT(walk.normal.dot(clip.normal), 1 - 1e-9);  // the same facet (or two that tie)
+      if (walk.t > 0) { EXPECT_GT(walk.normal.dot(clip.normal), 1 - 1e-9); }  // the same facet (or two that tie)
     }
     EXPECT_GT(hits, 500);
     EXPECT_GE(check_shape(hull, 1500, 7).compared, 1450);
