@@ -288,7 +288,7 @@ TEST(SweepAndPrune, IncrementalUpdatesEqualRebuildAfterSmallMotions) {
   }
   EXPECT_TRUE(pairs == brute_force_pairs(to_soa(b), f));
   // A shuffle keeps the grid (the same boxes in another order) and still gives the same pairs.
-  std::shuffle(b.begin(), b.end(), rng);
+  for (std::size_t i = b.size(); i > 1; --i) std::swap(b[i - 1], b[rng.index(i)]);  // Fisher-Yates, portable
   const AabbSoa s = to_soa(b);
   incremental.update(s, f, pairs);
   EXPECT_TRUE(incremental.stats().incremental);
