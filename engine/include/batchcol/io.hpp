@@ -41,7 +41,7 @@ BATCHCOL_API BatchFile parse_batch_json(const std::string& text, const std::stri
 /// Loads a mesh file (OBJ, STL, PLY, COLLADA, ... through assimp) and returns its vertices.
 BATCHCOL_API std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path);
 
-QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
+BATCHCOL_API QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
 BATCHCOL_API Solver parse_solver(const std::string& name);
 BATCHCOL_API Precision parse_precision(const std::string& name);
 BATCHCOL_API InstructionSet parse_instruction_set(const std::string& name);

@@ -62,7 +62,7 @@ enum class RayQuery : std::uint8_t {
   all,      // every object hit in [0, t_max], sorted by (t, object slot)
 };
 BATCHCOL_API const char* to_string(RayQuery query);
-RayQuery parse_ray_query(const std::string& name);  // throws InputError naming the value
+BATCHCOL_API RayQuery parse_ray_query(const std::string& name);  // throws InputError naming the value
 
 enum class RayStatus : std::uint8_t {
   ok,              // exact (closed form) or certified to the tolerance
