@@ -4,13 +4,14 @@
 // figure on a shared machine.
 // Counters: pairs found, overlaps per box (2 pairs / n), bytes per object held by the SAP, cell copies per object;
 // incremental_fraction = share of updates that kept the grid.
+#include "batchcol/shapes.hpp"
 #include "broadphase/sweep_and_prune.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
-#include <random>
 #include <utility>
 
 namespace {
@@ -25,14 +26,20 @@ struct Frames {
 };
 
 Frames make_frames(std::size_t n) {
-  std::mt19937_64 rng(42);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  batchcol::testkit::PortableRandom rng(42);
+  // One draw per statement: the evaluation order of constructor arguments is unspecified.
+  const auto unit3 = [&rng](double shift) {
+    const double x = rng.uniform() - shift;
+    const double y = rng.uniform() - shift;
+    const double z = rng.uniform() - shift;
+    return Eigen::Vector3d(x, y, z);
+  };
   // Equal boxes of half size h in a unit cube overlap with probability (4h)^3 (ignoring the faces).
   const double h = 0.25 * std::cbrt(0.4 / static_cast<double>(n - 1));
   std::vector<Aabb> a(n), b(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d c(unit(rng), unit(rng), unit(rng));
-    const Eigen::Vector3d d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    const Eigen::Vector3d c = unit3(0.0);
+    const Eigen::Vector3d d = unit3(0.5);
     a[i] = {c - Eigen::Vector3d::Constant(h), c + Eigen::Vector3d::Constant(h)};
     const Eigen::Vector3d m = c + 0.1 * h * d;
     b[i] = {m - Eigen::Vector3d::Constant(h), m + Eigen::Vector3d::Constant(h)};

@@ -22,7 +22,7 @@ Workload make_workload(ShapeType ta, ShapeType tb, std::size_t pairs) {
     w.shapes.add(testing::random_shape(rng, tb));
   }
   for (std::size_t i = 0; i < pairs; ++i) {
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
                   testing::random_rotation(rng)};
     w.batch.add(static_cast<std::uint32_t>(2 * (rng() % 16)), pa, static_cast<std::uint32_t>(2 * (rng() % 16) + 1), pb);

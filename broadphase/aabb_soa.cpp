@@ -63,7 +63,7 @@ void AabbSoa::resize(std::size_t n) {
   for (auto* v : {&min_x, &min_y, &min_z, &max_x, &max_y, &max_z}) v->resize(n, 0.0f);
 }
 
-void AabbSoa::set(std::size_t i, const Aabb& box, double margin) {
+void AabbSoa::set(std::size_t i, const PlainAabb& box, double margin) {
   if (!(margin >= 0.0) || !std::isfinite(margin)) {
     std::ostringstream s;
     s << "broadphase: object " << i << ": margin " << margin << " must be finite and >= 0";
@@ -87,11 +87,6 @@ void AabbSoa::set(std::size_t i, const Aabb& box, double margin) {
   }
   min_x[i] = lo[0], min_y[i] = lo[1], min_z[i] = lo[2];
   max_x[i] = hi[0], max_y[i] = hi[1], max_z[i] = hi[2];
-}
-
-void AabbSoa::assign(const std::vector<Aabb>& boxes, double margin) {
-  resize(boxes.size());
-  for (std::size_t i = 0; i < boxes.size(); ++i) set(i, boxes[i], margin);
 }
 
 void validate_aabbs(const AabbSoa& b) {

@@ -7,7 +7,7 @@
 // an exact statement.
 #pragma once
 
-#include "batchcol/shapes.hpp"
+#include "batchcol/types.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -26,9 +26,21 @@ struct AabbSoa {
   /// Stores box i inflated by `margin` (>= 0), rounded outward to float. Throws InputError naming object i when a
   /// coordinate is not finite (halfspaces have infinite boxes: they do not belong in the broad phase), leaves the
   /// float range, or min > max.
-  void set(std::size_t i, const Aabb& box, double margin = 0.0);
+  void set(std::size_t i, const PlainAabb& box, double margin = 0.0);
+  /// The same for any box type with min[k] and max[k] (the engine's batchcol::Aabb): the broad phase does not see
+  /// the public shape model, its callers convert here.
+  template <class Box>
+  void set(std::size_t i, const Box& box, double margin = 0.0) {
+    PlainAabb plain;
+    for (int a = 0; a < 3; ++a) plain.min[a] = box.min[a], plain.max[a] = box.max[a];
+    set(i, plain, margin);
+  }
   /// Replaces the contents with `boxes`, each inflated by `margin`; same checks as set().
-  void assign(const std::vector<Aabb>& boxes, double margin = 0.0);
+  template <class Box>
+  void assign(const std::vector<Box>& boxes, double margin = 0.0) {
+    resize(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) set(i, boxes[i], margin);
+  }
 };
 
 /// Throws InputError naming the lowest bad object index unless all arrays have the same size, every coordinate is

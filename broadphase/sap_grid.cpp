@@ -19,9 +19,8 @@ constexpr std::size_t kMinObjectsPerCell = 16;
 constexpr int kMaxCellsPerAxis = 4096;
 // The statistics come from at most kSampleCount boxes spread evenly over the input (all of them in smaller scenes): the
 // axis and the cell width need the variance and the mean extent only roughly (the relative error of a variance from
-// 2048 samples is about 3%), and the grid is exact for any origin and width (cell_of clamps). Summing every box in
-// double cost ~80 instructions per object, a sixth of a 10k-object rebuild. A fixed sample: the same grid for any
-// thread count.
+// 2048 samples is about 3%), and the grid is exact for any origin and width (cell_of clamps), while summing every
+// box in double is a sizeable part of a small scene's rebuild. A fixed sample: the same grid for any thread count.
 constexpr std::size_t kSampleCount = 2048;
 
 // Sample k of `samples` from n boxes: one per stretch of n / samples boxes, at a position inside the stretch that

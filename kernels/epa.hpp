@@ -201,7 +201,9 @@ EpaResult<T> epa(const MinkowskiDifference<T>& D, const Simplex<T>& start, T tol
   int closest = 0;
   T best_upper = std::numeric_limits<T>::infinity();  // min over the expansions of h_D(n)
   Vec3<T> best_normal = Vec3<T>::UnitX();
-  SupportPoint<T> best_support{};
+  // Read only once best_upper is finite, which sets it too; zeroed because Eigen's default constructor leaves it
+  // uninitialised and GCC 12 cannot see the link (-Wmaybe-uninitialized).
+  SupportPoint<T> best_support{Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero()};
   r.status = EpaStatus::max_iterations;
   std::vector<detail::HorizonEdge> horizon;
   std::vector<int> removed, forced;

@@ -5,7 +5,8 @@
 #   tools/run.sh asan-test        same, built with AddressSanitizer + UBSan in build-asan/
 # Missing Debian packages are installed with apt-get when running as root; otherwise the script prints the
 # exact install command and stops. BATCHCOL_BUILD_DIR overrides the build folder (default: build/);
-# BATCHCOL_CMAKE_ARGS adds CMake options (CI builds the demo with the optional peers switched off through it).
+# BATCHCOL_CMAKE_ARGS adds CMake options (CI builds the demo with the optional peers switched off through it, and
+# both builds with -DBATCHCOL_WERROR=ON: warnings are errors there).
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

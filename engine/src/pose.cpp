@@ -1,5 +1,6 @@
 #include "batchcol/errors.hpp"
 #include "batchcol/pose.hpp"
+#include "validate.hpp"
 
 #include <cmath>
 #include <iomanip>
@@ -7,8 +8,13 @@
 
 namespace batchcol {
 
+// Every quaternion check of the library goes through detail::normalize_unit_quaternion (validate.hpp), the rule of
+// the executor's hot path and the SIMD kernels: near the kUnitTolerance boundary the last bit of the norm decides,
+// so one summation order everywhere (not Eigen's norm() here and a fixed order there) keeps the same quaternion
+// valid or invalid whatever the shape types, the kernel or the entry point.
 bool is_unit_quaternion(const Eigen::Quaterniond& q) {
-  return q.coeffs().allFinite() && std::abs(q.norm() - 1.0) <= kUnitTolerance;
+  double c[4] = {q.w(), q.x(), q.y(), q.z()};
+  return detail::normalize_unit_quaternion(c);
 }
 
 Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
@@ -21,7 +27,7 @@ Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q) {
         << std::setprecision(10) << norm;
     throw InputError(msg.str());
   }
-  return q.normalized();
+  return *detail::unit_quaternion(q);
 }
 
 Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R) {

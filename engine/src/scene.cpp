@@ -1,5 +1,6 @@
 // batchcol::Scene: object bookkeeping (stable handles over dense arrays) and the per-frame pipeline
 // world AABBs -> sweep-and-prune (+ halfspaces) -> one PairBatch -> batchcol::collide().
+#include "scene_hooks.hpp"
 #include "scene_state.hpp"
 
 #include <tbb/blocked_range.h>
@@ -329,8 +330,8 @@ void Scene::collide(const QueryOptions& options, SceneResults& results) {
   if (s.frame_buffer_bytes() != bytes_before) ++s.reallocations;
 }
 
-void Scene::last_aabbs(std::vector<Aabb>& boxes, std::vector<ObjectHandle>& objects) const {
-  const State& s = *state_;
+void detail::SceneHooks::last_aabbs(const Scene& scene, std::vector<Aabb>& boxes, std::vector<ObjectHandle>& objects) {
+  const Scene::State& s = *scene.state_;
   if (s.topology_changed || s.boxes.size() != s.finite.size())
     throw InputError("scene: last_aabbs() needs a collide() after the last add() or remove()");
   const std::size_t n = s.finite.size();
@@ -354,6 +355,6 @@ std::size_t Scene::memory_bytes() const {
   return b;
 }
 
-std::size_t Scene::buffer_reallocations() const { return state_->reallocations; }
+std::size_t detail::SceneHooks::buffer_reallocations(const Scene& scene) { return scene.state_->reallocations; }
 
 }  // namespace batchcol

@@ -139,7 +139,7 @@ double Shape::bounding_radius() const {
   switch (type) {
     case ShapeType::sphere: core = size.x(); break;
     case ShapeType::capsule: core = size.x() + size.y(); break;
-    // (x x + y y) + z z without hypot's scaling (~70 instructions per call on the per-pair path); sizes are
+    // (x x + y y) + z z without hypot's scaling, which is costly on the per-pair path and not needed: sizes are
     // finite, and hypot takes over only if the squares overflow.
     case ShapeType::box: core = std::sqrt((size.x() * size.x() + size.y() * size.y()) + size.z() * size.z()); break;
     case ShapeType::cylinder:

@@ -76,8 +76,9 @@ void refuse_beyond_float_limits(const PairBatchView& batch, std::size_t begin, s
 }
 
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {
-  if (!is_unit_quaternion(q)) return std::nullopt;
-  return q.normalized();
+  double c[4] = {q.w(), q.x(), q.y(), q.z()};
+  if (!normalize_unit_quaternion(c)) return std::nullopt;
+  return Eigen::Quaterniond(c[0], c[1], c[2], c[3]);
 }
 
 }  // namespace detail

@@ -27,10 +27,12 @@ inline bool translation_in_range(const Eigen::Vector3d& t) {
 /// translation_b - translation_a) become invalid_input, whatever the float kernels computed for them.
 void refuse_beyond_float_limits(const PairBatchView& batch, std::size_t begin, std::size_t end, PairResults& results);
 
-/// The unit quaternion for `q`, or nothing when q is not finite or not unit within kUnitTolerance.
+/// The unit quaternion for `q` (normalize_unit_quaternion's rule and division), or nothing when q is not finite or
+/// not unit within kUnitTolerance.
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q);
 
-/// The executor's rule on its hot path: q = (w, x, y, z) is accepted when | |q| - 1 | <= kUnitTolerance, with
+/// THE quaternion rule of the library (is_unit_quaternion, checked_unit_quaternion, unit_quaternion, the executor's
+/// hot path, scenes and rays all call it): q = (w, x, y, z) is accepted when | |q| - 1 | <= kUnitTolerance, with
 /// |q| = sqrt(((w w + x x) + y y) + z z) as the SIMD kernels compute it (a NaN or infinite component fails the
 /// comparison), and is then divided by |q| in place.
 inline bool normalize_unit_quaternion(double q[4]) {

@@ -44,8 +44,8 @@ template <class T> struct WideGjkPairs {
     std::size_t fallbacks = 0;
     std::size_t read = 0;  // pairs[0 .. read) went through the pose stage
     std::size_t next = 0;  // chunk slot the next load takes
-    Chunk chunk;
-    LanePair lane[W];
+    Chunk chunk{};      // value-initialised, as the aggregate initialisation in run() always did (-Wextra asks
+    LanePair lane[W]{};  // for it to be spelled out: -Wmissing-field-initializers)
     /// Normalised momentum directions unless both cores are strictly convex (ShapeCore::strictly_convex()).
     bool normalize = !(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid);
 

@@ -42,14 +42,15 @@ TEST(BroadphaseAabb, DoubleBoxesRoundOutwardToFloat) {
     const double x = uniform(rng, -1e3, 1e3) * std::pow(10.0, static_cast<int>(rng() % 20) - 10);
     EXPECT_LE(static_cast<double>(float_down(x)), x);
     EXPECT_GE(static_cast<double>(float_up(x)), x);
-    if (static_cast<double>(float_down(x)) != x)  // tight: the next float up is already above x
+    if (static_cast<double>(float_down(x)) != x) {  // tight: the next float up is already above x
       EXPECT_GT(static_cast<double>(std::nextafter(float_down(x), FLT_MAX)), x);
+    }
   }
   EXPECT_FALSE(std::signbit(float_down(-0.0)));
   EXPECT_FALSE(std::signbit(float_up(-1e-300)));  // rounds up to -0, stored as +0
   AabbSoa s;
   s.resize(1);
-  s.set(0, {Eigen::Vector3d(0.1, -0.1, 1.0 / 3), Eigen::Vector3d(0.2, 0.3, 2.0 / 3)}, 0.05);
+  s.set(0, Aabb{Eigen::Vector3d(0.1, -0.1, 1.0 / 3), Eigen::Vector3d(0.2, 0.3, 2.0 / 3)}, 0.05);
   EXPECT_LE(s.min_x[0], 0.1 - 0.05);
   EXPECT_GE(s.max_y[0], 0.3 + 0.05);
 }
@@ -124,9 +125,9 @@ TEST(BroadphaseAabb, BadInputIsRejectedNamingTheObject) {
   AabbSoa s;
   s.resize(3);
   const double dnan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(s.set(2, {Eigen::Vector3d(0, dnan, 0), Eigen::Vector3d(1, 1, 1)}), InputError);
+  EXPECT_THROW(s.set(2, Aabb{Eigen::Vector3d(0, dnan, 0), Eigen::Vector3d(1, 1, 1)}), InputError);
   try {
-    s.assign({Aabb{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()},
+    s.assign(std::vector<Aabb>{Aabb{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()},
               Aabb{Eigen::Vector3d::Zero(), Eigen::Vector3d(1, -1, 1)}});
     ADD_FAILURE();
   } catch (const InputError& e) {
@@ -134,13 +135,13 @@ TEST(BroadphaseAabb, BadInputIsRejectedNamingTheObject) {
   }
   try {
     const double big = std::numeric_limits<double>::infinity();
-    s.assign({Aabb{Eigen::Vector3d::Constant(-big), Eigen::Vector3d::Constant(big)}});  // a halfspace's box
+    s.assign(std::vector<Aabb>{Aabb{Eigen::Vector3d::Constant(-big), Eigen::Vector3d::Constant(big)}});  // a halfspace's box
     ADD_FAILURE();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("object 0: min.x = -inf is not finite"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(s.set(0, {Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1e39)}), InputError);  // beyond float
-  EXPECT_THROW(s.set(0, {Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()}, -1.0), InputError);   // negative margin
+  EXPECT_THROW(s.set(0, Aabb{Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1e39)}), InputError);  // beyond float
+  EXPECT_THROW(s.set(0, Aabb{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()}, -1.0), InputError);   // negative margin
 }
 
 TEST(BroadphaseAabb, FilterOfTheWrongSizeIsRejected) {

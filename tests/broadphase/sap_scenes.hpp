@@ -1,13 +1,17 @@
-// Seeded AABB scenes shared by the broad-phase tests: uniform, clustered and degenerate layouts.
+// Seeded AABB scenes shared by the broad-phase tests: uniform, clustered and degenerate layouts. Drawn from the
+// testkit's PortableRandom, one draw per statement, so a seed gives the same scene with every standard library and
+// compiler (std:: distributions and the order of evaluation of function arguments do not).
 #pragma once
 
+#include "batchcol/shapes.hpp"  // batchcol::Aabb: the broad phase itself sees only plain types
 #include "broadphase/aabb_soa.hpp"
 #include "broadphase/pairs.hpp"
+#include "testkit/portable_random.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <ostream>
-#include <random>
 #include <vector>
 
 namespace batchcol::broadphase {
@@ -17,9 +21,23 @@ inline void PrintTo(const CandidatePair& p, std::ostream* os) { *os << "(" << p.
 
 namespace batchcol::broadphase::testing {
 
-using Rng = std::mt19937_64;
+using Rng = testkit::PortableRandom;
 
-inline double uniform(Rng& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+inline double uniform(Rng& rng, double lo, double hi) { return rng.uniform(lo, hi); }
+
+/// Uniform in [lo, hi]^3, x drawn first.
+inline Eigen::Vector3d uniform3(Rng& rng, double lo, double hi) {
+  const double x = uniform(rng, lo, hi);
+  const double y = uniform(rng, lo, hi);
+  const double z = uniform(rng, lo, hi);
+  return {x, y, z};
+}
+
+/// Standard normal deviate (Box-Muller from the portable source).
+inline double gauss(Rng& rng) {
+  const double u = std::max(rng.uniform(), 1e-300), v = rng.uniform();
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * 3.14159265358979323846 * v);
+}
 
 inline Aabb box_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& half) { return {centre - half, centre + half}; }
 
@@ -33,9 +51,8 @@ inline AabbSoa to_soa(const std::vector<Aabb>& boxes, double margin = 0.0) {
 inline std::vector<Aabb> uniform_boxes(Rng& rng, std::size_t n, double side, double half_size, double lo = 0.0) {
   std::vector<Aabb> b;
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d c(uniform(rng, lo, lo + side), uniform(rng, lo, lo + side), uniform(rng, lo, lo + side));
-    const Eigen::Vector3d h(uniform(rng, 0.5, 1.5) * half_size, uniform(rng, 0.5, 1.5) * half_size,
-                            uniform(rng, 0.5, 1.5) * half_size);
+    const Eigen::Vector3d c = uniform3(rng, lo, lo + side);
+    const Eigen::Vector3d h = uniform3(rng, 0.5, 1.5) * half_size;
     b.push_back(box_at(c, h));
   }
   return b;
@@ -49,11 +66,14 @@ inline double half_size_for(std::size_t n, double overlaps) {
 /// Gaussian clusters of boxes.
 inline std::vector<Aabb> clustered_boxes(Rng& rng, std::size_t n, int clusters) {
   std::vector<Eigen::Vector3d> centres;
-  for (int k = 0; k < clusters; ++k) centres.emplace_back(uniform(rng, -50, 50), uniform(rng, -50, 50), uniform(rng, -5, 5));
-  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (int k = 0; k < clusters; ++k) centres.push_back(uniform3(rng, -50, 50).cwiseProduct(Eigen::Vector3d(1, 1, 0.1)));
   std::vector<Aabb> b;
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d c = centres[rng() % centres.size()] + Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
+    const Eigen::Vector3d& centre = centres[rng() % centres.size()];
+    const double gx = gauss(rng);
+    const double gy = gauss(rng);
+    const double gz = gauss(rng);
+    const Eigen::Vector3d c = centre + Eigen::Vector3d(gx, gy, gz);
     b.push_back(box_at(c, Eigen::Vector3d::Constant(uniform(rng, 0.02, 0.2))));
   }
   return b;

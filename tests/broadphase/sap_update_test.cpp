@@ -25,7 +25,7 @@ std::vector<CandidatePair> rebuilt(const AabbSoa& s, const FilterSoa& f) {
 
 void move_all(Rng& rng, std::vector<Aabb>& b, double step) {
   for (Aabb& box : b) {
-    const Eigen::Vector3d d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Eigen::Vector3d d = uniform3(rng, -1, 1);
     box.min += d * step, box.max += d * step;
   }
 }
@@ -66,7 +66,7 @@ TEST(SapUpdate, LargeMotionsFillTheOverflowThenRebucketAndEqualRebuild) {
     move_all(rng, b, 0.05 * h);
     for (std::size_t k = 0; k < n / 33; ++k) {
       Aabb& box = b[rng() % n];
-      const Eigen::Vector3d jump(uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5));
+      const Eigen::Vector3d jump = uniform3(rng, -0.5, 0.5);
       box.min += jump, box.max += jump;
     }
     const AabbSoa s = to_soa(b);

@@ -111,7 +111,7 @@ TEST(SweepAndPrune, DegenerateScenes) {
     auto b = uniform_boxes(rng, 3000, 100.0, 0.01);
     for (int k = 0; k < 40; ++k)
       b.push_back(box_at({uniform(rng, 0, 100), uniform(rng, 0, 100), uniform(rng, 0, 100)},
-                         Eigen::Vector3d(uniform(rng, 5, 60), uniform(rng, 5, 60), uniform(rng, 5, 60))));
+                         uniform3(rng, 5, 60)));
     b.push_back(box_at({50, 50, 50}, Eigen::Vector3d::Constant(1e30)));  // covers everything
     expect_equals_brute_force(to_soa(b));
   }
@@ -135,7 +135,7 @@ TEST(SweepAndPrune, DegenerateScenes) {
     for (int i = 0; i < 5000; ++i) {
       line.push_back(box_at({0.15 * i, 0, 0}, h));
       point.push_back(box_at({1, 2, 3}, h));
-      const Eigen::Vector3d c(uniform(rng, 0, 100), uniform(rng, 0, 100), uniform(rng, 0, 100));
+      const Eigen::Vector3d c = uniform3(rng, 0, 100);
       periodic.push_back(box_at(c, Eigen::Vector3d::Constant(i % 4 == 0 ? 2.0 : 0.01)));
     }
     expect_equals_brute_force(to_soa(line));
@@ -252,7 +252,7 @@ TEST(SweepAndPrune, SweepAxisIsTheAxisOfLargestVariance) {
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<Aabb> b;
     for (int i = 0; i < 1000; ++i) {
-      Eigen::Vector3d c(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1));
+      Eigen::Vector3d c = uniform3(rng, 0, 1);
       c[axis] *= 10;
       b.push_back(box_at(c, Eigen::Vector3d::Constant(0.01)));
     }
@@ -276,7 +276,7 @@ TEST(SweepAndPrune, IncrementalUpdatesEqualRebuildAfterSmallMotions) {
   for (int frame = 0; frame < 6; ++frame) {
     const double step_size = frame < 4 ? 0.01 * h : 0.3 * h;
     for (Aabb& box : b) {
-      const Eigen::Vector3d step(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+      const Eigen::Vector3d step = uniform3(rng, -1, 1);
       box.min += step * step_size, box.max += step * step_size;
     }
     const AabbSoa s = to_soa(b);
@@ -288,7 +288,7 @@ TEST(SweepAndPrune, IncrementalUpdatesEqualRebuildAfterSmallMotions) {
   }
   EXPECT_TRUE(pairs == brute_force_pairs(to_soa(b), f));
   // A shuffle keeps the grid (the same boxes in another order) and still gives the same pairs.
-  std::shuffle(b.begin(), b.end(), rng);
+  for (std::size_t i = b.size(); i > 1; --i) std::swap(b[i - 1], b[rng.index(i)]);  // Fisher-Yates, portable
   const AabbSoa s = to_soa(b);
   incremental.update(s, f, pairs);
   EXPECT_TRUE(incremental.stats().incremental);

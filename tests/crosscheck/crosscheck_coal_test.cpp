@@ -32,8 +32,9 @@ constexpr double kCoalTolerance = 1e-10;
 constexpr double kCoalAgreement = 1e-6;
 // Coal's EPA runs at 1e-6 at best (peers/coal_adapter.hpp), so its depths differ from batchcol's by more than the
 // agreement tolerance on some pairs, and the certificates prove it: measured up to 1.7% of the overlapping
-// ellipsoid pairs (median 3e-6 m, max 1.1e-3 m), 0-0.6% on the other types. Separated distances never disagreed.
-constexpr double kCoalMaxPeerWrong = 0.02;
+// ellipsoid pairs (median 3e-6 m, max 1.1e-3 m), 0-0.6% on the other types, with std:: distributions; 2.5% on
+// nesterov ellipsoid pairs with the portable generator's draws. Separated distances never disagreed.
+constexpr double kCoalMaxPeerWrong = 0.03;
 
 /// Coal 3.0's sphereCylinderDistance (src/narrowphase/details.h), which coal::distance runs for sphere-cylinder
 /// pairs, returns the radial depth dPS - r_sphere - r_cylinder whenever the sphere's centre is between the caps, even

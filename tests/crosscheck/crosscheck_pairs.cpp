@@ -28,10 +28,9 @@ CrossPairs make_pairs(std::uint64_t seed, ShapeType primary, const std::vector<S
   CrossPairs out;
   out.batch.reserve(count);
   out.plane_gap.reserve(count);
-  std::uniform_int_distribution<std::size_t> pick(0, partners.size() - 1);
   for (std::size_t i = 0; i < count; ++i) {
     Shape a = testing::random_shape(rng, primary);
-    Shape b = testing::random_shape(rng, partners[pick(rng)]);
+    Shape b = testing::random_shape(rng, partners[rng.index(partners.size())]);
     if (uniform(rng, 0, 1) < 0.5) std::swap(a, b);
     Pose pa = random_pose(rng);
     Pose pb{Eigen::Vector3d::Zero(), testing::random_rotation(rng)};

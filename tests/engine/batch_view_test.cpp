@@ -22,7 +22,7 @@ TEST(PairBatchView, SameBitsAsPairBatchAtEveryLevelFromForeignMemory) {
   PairBatch batch;
   const std::size_t n = 3000;
   for (std::size_t i = 0; i < n; ++i) {
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
                   testing::random_rotation(rng)};
     batch.add(static_cast<std::uint32_t>(rng() % shapes.size()), pa, static_cast<std::uint32_t>(rng() % shapes.size()), pb);

@@ -42,7 +42,7 @@ Scene gjk_scene(std::size_t pairs, std::uint64_t seed) {
   for (std::size_t i = 0; i < pairs; ++i) {
     const auto a = static_cast<std::uint32_t>(rng() % s.shapes.size());
     const auto b = static_cast<std::uint32_t>(rng() % s.shapes.size());
-    Pose pa{Eigen::Vector3d::Random() * 3.0, testing::random_rotation(rng)};
+    Pose pa{testing::random_vector(rng) * 3.0, testing::random_rotation(rng)};
     Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.6),
             testing::random_rotation(rng)};
     std::uint32_t ia = a;
@@ -173,7 +173,7 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
   const std::size_t n = 700;
   std::vector<std::uint32_t> invalid;
   for (std::size_t i = 0; i < n; ++i) {
-    Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0.05, 0.5),
             testing::random_rotation(rng)};
     if (i % 53 == 7) pa.rotation.coeffs() *= 0.9, invalid.push_back(static_cast<std::uint32_t>(i));
@@ -193,7 +193,7 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
   fallback.resize(left);
   std::sort(fallback.begin(), fallback.end());
   // Double never stalls above its floor here; float may hand back a stalled pair (redone in double elsewhere).
-  if (std::is_same_v<T, double>) EXPECT_EQ(fallback, invalid);
+  if (std::is_same_v<T, double>) { EXPECT_EQ(fallback, invalid); }
   EXPECT_TRUE(std::includes(fallback.begin(), fallback.end(), invalid.begin(), invalid.end()));
   EXPECT_LE(left, invalid.size() + n / 100);
   const PairResults want = reference<T>(s, o, got);

@@ -28,7 +28,7 @@ Scene mixed_scene(std::size_t pairs, std::uint64_t seed) {
   for (std::size_t i = 0; i < pairs; ++i) {
     const auto a = static_cast<std::uint32_t>(rng() % s.shapes.size());
     const auto b = static_cast<std::uint32_t>(rng() % s.shapes.size());
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
                   testing::random_rotation(rng)};
     s.batch.add(a, pa, b, pb);
@@ -204,7 +204,7 @@ TEST(Executor, WarmStartFromThePreviousFrameSavesIterations) {
   for (std::size_t i = 0; i < s.batch.size(); ++i) {
     cold += first.iterations[i];
     warm += second.iterations[i];
-    if (first.distance[i] > 0) EXPECT_NEAR(first.distance[i], second.distance[i], 1e-7) << i;
+    if (first.distance[i] > 0) { EXPECT_NEAR(first.distance[i], second.distance[i], 1e-7) << i; }
   }
   EXPECT_LT(warm, cold * 0.8) << "cold " << cold << " warm " << warm;
 }
@@ -276,7 +276,7 @@ TEST(Executor, OneTypeTableGivesTheResultsOfTheGeneralGrouping) {
     const std::uint32_t invalid[] = {999, 0x80000000u, 0xffffffffu};
     for (std::size_t i = 0; i < 3000; ++i) {
       const auto a = static_cast<std::uint32_t>(rng() % 5), b = static_cast<std::uint32_t>(rng() % 5);
-      const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+      const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
       const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0, 0.5),
                     testing::random_rotation(rng)};
       // Pairs 2500.. (the third tile) hold invalid indices; the first two tiles are all valid.

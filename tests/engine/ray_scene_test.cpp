@@ -117,7 +117,7 @@ void expect_matches_brute_force(const RaySceneIndex& index, const World& w, cons
     ++hits;
     EXPECT_NEAR(closest.t[i], b[0].t, kTransformSlack);
     // The same object, unless a second one is hit within the slack (a tie up to rounding).
-    if (b.size() < 2 || b[1].t - b[0].t > kTransformSlack) EXPECT_EQ(closest.object[i], b[0].object);
+    if (b.size() < 2 || b[1].t - b[0].t > kTransformSlack) { EXPECT_EQ(closest.object[i], b[0].object); }
     EXPECT_NEAR(closest.normal[i].norm(), 1.0, 1e-12);
     // Any: one of the objects brute force hits, at its t.
     const auto it = std::find_if(b.begin(), b.end(), [&](const BruteHit& h) { return h.object == any.object[i]; });
@@ -128,7 +128,7 @@ void expect_matches_brute_force(const RaySceneIndex& index, const World& w, cons
       const auto m = std::find_if(b.begin(), b.end(), [&](const BruteHit& h) { return h.object == all.all_object[row]; });
       ASSERT_NE(m, b.end());
       EXPECT_NEAR(all.all_t[row], m->t, kTransformSlack);
-      if (row > all.hit_begin[i]) EXPECT_LE(all.all_t[row - 1], all.all_t[row]);
+      if (row > all.hit_begin[i]) { EXPECT_LE(all.all_t[row - 1], all.all_t[row]); }
     }
     EXPECT_EQ(all.t[i], all.all_t[all.hit_begin[i]]);
   }

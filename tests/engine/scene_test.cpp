@@ -4,6 +4,7 @@
 #include "support/generators.hpp"
 
 #include "batchcol/scene.hpp"
+#include "scene_hooks.hpp"  // engine/src: last_aabbs, buffer_reallocations
 
 #include <gtest/gtest.h>
 
@@ -160,7 +161,7 @@ TEST(Scene, WorldBoxesContainTheShapesAndAreTightForPrimitives) {
   scene.collide(options_at(QueryLevel::boolean, margin), results);
   std::vector<Aabb> boxes;
   std::vector<ObjectHandle> objects;
-  scene.last_aabbs(boxes, objects);
+  detail::SceneHooks::last_aabbs(scene, boxes, objects);
   ASSERT_EQ(boxes.size(), handles.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Shape& shape = (*shapes)[scene.shape(objects[i])];
@@ -318,7 +319,7 @@ TEST(Scene, WarmFramesReuseBuffers) {
     scene.collide(options, r);
   };
   frame(a), frame(b), frame(a), frame(b);  // warm-up
-  const std::size_t reallocations = scene.buffer_reallocations();
+  const std::size_t reallocations = detail::SceneHooks::buffer_reallocations(scene);
   const std::size_t bytes = scene.memory_bytes();
   const void* const pointers[] = {r.object_a.data(), r.pairs.distance.data(), r.pairs.normal.x.data(),
                                   r.colliding.data()};
@@ -327,7 +328,7 @@ TEST(Scene, WarmFramesReuseBuffers) {
     EXPECT_TRUE(r.incremental);
   }
   EXPECT_GT(r.colliding_count(), 1000u);
-  EXPECT_EQ(scene.buffer_reallocations(), reallocations);
+  EXPECT_EQ(detail::SceneHooks::buffer_reallocations(scene), reallocations);
   EXPECT_EQ(scene.memory_bytes(), bytes);
   const void* const after[] = {r.object_a.data(), r.pairs.distance.data(), r.pairs.normal.x.data(),
                                r.colliding.data()};
@@ -335,7 +336,7 @@ TEST(Scene, WarmFramesReuseBuffers) {
   // The counter does move when a frame needs more room: the check can fail.
   for (std::size_t i = 0; i < handles.size(); ++i) scene.set_pose(handles[i], Pose::from_translation(a[i].translation * 0.5));
   scene.collide(options, r);
-  EXPECT_GT(scene.buffer_reallocations(), reallocations);
+  EXPECT_GT(detail::SceneHooks::buffer_reallocations(scene), reallocations);
 }
 
 TEST(Scene, RebuildRenumbersObjectsSpatiallyKeepingHandlesPosesAndResults) {
@@ -369,7 +370,7 @@ TEST(Scene, RebuildRenumbersObjectsSpatiallyKeepingHandlesPosesAndResults) {
   }
   std::vector<Aabb> boxes;
   std::vector<ObjectHandle> owners;
-  scene.last_aabbs(boxes, owners);
+  detail::SceneHooks::last_aabbs(scene, boxes, owners);
   ASSERT_EQ(boxes.size(), handles.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Aabb exact = compute_aabb((*shapes)[scene.shape(owners[i])], scene.pose(owners[i]).rotation,
@@ -401,10 +402,10 @@ TEST(Scene, RejectsBadInput) {
   EXPECT_EQ(r.candidate_count(), 0u);
   std::vector<Aabb> boxes;
   std::vector<ObjectHandle> objects;
-  scene.last_aabbs(boxes, objects);
+  detail::SceneHooks::last_aabbs(scene, boxes, objects);
   EXPECT_EQ(objects, std::vector<ObjectHandle>{h});
   scene.add(0, Pose::identity());
-  EXPECT_THROW(scene.last_aabbs(boxes, objects), InputError);  // boxes of a different set of objects
+  EXPECT_THROW(detail::SceneHooks::last_aabbs(scene, boxes, objects), InputError);  // boxes of a different set of objects
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ TEST(Shapes, AabbIsTightAndBoundingRadiusContainsTheShape) {
       Shape s = testing::random_shape(rng, t);
       if (trial % 2) s = s.inflated(0.01);
       const Eigen::Quaterniond q = testing::random_rotation(rng);
-      const Eigen::Vector3d p = Eigen::Vector3d::Random();
+      const Eigen::Vector3d p = testing::random_vector(rng);
       const Aabb box = compute_aabb(s, q, p);
       for (int axis = 0; axis < 3; ++axis) {
         const Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);

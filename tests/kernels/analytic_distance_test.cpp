@@ -50,7 +50,7 @@ Config make_config(Rng& rng, ShapeType ta, ShapeType tb, double gap) {
   const double ha = testing::extent(c.a, Ra.transpose() * e), hb = testing::extent(c.b, Rb.transpose() * -e);
   const double L = ha + hb + gap;
   const Eigen::Quaterniond Q = testing::random_rotation(rng);
-  const Eigen::Vector3d T = Eigen::Vector3d::Random() * 10;
+  const Eigen::Vector3d T = testing::random_vector(rng) * 10;
   c.pa = {T, Q * Eigen::Quaterniond(Ra)};
   c.pb = {T + Q * (L * e), Q * Eigen::Quaterniond(Rb)};
   c.distance = gap;

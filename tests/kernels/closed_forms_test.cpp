@@ -28,7 +28,7 @@ TEST_P(ClosedFormVsGjk, AgreeOnRandomPairs) {
   for (int trial = 0; trial < 2000; ++trial) {
     Shape a = testing::random_shape(rng, f.a), b = testing::random_shape(rng, f.b);
     if (trial % 4 == 0) a = a.inflated(testing::uniform(rng, 0, 0.03));
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     const Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.5),
                   testing::random_rotation(rng)};
     const auto c = testing::run_pair(a, pa, b, pb, closed);
@@ -97,7 +97,7 @@ TEST(ClosedForms, HalfspaceAgainstEveryShapeMatchesExtentFormula) {
       const double offset = testing::uniform(rng, -0.2, 0.2);
       const Shape h = Shape::halfspace(n, offset).inflated(trial % 3 == 0 ? 0.01 : 0.0);
       const Shape b = testing::random_shape(rng, t);
-      const Pose pb{Eigen::Vector3d::Random() * 0.5, testing::random_rotation(rng)};
+      const Pose pb{testing::random_vector(rng) * 0.5, testing::random_rotation(rng)};
       const double expected =
           n.dot(pb.translation) - testing::extent(b, pb.rotation.inverse() * -n) - offset - h.inflation;
       for (bool swap : {false, true}) {

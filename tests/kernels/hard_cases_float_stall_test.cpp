@@ -71,7 +71,7 @@ TEST(HardCasesFloatStall, EveryConvergedFloatResultIsWithinTheToleranceOrTwoFloo
     ShapeType tb = curved[rng() % curved.size()];
     if (point_or_segment(ta) && point_or_segment(tb)) tb = curved[rng() % 3];
     const Shape a = testing::random_shape(rng, ta), b = testing::random_shape(rng, tb);
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     Pose pb{pa.translation + testing::random_unit_vector(rng), testing::random_rotation(rng)};
     const auto first = testing::run_pair(a, pa, b, pb, double_reference());
     ASSERT_GT(first.distance, 0.0);
@@ -112,7 +112,7 @@ TEST(HardCasesFloatStall, ConeConeCloseRegimeRelativeErrorBelow1e5) {
   double worst = 0.0;
   for (int trial = 0; trial < 1000; ++trial) {
     const Shape a = testing::random_shape(rng, ShapeType::cone), b = testing::random_shape(rng, ShapeType::cone);
-    const Pose pa{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose pa{testing::random_vector(rng), testing::random_rotation(rng)};
     Pose pb{pa.translation + testing::random_unit_vector(rng), testing::random_rotation(rng)};
     const auto first = testing::run_pair(a, pa, b, pb, double_reference());
     pb.translation += (std::pow(10.0, testing::uniform(rng, -4, -2)) - first.distance) * first.normal;

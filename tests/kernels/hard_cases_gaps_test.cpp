@@ -96,7 +96,7 @@ double sweep_gaps(const Family& f, Precision p, double bound, const char* family
         EXPECT_LE(error, bound);
         worst = std::max(worst, error);
         // Collision is decided up to the bound: only gaps beyond it must be classified exactly.
-        if (gap > bound) EXPECT_EQ(r.collide, sign < 0);
+        if (gap > bound) { EXPECT_EQ(r.collide, sign < 0); }
         const double angle = std::acos(std::min(1.0, r.normal.x()));
         worst_angle_ratio = std::max(worst_angle_ratio, angle * gap / epsilon(p));
         EXPECT_LE(angle, 1e-7 + 20 * epsilon(p) / gap);  // measured <= 2.2 eps / gap (float), <= 0.3 eps / gap (double)
@@ -149,7 +149,7 @@ TEST(HardCasesGaps, ExactTouchingFaceFaceEdgeEdgeVertexFace) {
         if (level == QueryLevel::penetration || (level != QueryLevel::boolean && !r.collide)) {
           EXPECT_LE(std::abs(r.distance), bound);
           worst = std::max(worst, std::abs(r.distance));
-          if (!r.collide) EXPECT_GE(r.distance, 0.0);
+          if (!r.collide) { EXPECT_GE(r.distance, 0.0); }
         }
       }
     std::printf("[measured] exact touching, %s: max |distance| %.3g m (bound %.0e)\n", precision_name(p), worst, bound);

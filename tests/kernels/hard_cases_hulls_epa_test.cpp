@@ -72,8 +72,8 @@ TEST(HardCasesHulls, MessyPointsGiveTheSamePolytopeAsTheBoxPrimitive) {
     for (ShapeType t : testing::bounded_shape_types())
       for (int trial = 0; trial < 30; ++trial) {
         const Shape other = testing::random_shape(rng, t);
-        const Pose pa{Eigen::Vector3d::Random() * 0.1, testing::random_rotation(rng)};
-        const Pose pb{Eigen::Vector3d::Random() * 0.4, testing::random_rotation(rng)};
+        const Pose pa{testing::random_vector(rng) * 0.1, testing::random_rotation(rng)};
+        const Pose pb{testing::random_vector(rng) * 0.4, testing::random_rotation(rng)};
         SCOPED_TRACE(std::string(to_string(t)) + " trial " + std::to_string(trial) + " " + precision_name(p));
         const auto from_hull = testing::run_pair(hull, pa, other, pb, hard_case_options(p, QueryLevel::penetration, 1e-10));
         const auto from_box = testing::run_pair(box, pa, other, pb, hard_case_options(p, QueryLevel::penetration, 1e-10));

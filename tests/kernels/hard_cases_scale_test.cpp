@@ -153,7 +153,7 @@ TEST(HardCasesScale, IdenticalPosesGiveTheMinimalWidth) {
     double worst = 0.0;
     for (const auto& c : cases)
       for (int trial = 0; trial < 4; ++trial) {
-        const Pose pose{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+        const Pose pose{testing::random_vector(rng), testing::random_rotation(rng)};
         SCOPED_TRACE(std::string(to_string(c.shape.type)) + " trial " + std::to_string(trial) + " " + precision_name(p));
         QueryOptions o = hard_case_options(p);
         if (p == Precision::float64) o.tolerance = 1e-9;  // EPA on a curved Minkowski difference: 1e-12 needs >2000 faces
@@ -166,7 +166,7 @@ TEST(HardCasesScale, IdenticalPosesGiveTheMinimalWidth) {
     // Shapes without a simple width formula: only sanity (finite, overlapping, negative distance).
     for (ShapeType t : {ShapeType::cone, ShapeType::convex}) {
       const Shape s = testing::random_shape(rng, t);
-      const Pose pose{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+      const Pose pose{testing::random_vector(rng), testing::random_rotation(rng)};
       const auto r = testing::run_pair(s, pose, s, pose, hard_case_options(p));
       SCOPED_TRACE(std::string(to_string(t)) + " " + precision_name(p));
       // A cone's self Minkowski difference is curved around its minimal width too: EPA may run out of budget
@@ -185,7 +185,7 @@ TEST(HardCasesScale, IdenticalPosesGiveTheMinimalWidth) {
     double rod_worst = 0.0;
     for (int trial = 0; trial < 4; ++trial) {
       const Shape rod = Shape::cylinder(0.05, 0.3);
-      const Pose pose{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+      const Pose pose{testing::random_vector(rng), testing::random_rotation(rng)};
       const auto r = testing::run_pair(rod, pose, rod, pose, hard_case_options(p));
       SCOPED_TRACE("long cylinder trial " + std::to_string(trial) + " " + precision_name(p));
       EXPECT_EQ(r.status, p == Precision::float64 ? Status::max_iterations : Status::converged);

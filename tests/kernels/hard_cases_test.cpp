@@ -62,8 +62,9 @@ TEST(HardCases, ExactTouchingFaceFaceEdgeEdgeVertexFace) {
       SCOPED_TRACE(std::string(c.name) + " " + to_string(level));
       EXPECT_EQ(r.status, Status::converged);
       // Touching is decided within rounding: either a tiny gap, or an overlap of depth ~0.
-      if (level == QueryLevel::penetration || (level == QueryLevel::distance && !r.collide))
+      if (level == QueryLevel::penetration || (level == QueryLevel::distance && !r.collide)) {
         EXPECT_NEAR(r.distance, 0.0, 1e-13);
+      }
     }
 }
 
@@ -118,7 +119,7 @@ TEST(HardCases, IdenticalPosesOfIdenticalShapes) {
   Rng rng(4);
   for (ShapeType t : testing::bounded_shape_types()) {
     const Shape s = testing::random_shape(rng, t);
-    const Pose p{Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+    const Pose p{testing::random_vector(rng), testing::random_rotation(rng)};
     const auto r = testing::run_pair(s, p, s, p, opts());
     SCOPED_TRACE(to_string(t));
     EXPECT_TRUE(r.collide);
@@ -126,8 +127,8 @@ TEST(HardCases, IdenticalPosesOfIdenticalShapes) {
     EXPECT_LE(r.distance, 0.0);
     EXPECT_NE(r.status, Status::invalid_input);
     EXPECT_TRUE(r.normal.allFinite());
-    if (t == ShapeType::sphere) EXPECT_NEAR(r.distance, -2 * s.size.x(), 1e-12);
-    if (t == ShapeType::box) EXPECT_NEAR(r.distance, -2 * s.size.minCoeff(), 1e-9);
+    if (t == ShapeType::sphere) { EXPECT_NEAR(r.distance, -2 * s.size.x(), 1e-12); }
+    if (t == ShapeType::box) { EXPECT_NEAR(r.distance, -2 * s.size.minCoeff(), 1e-9); }
   }
 }
 

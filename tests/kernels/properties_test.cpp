@@ -18,7 +18,7 @@ struct RandomPair {
 RandomPair random_pair(Rng& rng, ShapeType ta, ShapeType tb) {
   RandomPair p{testing::random_shape(rng, ta), testing::random_shape(rng, tb), {}, {}};
   if (rng() % 4 == 0) p.b = p.b.inflated(testing::uniform(rng, 0.0, 0.02));
-  p.pa = {Eigen::Vector3d::Random(), testing::random_rotation(rng)};
+  p.pa = {testing::random_vector(rng), testing::random_rotation(rng)};
   p.pb = {p.pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.5),
           testing::random_rotation(rng)};
   return p;
@@ -66,11 +66,12 @@ TEST_P(Properties, KktSwapInvarianceSolversAndFloat) {
 
       const auto swapped = testing::run_pair(p.b, p.pb, p.a, p.pa, tight());
       EXPECT_NEAR(swapped.distance, r.distance, tol);
-      if (std::abs(r.distance) > 1e-6 && tb != ShapeType::triangle && GetParam() != ShapeType::triangle)
+      if (std::abs(r.distance) > 1e-6 && tb != ShapeType::triangle && GetParam() != ShapeType::triangle) {
         EXPECT_GT(swapped.normal.dot(-r.normal), 1 - 1e-6);
+      }
 
       const Eigen::Quaterniond Q = testing::random_rotation(rng);
-      const Eigen::Vector3d T = Eigen::Vector3d::Random() * 50;
+      const Eigen::Vector3d T = testing::random_vector(rng) * 50;
       const auto moved = testing::run_pair(p.a, Pose{Q * p.pa.translation + T, Q * p.pa.rotation}, p.b,
                                            Pose{Q * p.pb.translation + T, Q * p.pb.rotation}, tight());
       EXPECT_NEAR(moved.distance, r.distance, tol);

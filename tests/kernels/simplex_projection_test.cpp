@@ -52,7 +52,7 @@ bool check_step(const std::vector<Eigen::Vector3d>& p, const SimplexProjection<d
   const int n = static_cast<int>(p.size());
   const BruteForce ref = brute_force(p);
   const bool keeps_newest = (ref.support >> (n - 1)) & 1;
-  if (keeps_newest) EXPECT_NEAR(r.x.norm(), ref.distance, tol) << "trial " << trial;
+  if (keeps_newest) { EXPECT_NEAR(r.x.norm(), ref.distance, tol) << "trial " << trial; }
   if (r.count == 0) {  // no candidate: only a tetrahedron whose closest point lies on the old face
     EXPECT_EQ(n, 4) << "trial " << trial;
     EXPECT_FALSE(keeps_newest) << "trial " << trial;
@@ -69,7 +69,7 @@ TEST(SimplexProjection, MatchesBruteForceOnRandomSimplices) {
   for (int trial = 0; trial < 4000; ++trial) {
     const int n = 1 + trial % 4;
     std::vector<Eigen::Vector3d> p;
-    for (int i = 0; i < n; ++i) p.push_back(Eigen::Vector3d::Random() + Eigen::Vector3d::Constant(trial % 3 == 0 ? 0.0 : 0.7));
+    for (int i = 0; i < n; ++i) p.push_back(testing::random_vector(rng) + Eigen::Vector3d::Constant(trial % 3 == 0 ? 0.0 : 0.7));
     const SimplexProjection<double> r = project_origin(p.data(), n);
     (check_step(p, r, 1e-12, trial) ? exact : skipped) += 1;
     if (r.count == 0) continue;
@@ -81,7 +81,7 @@ TEST(SimplexProjection, MatchesBruteForceOnRandomSimplices) {
       x += r.lambda[k] * p[r.index[k]];
     }
     EXPECT_NEAR(sum, 1.0, 1e-12);
-    if (!r.contains_origin) EXPECT_LT((x - r.x).norm(), 1e-12);
+    if (!r.contains_origin) { EXPECT_LT((x - r.x).norm(), 1e-12); }
   }
   EXPECT_GT(exact, 2000);  // most random simplices have their closest point on the newest vertex's side
   EXPECT_GT(skipped, 100);
@@ -127,13 +127,13 @@ TEST(SimplexProjection, FloatVersionStaysWithinFloatRounding) {
     std::vector<Eigen::Vector3d> p;
     std::vector<Eigen::Vector3f> pf;
     for (int i = 0; i < n; ++i) {
-      p.push_back(Eigen::Vector3d::Random() + Eigen::Vector3d::Constant(0.5));
+      p.push_back(testing::random_vector(rng) + Eigen::Vector3d::Constant(0.5));
       pf.push_back(p.back().cast<float>());
     }
     const auto r = project_origin(pf.data(), n);
     const BruteForce ref = brute_force(p);
-    if ((ref.support >> (n - 1)) & 1) EXPECT_NEAR(r.x.norm(), ref.distance, 2e-6) << trial;
-    else if (r.count > 0) EXPECT_GE(r.x.norm(), ref.distance - 2e-6) << trial;
+    if ((ref.support >> (n - 1)) & 1) { EXPECT_NEAR(r.x.norm(), ref.distance, 2e-6) << trial; }
+    else if (r.count > 0) { EXPECT_GE(r.x.norm(), ref.distance - 2e-6) << trial; }
   }
 }
 

@@ -92,7 +92,7 @@ TEST(WideClosedForms, SphereCapsuleLanesEqualTheScalarClosedForm) {
       EXPECT_EQ(r.distance.empty(), level < QueryLevel::distance);  // not computed: no array at all
       EXPECT_EQ(r.witness_a.x.empty(), level < QueryLevel::witness);
       EXPECT_TRUE(std::isnan(r.direction.x[i]));  // closed forms have no search direction
-      if (level >= QueryLevel::distance) EXPECT_NEAR(r.distance[i], ref.distance, 1e-14) << "pair " << i;
+      if (level >= QueryLevel::distance) { EXPECT_NEAR(r.distance[i], ref.distance, 1e-14) << "pair " << i; }
       if (level >= QueryLevel::witness) {
         // The normal is (cb - ca) / |cb - ca|: a few ulps of the coordinates in the closest points, divided by
         // the core distance. The witness points add the radius times that; the closest points themselves agree
@@ -199,8 +199,9 @@ TEST(WideClosedForms, ReusedResultsKeepNothingOfTheLevelBefore) {
         EXPECT_EQ(r.distance.size(), level == QueryLevel::boolean ? 0 : b.pairs.size());
         for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal})
           EXPECT_TRUE((r.*m).x.empty() && (r.*m).y.empty() && (r.*m).z.empty()) << i;
-        if (r.status[i] != Status::invalid_input && level == QueryLevel::distance && !r.collide[i])
+        if (r.status[i] != Status::invalid_input && level == QueryLevel::distance && !r.collide[i]) {
           EXPECT_FALSE(std::isnan(r.distance[i])) << i;  // separated: computed
+        }
         const std::uint32_t ia = b.pairs.shape_a[i], ib = b.pairs.shape_b[i];
         if (r.status[i] == Status::invalid_input) {
           EXPECT_EQ(r.collide[i], 0) << i;
@@ -225,6 +226,8 @@ TEST(WideClosedForms, ReusedResultsKeepNothingOfTheLevelBefore) {
 }
 
 TEST(WideClosedForms, EveryInstructionSetThisCpuRunsGivesTheSameBits) {
+  if (!kernels::simd::cpu_has(InstructionSet::avx2))
+    GTEST_SKIP() << "this CPU runs only the scalar kernels: no wide set to compare with the scalar one";
   for (const bool boxes : {false, true}) {
     const Batch b = boxes ? box_batch(13) : mixed_batch(11);
     QueryOptions o;

@@ -6,21 +6,19 @@
 
 namespace batchcol::testing {
 
-double uniform(Rng& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(Rng& rng, double lo, double hi) { return rng.uniform(lo, hi); }
 
-Eigen::Vector3d random_unit_vector(Rng& rng) {
-  std::normal_distribution<double> g;
-  Eigen::Vector3d v;
-  do v = {g(rng), g(rng), g(rng)};
-  while (v.norm() < 1e-6);
-  return v.normalized();
+Eigen::Vector3d random_vector(Rng& rng, double scale) {
+  // One draw per statement: the evaluation order of constructor arguments is unspecified.
+  const double x = rng.uniform(-scale, scale);
+  const double y = rng.uniform(-scale, scale);
+  const double z = rng.uniform(-scale, scale);
+  return {x, y, z};
 }
 
-Eigen::Quaterniond random_rotation(Rng& rng) {
-  std::normal_distribution<double> g;
-  Eigen::Quaterniond q(g(rng), g(rng), g(rng), g(rng));
-  return q.normalized();
-}
+Eigen::Vector3d random_unit_vector(Rng& rng) { return rng.unit_vector(); }
+
+Eigen::Quaterniond random_rotation(Rng& rng) { return rng.rotation(); }
 
 std::vector<ShapeType> bounded_shape_types() {
   return {ShapeType::sphere,    ShapeType::capsule,  ShapeType::box,     ShapeType::cylinder,

@@ -1,17 +1,21 @@
-// Seeded generators of shapes, poses and pairs shared by the tests (and later the benchmarks).
+// Seeded generators of shapes, poses and pairs shared by the tests and the benchmarks. They draw from the testkit's
+// PortableRandom, so a seed gives the same shapes and poses with every standard library (std:: distributions and
+// Eigen's Random(), which calls std::rand, do not).
 #pragma once
 
 #include "batchcol/batchcol.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <ostream>
-#include <random>
 #include <vector>
 
 namespace batchcol::testing {
 
-using Rng = std::mt19937_64;
+using Rng = testkit::PortableRandom;
 
 double uniform(Rng& rng, double lo, double hi);
+/// Uniform in the cube [-scale, scale]^3 (what testing::random_vector(rng) * scale draws, but seeded and portable).
+Eigen::Vector3d random_vector(Rng& rng, double scale = 1.0);
 Eigen::Quaterniond random_rotation(Rng& rng);
 Eigen::Vector3d random_unit_vector(Rng& rng);
 

@@ -165,7 +165,7 @@ TEST_F(AccuracyCli, PolytopeWitnessesAreScoredOnTheSurfaces) {
     EXPECT_EQ(row.at("reference"), "gjk-1e-12");
     EXPECT_EQ(row.at("witness_measure"), "surface");
     EXPECT_EQ(number(row, "scored_pairs"), 200);
-    if (row.at("tolerance") == "1e-10") EXPECT_LE(number(row, "witness_error_max"), 1e-9);
+    if (row.at("tolerance") == "1e-10") { EXPECT_LE(number(row, "witness_error_max"), 1e-9); }
   }
 }
 

@@ -73,7 +73,7 @@ RefPair separated(Rng& rng) {
   const Eigen::Vector3d e = Eigen::Vector3d::UnitX();
   const double L = testing::extent(a, ra.inverse() * e) + testing::extent(b, rb.inverse() * -e) + gap;
   const Eigen::Quaterniond Q = testing::random_rotation(rng);
-  const Eigen::Vector3d T = Eigen::Vector3d::Random() * 20;
+  const Eigen::Vector3d T = testing::random_vector(rng) * 20;
   return {shape_json(a), shape_json(b), {T, Q * ra}, {T + Q * (L * e), Q * rb}, gap};
 }
 
@@ -81,7 +81,7 @@ RefPair separated(Rng& rng) {
 /// curved shape), axis-aligned boxes, and a ball against a box.
 RefPair overlapping(Rng& rng) {
   const Eigen::Quaterniond Q = testing::random_rotation(rng);
-  const Eigen::Vector3d T = Eigen::Vector3d::Random() * 20;
+  const Eigen::Vector3d T = testing::random_vector(rng) * 20;
   const int kind = static_cast<int>(rng() % 3);
   if (kind == 0) {
     const double ra = testing::uniform(rng, 0.02, 0.2), rb = testing::uniform(rng, 0.02, 0.2);
@@ -92,15 +92,15 @@ RefPair overlapping(Rng& rng) {
     return {shape_json(a), shape_json(b), {T, Q}, {T + Q * (testing::random_unit_vector(rng) * (ra + rb - depth)),
             testing::random_rotation(rng)}, -depth};
   }
-  const Eigen::Vector3d ha = Eigen::Vector3d::Random().cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
+  const Eigen::Vector3d ha = testing::random_vector(rng).cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
   if (kind == 1) {
-    const Eigen::Vector3d hb = Eigen::Vector3d::Random().cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
-    const Eigen::Vector3d c = Eigen::Vector3d::Random().cwiseProduct(ha + hb) * 0.98;
+    const Eigen::Vector3d hb = testing::random_vector(rng).cwiseAbs() * 0.2 + Eigen::Vector3d::Constant(0.02);
+    const Eigen::Vector3d c = testing::random_vector(rng).cwiseProduct(ha + hb) * 0.98;
     const Eigen::Vector3d room = (ha + hb) - c.cwiseAbs();
     return {shape_json(Shape::box(ha)), shape_json(Shape::box(hb)), {T, Q}, {T + Q * c, Q}, -room.minCoeff()};
   }
   const double r = testing::uniform(rng, 0.02, 0.2);
-  const Eigen::Vector3d c = Eigen::Vector3d::Random().cwiseProduct(ha + Eigen::Vector3d::Constant(r)) * 0.98;
+  const Eigen::Vector3d c = testing::random_vector(rng).cwiseProduct(ha + Eigen::Vector3d::Constant(r)) * 0.98;
   const Eigen::Vector3d q = c.cwiseMax(-ha).cwiseMin(ha);
   const double depth = q == c ? r + (ha - c.cwiseAbs()).minCoeff() : r - (c - q).norm();
   if (depth <= 1e-5) return overlapping(rng);  // a corner region miss: draw again

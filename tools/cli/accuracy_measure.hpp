@@ -3,8 +3,8 @@
 // against the reference.
 #pragma once
 
-#include "cli/accuracy_reference.hpp"
-#include "cli/bench_pairs.hpp"
+#include "testkit/reference_set.hpp"
+#include "testkit/bench_pairs.hpp"
 
 #include <batchcol/batch.hpp>
 
@@ -13,6 +13,17 @@
 #include <vector>
 
 namespace batchcol::cli {
+
+using testkit::BenchCase;
+using testkit::BenchPairs;
+using testkit::ReferencePair;
+using testkit::ReferenceSet;
+using testkit::Regime;
+using testkit::compute_references;
+using testkit::make_bench_pairs;
+using testkit::parse_bench_cases;
+using testkit::parse_regime;
+using testkit::reference_options;
 
 /// The pairs of one case and regime with everything the error measures need, built once and shared by the sweep.
 struct CaseData {

@@ -4,7 +4,7 @@
 // best this CPU runs); closed forms run in SIMD lanes for sphere/capsule pairs and box-box boolean, per pair for
 // the other closed-form types.
 #include "cli/atomic_output.hpp"
-#include "cli/bench_pairs.hpp"
+#include "testkit/bench_pairs.hpp"
 #include "cli/bench_peers.hpp"
 #include "cli/bench_timing.hpp"
 #include "cli/commands.hpp"
@@ -26,6 +26,13 @@
 #include <vector>
 
 namespace batchcol::cli {
+
+using testkit::BenchCase;
+using testkit::BenchPairs;
+using testkit::Regime;
+using testkit::make_bench_pairs;
+using testkit::parse_bench_cases;
+using testkit::parse_regime;
 namespace {
 
 struct BenchSettings {

@@ -2,7 +2,7 @@
 // tbb::parallel_for in a task_arena of the same thread count, timed as batchcol is (bench_timing.hpp).
 #pragma once
 
-#include "cli/bench_pairs.hpp"
+#include "testkit/bench_pairs.hpp"
 
 #include <batchcol/batch.hpp>
 
@@ -10,6 +10,9 @@
 #include <vector>
 
 namespace batchcol::cli {
+
+using testkit::BenchCase;
+using testkit::BenchPairs;
 
 struct PeerTiming {
   std::string name;              // "FCL", "Bullet", "Coal collide", "Coal distance", "Coal GJK direct", ...

@@ -1,37 +1,11 @@
-// A seeded random source that gives the same numbers with every standard library: std::uniform_real_distribution
-// differs between implementations, raw mt19937_64 bits do not. Used by the demo scene and the bench pairs.
+// The CLI's name for the testkit's portable random source (tools/testkit/portable_random.hpp), kept so that the
+// command files that draw from it need no edit when the generator moves.
 #pragma once
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-
-#include <algorithm>
-#include <cmath>
-#include <cstdint>
-#include <random>
+#include "testkit/portable_random.hpp"
 
 namespace batchcol::cli {
 
-class PortableRandom {
- public:
-  explicit PortableRandom(std::uint64_t seed) : engine_(seed) {}
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  std::size_t index(std::size_t n) { return std::min(n - 1, static_cast<std::size_t>(uniform() * double(n))); }
-  Eigen::Vector3d unit_vector() {
-    const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * kPi), s = std::sqrt(1.0 - z * z);
-    return {s * std::cos(phi), s * std::sin(phi), z};
-  }
-  // Uniformly distributed rotation (Shoemake 1992).
-  Eigen::Quaterniond rotation() {
-    const double u1 = uniform(), a = 2.0 * kPi * uniform(), b = 2.0 * kPi * uniform();
-    const double s = std::sqrt(1.0 - u1), t = std::sqrt(u1);
-    return Eigen::Quaterniond(t * std::cos(b), s * std::sin(a), s * std::cos(a), t * std::sin(b)).normalized();
-  }
-
- private:
-  static constexpr double kPi = 3.14159265358979323846;
-  std::mt19937_64 engine_;
-};
+using testkit::PortableRandom;
 
 }  // namespace batchcol::cli

@@ -3,11 +3,12 @@
 // (candidate pairs equal brute force, see stress_verify.hpp). It also times a full sweep-and-prune rebuild and an
 // incremental update on the last frame's boxes, and with --peers the Bullet/FCL broad phases on the same boxes.
 #include "cli/commands.hpp"
-#include "cli/stress_scene.hpp"
-#include "cli/stress_verify.hpp"
+#include "testkit/stress_scene.hpp"
+#include "testkit/stress_verify.hpp"
 
 #include "broadphase/sweep_and_prune.hpp"
 #include "peers/broadphase_peers.hpp"
+#include "scene_hooks.hpp"  // engine/src: the scene's last boxes, for the peers
 
 #include <batchcol/io.hpp>
 #include <batchcol/scene.hpp>
@@ -32,6 +33,14 @@
 #include <unistd.h>
 
 namespace batchcol::cli {
+
+using testkit::StressScene;
+using testkit::StressSceneSpec;
+using testkit::Verification;
+using testkit::make_stress_scene;
+using testkit::parse_distribution;
+using testkit::step_stress_scene;
+using testkit::verify_candidates;
 namespace {
 
 struct StressSettings {
@@ -220,7 +229,7 @@ int run_stress(const StressSettings& s) {
   const Verification v = verify_candidates(*scene.scene, results, s.seed + 1);
   std::vector<Aabb> frame, moved;
   std::vector<ObjectHandle> objects;
-  scene.scene->last_aabbs(frame, objects);
+  detail::SceneHooks::last_aabbs(*scene.scene, frame, objects);
   moved = frame;
   for (std::size_t i = 0; i < moved.size(); ++i) {  // the next step's translation (same order as the handles)
     moved[i].min += scene.velocity[objects[i].slot];

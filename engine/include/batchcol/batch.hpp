@@ -9,6 +9,8 @@
 // distance below penetration, invalid input) hold NaN; the CLI prints NaN and missing arrays as empty fields.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/errors.hpp"
 #include "batchcol/pose.hpp"
 #include "batchcol/shapes.hpp"
@@ -55,18 +57,18 @@ enum class Status : std::uint8_t {
   invalid_input,   // bad pair (shape index out of range, non-finite or non-unit pose); nothing else computed
 };
 
-const char* to_string(QueryLevel level);
-const char* to_string(Solver solver);
-const char* to_string(Precision precision);
-const char* to_string(Status status);
+BATCHCOL_API const char* to_string(QueryLevel level);
+BATCHCOL_API const char* to_string(Solver solver);
+BATCHCOL_API const char* to_string(Precision precision);
+BATCHCOL_API const char* to_string(Status status);
 
 /// Instruction set of the narrow-phase kernels (one pair per SIMD lane). `automatic` = the best this CPU runs,
 /// lowered to the environment variable BATCHCOL_ISA (scalar | avx2 | avx512) when that is set. All sets give
 /// bitwise the same results (the wide kernels repeat the scalar reference's operations in the same order).
 enum class InstructionSet : std::uint8_t { automatic, scalar, avx2, avx512 };
-const char* to_string(InstructionSet isa);
+BATCHCOL_API const char* to_string(InstructionSet isa);
 /// What `requested` runs as on this machine (never `automatic`); throws InputError for a set the CPU lacks.
-InstructionSet resolve_instruction_set(InstructionSet requested = InstructionSet::automatic);
+BATCHCOL_API InstructionSet resolve_instruction_set(InstructionSet requested = InstructionSet::automatic);
 
 /// Upper bound on QueryOptions::threads (validate() rejects more). Fixed rather than derived from the machine so a
 /// setting that validates on one machine validates on every other; 1024 is above the hardware threads of today's
@@ -100,11 +102,11 @@ struct QueryOptions {
 /// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic: in SIMD lanes straight
 /// from the batch arrays for sphere/capsule pairs and box-box boolean, per pair otherwise) or "gjk" (the SIMD GJK,
 /// one pair per lane; EPA runs scalar on the overlapping pairs that asked for depth).
-const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options);
+BATCHCOL_API const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options);
 
 /// A batch of pairs in structure-of-arrays layout. `warm_start`, when not empty, holds one support direction per
 /// pair (world frame, e.g. the `direction` output of the previous frame) used to start GJK.
-struct PairBatch {
+struct BATCHCOL_API PairBatch {
   std::vector<std::uint32_t> shape_a, shape_b;
   Vec3Array translation_a, translation_b;
   QuatArray rotation_a, rotation_b;
@@ -121,7 +123,7 @@ struct PairBatch {
 /// A pair batch whose arrays are owned by the caller (NumPy arrays, memory-mapped files): the same layout as
 /// PairBatch, viewed instead of copied. Each component array must hold size() entries (warm_start may be empty) and
 /// stay unchanged until collide() returns.
-struct PairBatchView {
+struct BATCHCOL_API PairBatchView {
   ConstSpan<std::uint32_t> shape_a, shape_b;
   Vec3View translation_a, translation_b;
   QuatView rotation_a, rotation_b;
@@ -132,7 +134,7 @@ struct PairBatchView {
 };
 
 /// Per-pair results in input order (structure of arrays).
-struct PairResults {
+struct BATCHCOL_API PairResults {
   std::vector<Status> status;
   std::vector<std::uint8_t> collide;
   std::vector<double> distance;           // empty below QueryLevel::distance
@@ -148,12 +150,12 @@ struct PairResults {
 /// Runs every pair of `batch` against `shapes`. Per-pair problems become Status::invalid_input; the function
 /// throws InputError only for problems with the call itself (mismatched array sizes, invalid options).
 /// Results are bitwise identical for any thread count.
-void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results);
+BATCHCOL_API void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& options, PairResults& results);
 /// The same on caller-owned arrays (bitwise the same results as on a PairBatch holding the same values). Throws
 /// InputError when the view's arrays have different lengths or a non-empty one has no data pointer.
-void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, PairResults& results);
+BATCHCOL_API void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, PairResults& results);
 
 /// Throws InputError naming the option when `options` is invalid (non-finite or negative tolerance, ...).
-void validate(const QueryOptions& options);
+BATCHCOL_API void validate(const QueryOptions& options);
 
 }  // namespace batchcol

@@ -36,6 +36,8 @@
 // direction noise epsilon / r).
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/batch.hpp"
 
 #include <Eigen/Core>
@@ -48,8 +50,8 @@ namespace batchcol {
 enum class DerivativeMethod : std::uint8_t { analytic, smoothed0, smoothed1 };
 enum class NoiseScale : std::uint8_t { relative, absolute };
 
-const char* to_string(DerivativeMethod method);
-const char* to_string(NoiseScale scale);
+BATCHCOL_API const char* to_string(DerivativeMethod method);
+BATCHCOL_API const char* to_string(NoiseScale scale);
 
 /// The most samples per pair (smoothed0 runs at most this many samples per collide() call: ~250 MB of temporaries).
 constexpr int kMaxDerivativeSamples = 1 << 20;
@@ -65,7 +67,7 @@ struct DerivativeOptions {
 
 /// Throws InputError naming the option when `options` is invalid (samples < 1 or too many, noise <= 0 or not
 /// finite).
-void validate(const DerivativeOptions& options);
+BATCHCOL_API void validate(const DerivativeOptions& options);
 
 /// Per-pair derivative status. Values are NaN when the status says nothing was computed.
 enum class DerivativeStatus : std::uint8_t {
@@ -85,10 +87,10 @@ enum class DerivativeStatus : std::uint8_t {
   no_witness,      // the query gave the pair no witness points (invalid input, not converged, overlap below
                    // QueryLevel::penetration, a halfspace shape): nothing computed
 };
-const char* to_string(DerivativeStatus status);
+BATCHCOL_API const char* to_string(DerivativeStatus status);
 
 /// Structure-of-arrays storage of one 6-vector per pair: component k of pair i at data[k * size + i].
-struct Vec6Array {
+struct BATCHCOL_API Vec6Array {
   std::vector<double> data;
   std::size_t size() const { return data.size() / 6; }
   void resize(std::size_t n, double value) { data.assign(6 * n, value); }
@@ -98,7 +100,7 @@ struct Vec6Array {
 };
 
 /// Structure-of-arrays storage of one 3x6 matrix per pair: entry (r, c) of pair i at data[(6 r + c) * size + i].
-struct Mat36Array {
+struct BATCHCOL_API Mat36Array {
   std::vector<double> data;
   std::size_t size() const { return data.size() / 18; }
   void resize(std::size_t n, double value) { data.assign(18 * n, value); }
@@ -107,7 +109,7 @@ struct Mat36Array {
 };
 
 /// Derivatives per pair in input order. `_wrt_a` / `_wrt_b`: with respect to the twist of shape a / b.
-struct DerivativeResults {
+struct BATCHCOL_API DerivativeResults {
   std::vector<DerivativeStatus> status;
   Vec6Array distance_gradient_a, distance_gradient_b;  // d(signed distance) / d(xi)
   Mat36Array witness_a_wrt_a, witness_a_wrt_b;         // d(witness_a) / d(xi)
@@ -126,13 +128,13 @@ struct DerivativeResults {
 /// penetration (InputError naming "level" otherwise); derivative options are validated as by validate(). smoothed0
 /// runs the M perturbed copies of all pairs as batches of M * (at most 2^20 / M) pairs through collide() with the
 /// same query options, warm-started from the unperturbed query. Results are bitwise identical for any thread count.
-void differentiate(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
+BATCHCOL_API void differentiate(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                    const DerivativeOptions& options, PairResults& results, DerivativeResults& derivatives);
 
 /// The analytic or smoothed1 derivatives from an existing witness-level (or penetration) query `results` of
 /// `batch` (no new GJK run). smoothed0 needs new queries: use differentiate(). Throws InputError when sizes differ,
 /// the witness arrays are empty or the method is smoothed0.
-void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
+BATCHCOL_API void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                            const DerivativeOptions& options, int threads, DerivativeResults& derivatives);
 
 }  // namespace batchcol

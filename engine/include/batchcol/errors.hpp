@@ -2,12 +2,14 @@
 // input, batch submission), never from inside a worker task; per-pair problems are reported as statuses.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include <stdexcept>
 #include <string>
 
 namespace batchcol {
 
-class InputError : public std::runtime_error {
+class BATCHCOL_API InputError : public std::runtime_error {
  public:
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };

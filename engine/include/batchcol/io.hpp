@@ -3,6 +3,8 @@
 // /pairs/3/pose_a/quaternion) and, for parse errors, the line.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/batch.hpp"
 #include "batchcol/rays.hpp"
 #include "batchcol/shapes.hpp"
@@ -32,24 +34,24 @@ struct BatchFile {
 };
 
 /// Reads a batch file; mesh paths inside it are relative to the file's folder.
-BatchFile load_batch_file(const std::string& path);
+BATCHCOL_API BatchFile load_batch_file(const std::string& path);
 /// Parses batch-file text; `source` names it in messages and `base_dir` resolves mesh paths.
-BatchFile parse_batch_json(const std::string& text, const std::string& source, const std::string& base_dir);
+BATCHCOL_API BatchFile parse_batch_json(const std::string& text, const std::string& source, const std::string& base_dir);
 
 /// Loads a mesh file (OBJ, STL, PLY, COLLADA, ... through assimp) and returns its vertices.
-std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path);
+BATCHCOL_API std::vector<Eigen::Vector3d> load_mesh_points(const std::string& path);
 
-QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
-Solver parse_solver(const std::string& name);
-Precision parse_precision(const std::string& name);
-InstructionSet parse_instruction_set(const std::string& name);
+BATCHCOL_API QueryLevel parse_query_level(const std::string& name);  // throws InputError on an unknown name
+BATCHCOL_API Solver parse_solver(const std::string& name);
+BATCHCOL_API Precision parse_precision(const std::string& name);
+BATCHCOL_API InstructionSet parse_instruction_set(const std::string& name);
 
 /// Result rows: pair,status,collide,distance,pa_x,pa_y,pa_z,pb_x,pb_y,pb_z,n_x,n_y,n_z,iterations.
 /// Values the query level did not compute are empty (CSV) or null (JSON). Numbers use 17 significant digits.
 /// With `derivatives` (same size), the derivative columns follow (d_status, g_a0.., dpa_da_00.., see
 /// results_output.cpp).
 struct DerivativeResults;
-void write_results_csv(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
-void write_results_json(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
+BATCHCOL_API void write_results_csv(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
+BATCHCOL_API void write_results_json(const PairResults& results, std::ostream& out, const DerivativeResults* derivatives = nullptr);
 
 }  // namespace batchcol

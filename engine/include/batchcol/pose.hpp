@@ -2,6 +2,8 @@
 // Conventions: metres, right-handed frames, quaternions written [w, x, y, z].
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -15,12 +17,12 @@ namespace batchcol {
 constexpr double kUnitTolerance = 1e-6;
 
 /// True when q is finite and | |q| - 1 | <= kUnitTolerance.
-bool is_unit_quaternion(const Eigen::Quaterniond& q);
+BATCHCOL_API bool is_unit_quaternion(const Eigen::Quaterniond& q);
 /// The normalised quaternion; throws InputError unless | |q| - 1 | <= kUnitTolerance and q is finite.
-Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q);
+BATCHCOL_API Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q);
 /// The unit quaternion of a rotation matrix; throws InputError unless R R^T = I and det R = +1 within
 /// kUnitTolerance.
-Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R);
+BATCHCOL_API Eigen::Quaterniond rotation_from_matrix(const Eigen::Matrix3d& R);
 
 /// A rigid transform x_world = rotation * x_local + translation.
 struct Pose {

@@ -19,6 +19,8 @@
 // whose cast ran out of iterations. Results are bitwise identical for any thread count.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/batch.hpp"
 #include "batchcol/pose.hpp"
 #include "batchcol/scene.hpp"
@@ -31,7 +33,7 @@
 namespace batchcol {
 
 /// Rays in structure-of-arrays form.
-struct RayBatch {
+struct BATCHCOL_API RayBatch {
   Vec3Array origin, direction;
   std::vector<double> t_max;
 
@@ -59,15 +61,15 @@ enum class RayQuery : std::uint8_t {
   any,      // whether anything is hit (occlusion): stops at the first hit found, which need not be the closest
   all,      // every object hit in [0, t_max], sorted by (t, object slot)
 };
-const char* to_string(RayQuery query);
-RayQuery parse_ray_query(const std::string& name);  // throws InputError naming the value
+BATCHCOL_API const char* to_string(RayQuery query);
+BATCHCOL_API RayQuery parse_ray_query(const std::string& name);  // throws InputError naming the value
 
 enum class RayStatus : std::uint8_t {
   ok,              // exact (closed form) or certified to the tolerance
   max_iterations,  // a GJK ray cast (inflated shape) ran out of iterations: t is its last lower bound
   invalid_input,   // see the top of this file; nothing computed
 };
-const char* to_string(RayStatus status);
+BATCHCOL_API const char* to_string(RayStatus status);
 
 struct RayOptions {
   RayQuery query = RayQuery::closest;
@@ -77,7 +79,7 @@ struct RayOptions {
   int threads = 0;          // 0 = all cores
 };
 /// Throws InputError naming the option (tolerance not finite or <= 0, max_iterations < 1, threads < 0).
-void validate(const RayOptions& options);
+BATCHCOL_API void validate(const RayOptions& options);
 
 /// Per-ray results in input order. For closest and all queries, hit/t/normal/object describe the closest hit; for
 /// any, the hit found first. Rays without a hit have hit = 0, t = NaN, normal NaN and an invalid ObjectHandle{}.
@@ -99,7 +101,7 @@ struct RayResults {
 };
 
 /// Rays against one posed shape each (ShapeRayBatch). options.query is ignored (one shape: closest = any = all).
-void cast_rays(const ShapeTable& shapes, const ShapeRayBatch& batch, const RayOptions& options, RayResults& results);
+BATCHCOL_API void cast_rays(const ShapeTable& shapes, const ShapeRayBatch& batch, const RayOptions& options, RayResults& results);
 
 /// Wall-clock milliseconds of the last RaySceneIndex::update().
 struct RaySceneTimings {
@@ -114,7 +116,7 @@ struct RaySceneTimings {
 /// parallel from Morton codes and collapsed into an 8-wide BVH (float boxes, one SIMD test per node), both refitted
 /// (boxes only) when only poses changed since the last update. It snapshots the
 /// scene's objects and poses at update(): later scene changes are seen at the next update().
-class RaySceneIndex {
+class BATCHCOL_API RaySceneIndex {
  public:
   RaySceneIndex();
   ~RaySceneIndex();

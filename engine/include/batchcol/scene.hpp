@@ -20,6 +20,8 @@
 // count, for a given sequence of add/remove/update calls.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/batch.hpp"
 #include "batchcol/pose.hpp"
 #include "batchcol/shapes.hpp"
@@ -83,7 +85,11 @@ struct SceneResults {
   std::size_t colliding_count() const { return colliding.size(); }
 };
 
-class Scene {
+namespace detail {
+struct SceneHooks;  // engine/src/scene_hooks.hpp: what the tests and tools read beyond the API
+}
+
+class BATCHCOL_API Scene {
  public:
   /// The scene keeps `shapes` alive; objects refer to its shapes by index. Throws InputError when null.
   explicit Scene(std::shared_ptr<const ShapeTable> shapes);
@@ -114,20 +120,13 @@ class Scene {
   /// options.threads applies to every stage (0 = all cores).
   void collide(const QueryOptions& options, SceneResults& results);
 
-  /// The float world boxes of the last collide() (margin included) of all objects except halfspaces, widened to
-  /// double exactly, with their objects. For checks and benchmarks against other broad phases. Throws InputError
-  /// when objects were added or removed since that collide().
-  void last_aabbs(std::vector<Aabb>& boxes, std::vector<ObjectHandle>& objects) const;
   /// Bytes held by the scene's buffers (capacities), excluding the shape table and the caller's results.
   std::size_t memory_bytes() const;
-  /// How many collide() calls moved one of the scene's frame buffers (a reallocation). Stays constant once the
-  /// buffers are warm and the object and pair counts do not grow: the no-allocation-per-frame check.
-  std::size_t buffer_reallocations() const;
-
-  struct State;  // private implementation (engine/src/scene_state.hpp)
 
  private:
+  struct State;                // private implementation (engine/src/scene_state.hpp)
   friend class RaySceneIndex;  // reads the objects and poses to build its ray acceleration (batchcol/rays.hpp)
+  friend struct detail::SceneHooks;
   std::unique_ptr<State> state_;
 };
 

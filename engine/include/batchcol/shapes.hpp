@@ -6,6 +6,8 @@
 // point and a segment inflated by their radius, so GJK iterates on the core and the radius is added afterwards.
 #pragma once
 
+#include "batchcol/export.hpp"
+
 #include "batchcol/errors.hpp"
 
 #include <Eigen/Core>
@@ -38,7 +40,7 @@ constexpr double kMinLengthFloat = 1e-6;
 enum class ShapeType : std::uint8_t { sphere, capsule, box, cylinder, cone, ellipsoid, convex, triangle, halfspace };
 constexpr int kShapeTypeCount = 9;
 
-const char* to_string(ShapeType type);
+BATCHCOL_API const char* to_string(ShapeType type);
 
 /// Cells per cube-face side of ConvexHull::start_vertices (kernels/support.hpp, start_cell).
 constexpr std::uint32_t kHullStartGrid = 16;
@@ -71,12 +73,12 @@ struct ConvexHull {
 
 /// Computes the convex hull of `points` with qhull. Throws InputError (naming `what`) when a point is not finite or
 /// when fewer than 4 non-coplanar points remain.
-std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
+BATCHCOL_API std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::Vector3d>& points,
                                                       const std::string& what = "convex");
 
 /// One shape. Build it with the factories below: they validate sizes (finite, within [kMinLength, kMaxLength]) and
 /// throw InputError naming the offending field; ShapeTable::add() checks the limits again.
-struct Shape {
+struct BATCHCOL_API Shape {
   ShapeType type = ShapeType::sphere;
   /// sphere: (radius, 0, 0); capsule, cylinder, cone: (radius, half_length, 0); box: half extents;
   /// ellipsoid: radii; halfspace: unit outward normal (the solid is {x : normal.x <= offset}).
@@ -114,10 +116,10 @@ struct Aabb {
 };
 
 /// Tight world AABB of `shape` under the pose (rotation, translation); infinite extents for halfspaces.
-Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
+BATCHCOL_API Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
 
 /// Stores each shape once; pairs refer to shapes by index, so many instances of one mesh cost one mesh.
-class ShapeTable {
+class BATCHCOL_API ShapeTable {
  public:
   std::uint32_t add(Shape shape);
   std::size_t size() const { return shapes_.size(); }

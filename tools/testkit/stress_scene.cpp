@@ -6,14 +6,14 @@
 // (rotated) objects and L is solved for `density`. Clustered: Gaussian clusters of ~2000 objects, 4x denser than
 // `density` inside; layered: horizontal layers (shelves) about one object thick, each with `density` overlaps per
 // object, stacked far enough apart not to touch.
-#include "cli/stress_scene.hpp"
+#include "testkit/stress_scene.hpp"
 
-#include "cli/portable_random.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 constexpr int kShapesPerType = 8;
@@ -135,4 +135,4 @@ void step_stress_scene(StressScene& s) {
   }
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

@@ -1,5 +1,5 @@
-// Closed-form references of `batchcol accuracy`, written from the shape definitions independently of the
-// engine's own analytic kernels (kernels/closed_forms.hpp), so that each checks the other:
+// Closed-form references of `batchcol accuracy` and the tests, written from the shape definitions independently
+// of the engine's own analytic kernels (kernels/closed_forms.hpp), so that each checks the other:
 //   - a point against a sphere, capsule, box, cylinder or cone: the nearest point of the solid, found in the
 //     meridian plane for the solids of revolution (the nearest point of a body of revolution lies in the plane
 //     through its axis and the query point); inside the solid, the nearest boundary point is the foot on the
@@ -9,14 +9,14 @@
 // Inflation is included: the signed distance to X + ball(r) is the signed distance to X minus r.
 #pragma once
 
-#include "cli/accuracy_reference.hpp"
+#include "testkit/reference_set.hpp"
 
 #include <batchcol/pose.hpp>
 #include <batchcol/shapes.hpp>
 
 #include <optional>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 /// Signed distance from a point to a solid, the nearest boundary point and the outward unit normal there.
 struct BoundaryPoint {
@@ -40,4 +40,4 @@ std::optional<ReferencePair> analytic_reference(const Shape& a, const Pose& pose
 /// True when analytic_reference covers this type pair (in either order).
 bool has_closed_form(ShapeType a, ShapeType b);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

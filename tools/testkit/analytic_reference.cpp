@@ -1,10 +1,10 @@
-#include "cli/accuracy_closed_forms.hpp"
+#include "testkit/analytic_reference.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 using Eigen::Vector2d;
@@ -201,4 +201,4 @@ std::optional<ReferencePair> analytic_reference(const Shape& a, const Pose& pose
   return sphere_against(b, pose_b, a, pose_a, false);
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

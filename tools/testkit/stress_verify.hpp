@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 constexpr std::size_t kWholeSceneLimit = 20000;
 
@@ -23,4 +23,4 @@ struct Verification {
 /// Compares the candidates of the scene's last collide() (`results`) with brute force.
 Verification verify_candidates(const Scene& scene, const SceneResults& results, std::uint64_t seed);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

@@ -1,17 +1,17 @@
 // The reference every `batchcol accuracy` measurement is compared with: per pair, the signed distance, witness
 // points and normal of a tight double-precision solution, analytic where a closed form exists (see
-// accuracy_closed_forms.hpp), else plain GJK/EPA in double at tolerance 1e-12 (bench_pairs.hpp reference_options),
+// analytic_reference.hpp), else plain GJK/EPA in double at tolerance 1e-12 (bench_pairs.hpp reference_options),
 // trusted only when its duality gap certified it (status converged).
 #pragma once
 
-#include "cli/bench_pairs.hpp"
+#include "testkit/bench_pairs.hpp"
 
 #include <Eigen/Core>
 
 #include <string>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 struct ReferencePair {
   double distance = 0;  // signed: negative is a penetration depth
@@ -35,4 +35,4 @@ struct ReferenceSet {
 /// References for every pair of `p` (the numeric one is recomputed to get witness points and normals).
 ReferenceSet compute_references(const BenchPairs& p, int threads);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

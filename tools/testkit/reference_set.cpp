@@ -1,10 +1,10 @@
-#include "cli/accuracy_reference.hpp"
-#include "cli/accuracy_closed_forms.hpp"
+#include "testkit/reference_set.hpp"
+#include "testkit/analytic_reference.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 bool strictly_convex(ShapeType t) { return t == ShapeType::sphere || t == ShapeType::ellipsoid; }
@@ -45,4 +45,4 @@ ReferenceSet compute_references(const BenchPairs& p, int threads) {
   return set;
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

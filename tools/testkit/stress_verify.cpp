@@ -1,9 +1,10 @@
 // Brute-force check of the scene's candidate pairs (see stress_verify.hpp).
-#include "cli/stress_verify.hpp"
+#include "testkit/stress_verify.hpp"
 
-#include "cli/portable_random.hpp"
+#include "testkit/portable_random.hpp"
 
 #include "broadphase/brute_force.hpp"
+#include "scene_hooks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 // Objects expected inside the sub-volume: brute force over them costs ~n^2 / 2 box tests.
@@ -27,7 +28,7 @@ Key key_of(ObjectHandle a, ObjectHandle b) { return a.slot < b.slot ? Key{a.slot
 Verification verify_candidates(const Scene& scene, const SceneResults& results, std::uint64_t seed) {
   std::vector<Aabb> boxes;
   std::vector<ObjectHandle> objects;
-  scene.last_aabbs(boxes, objects);
+  detail::SceneHooks::last_aabbs(scene, boxes, objects);
   Verification v;
   std::vector<std::uint32_t> subset;  // indices into boxes
   if (boxes.size() <= kWholeSceneLimit) {
@@ -75,4 +76,4 @@ Verification verify_candidates(const Scene& scene, const SceneResults& results, 
   return v;
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

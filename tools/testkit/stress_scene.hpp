@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 enum class Distribution { uniform, clustered, layered };
 
@@ -39,4 +39,4 @@ StressScene make_stress_scene(const StressSceneSpec& spec);
 /// Advances every object by one step (poses and scene).
 void step_stress_scene(StressScene& s);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

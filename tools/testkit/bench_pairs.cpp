@@ -1,5 +1,5 @@
-#include "cli/bench_pairs.hpp"
-#include "cli/portable_random.hpp"
+#include "testkit/bench_pairs.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 using Random = PortableRandom;
@@ -220,4 +220,4 @@ BenchPairs make_bench_pairs(const BenchCase& bench_case, Regime regime, std::siz
   return out;
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

@@ -1,5 +1,5 @@
-// Pair batches of `batchcol bench`: one shape-type pair per case, placed at a prescribed reference signed distance
-// (the regime), seeded and identical on every machine.
+// Pair batches of `batchcol bench` and `batchcol accuracy`: one shape-type pair per case, placed at a prescribed
+// reference signed distance (the regime), seeded and identical on every machine.
 #pragma once
 
 #include <batchcol/batch.hpp>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 /// A shape type of the bench; hulls carry their vertex count (convex8, convex250, convex940).
 struct BenchShapeKind {
@@ -54,4 +54,4 @@ struct BenchPairs {
 BenchPairs make_bench_pairs(const BenchCase& bench_case, Regime regime, std::size_t count, std::uint64_t seed,
                             int threads);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit
