@@ -35,6 +35,13 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
 /// Stores one pair's Jacobians.
 void store(DerivativeResults& d, std::size_t i, const PairJacobians& J);
 
+/// Stores NaN everywhere for pair i (the smoothed values too when present) and status no_witness.
+void store_nothing(DerivativeResults& d, std::size_t i);
+
+/// Sizes `d` for n pairs (the smoothed arrays only when `smoothed`) without filling it: the callers write every
+/// entry of every pair (store() or store_nothing()), so a reused result is not written twice.
+void size_for(DerivativeResults& d, std::size_t n, bool smoothed);
+
 /// The 0th-order estimator (derivative_smoothed0.cpp); `results` holds the unperturbed query.
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                const DerivativeOptions& options, const PairResults& results, DerivativeResults& derivatives);

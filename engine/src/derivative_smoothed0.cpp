@@ -88,9 +88,9 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
                  const double* noise, DerivativeResults& d) {
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;
-  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return;
+  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return store_nothing(d, i);
   const Noise s = noise_of(shapes, batch.shape_b[i], o);
-  if (!(s.translation > 0.0)) return;
+  if (!(s.translation > 0.0)) return store_nothing(d, i);
   Values g0, v, mean = Values::Zero();
   g0 << g.distance, g.witness_a, g.witness_b, g.normal;
   Eigen::Matrix<double, 10, 6> G = Eigen::Matrix<double, 10, 6>::Zero();
@@ -105,7 +105,7 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
     G += (v - g0) * score;
     ++valid;
   }
-  if (valid == 0) return;
+  if (valid == 0) return store_nothing(d, i);
   mean /= valid;
   G /= valid;
   // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
@@ -134,7 +134,7 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                const DerivativeOptions& o, const PairResults& results, DerivativeResults& d) {
   const std::size_t n = batch.size(), M = static_cast<std::size_t>(o.samples);
-  d.resize(n, true);
+  size_for(d, n, true);  // every pair writes all its entries
   const std::size_t chunk = std::max<std::size_t>(1, kSamplesPerCall / M);
   PairBatch samples;
   PairResults sample_results;

@@ -6,6 +6,7 @@
 #include "derivative_support.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace batchcol {
@@ -29,15 +30,60 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
   return true;
 }
 
+namespace {
+
+// Writes one pair's entries straight into the structure-of-arrays storage (n pairs: entry k of pair i at
+// data[k * n + i]); the arrays' set() recomputed their size per entry.
+void put(Vec6Array& a, std::size_t n, std::size_t i, const Row6& v) {
+  double* p = a.data.data() + i;
+  for (int k = 0; k < 6; ++k) p[k * n] = v(k);
+}
+void put(Mat36Array& a, std::size_t n, std::size_t i, const Mat36& m) {
+  double* p = a.data.data() + i;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 6; ++c) p[(6 * r + c) * n] = m(r, c);
+}
+
+}  // namespace
+
 void store(DerivativeResults& d, std::size_t i, const PairJacobians& J) {
-  d.distance_gradient_a.set(i, J.distance_a);
-  d.distance_gradient_b.set(i, J.distance_b);
-  d.witness_a_wrt_a.set(i, J.witness_a_a);
-  d.witness_a_wrt_b.set(i, J.witness_a_b);
-  d.witness_b_wrt_a.set(i, J.witness_b_a);
-  d.witness_b_wrt_b.set(i, J.witness_b_b);
-  d.normal_wrt_a.set(i, J.normal_a);
-  d.normal_wrt_b.set(i, J.normal_b);
+  const std::size_t n = d.status.size();
+  put(d.distance_gradient_a, n, i, J.distance_a);
+  put(d.distance_gradient_b, n, i, J.distance_b);
+  put(d.witness_a_wrt_a, n, i, J.witness_a_a);
+  put(d.witness_a_wrt_b, n, i, J.witness_a_b);
+  put(d.witness_b_wrt_a, n, i, J.witness_b_a);
+  put(d.witness_b_wrt_b, n, i, J.witness_b_b);
+  put(d.normal_wrt_a, n, i, J.normal_a);
+  put(d.normal_wrt_b, n, i, J.normal_b);
+}
+
+void store_nothing(DerivativeResults& d, std::size_t i) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  PairJacobians J;
+  J.distance_a.setConstant(nan);
+  J.distance_b.setConstant(nan);
+  for (Mat36* m : {&J.witness_a_a, &J.witness_a_b, &J.witness_b_a, &J.witness_b_b, &J.normal_a, &J.normal_b})
+    m->setConstant(nan);
+  store(d, i, J);
+  d.status[i] = DerivativeStatus::no_witness;
+  if (!d.smoothed_distance.empty()) {
+    d.smoothed_distance[i] = nan;
+    const Eigen::Vector3d v = Eigen::Vector3d::Constant(nan);
+    d.smoothed_witness_a.set(i, v);
+    d.smoothed_witness_b.set(i, v);
+    d.smoothed_normal.set(i, v);
+  }
+}
+
+void size_for(DerivativeResults& d, std::size_t n, bool smoothed) {
+  d.status.resize(n);
+  for (Vec6Array* v : {&d.distance_gradient_a, &d.distance_gradient_b}) v->data.resize(6 * n);
+  for (Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
+                        &d.normal_wrt_a, &d.normal_wrt_b})
+    m->data.resize(18 * n);
+  d.smoothed_distance.resize(smoothed ? n : 0);
+  for (Vec3Array* v : {&d.smoothed_witness_a, &d.smoothed_witness_b, &d.smoothed_normal}) v->resize(smoothed ? n : 0);
 }
 
 namespace {
@@ -47,7 +93,10 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
                         const DerivativeOptions& o, std::size_t i, DerivativeResults& d) {
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;
-  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return;
+  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) {
+    store_nothing(d, i);
+    return;
+  }
   const Shape& a = shapes[batch.shape_a[i]];
   const Shape& b = shapes[batch.shape_b[i]];
   const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
@@ -97,7 +146,7 @@ void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, con
     throw InputError("method: smoothed0 runs new queries; call differentiate() instead of differentiate_results()");
   if (threads < 0) throw InputError("threads must be >= 0 (0 = all cores)");
   detail::check_sizes(batch, results);
-  derivatives.resize(batch.size(), false);
+  detail::size_for(derivatives, batch.size(), false);  // every pair writes all its entries
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
       detail::differentiate_pair(shapes, batch, results, options, i, derivatives);
