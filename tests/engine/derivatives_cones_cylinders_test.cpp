@@ -3,8 +3,8 @@
 // There is no machine-precision reference here (no closed form, no Newton polish: the support maps jump on the
 // caps, sides and the other shapes' faces), so the reference witness points are GJK's at the precision floor
 // (tight_query(), ~1e-15 m duality gap). On a curved contact that leaves the witness points off by up to
-// ~sqrt(2 R 1e-15) ~ 5e-8 m (R <= 0.4 m here). Steps of 1e-2 x distance (1e-4 m and more: distances are >= 2% of
-// the bounding radii sum, >= 0.1 m) keep that noise below ~5e-8 / 1e-4 / 2 ~ 2.5e-4 of an O(1) entry, and the
+// ~sqrt(2 R 1e-15) ~ 5e-8 m (R <= 0.4 m here). Steps of 3e-3 x distance keep that noise below ~5e-8 / 3e-4 / 2
+// ~ 1e-4 of an O(1) entry for pairs 0.1 m apart (the closest pairs, 2% of the radii sum, get up to ~10x more), and the
 // central differences' truncation error (O(h^2) relative to the curvature radii, >= 0.05 m) below ~1e-4. Hence
 // bounds of 1e-3 here, not the 1e-5 of the exact references in derivatives_analytic_test.cpp: a wrong formula
 // (a missing curvature term, a sign) shows as an O(1) error. Steps that cross a feature boundary (rim to side,
