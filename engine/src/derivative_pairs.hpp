@@ -32,8 +32,37 @@ template <class Body> void for_pairs(int threads, std::size_t n, const Body& bod
 bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
                       PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b);
 
+/// Collects the Jacobians of up to 8 consecutive pairs and writes them array by array: each of the 120 SoA
+/// arrays then gets one whole cache line per flush. Writing pair by pair touched 120 lines per pair, which for a
+/// power-of-two batch size (arrays a multiple of 4 KB apart) all fall in one L1 set: 4.5x a witness query in
+/// wall time for 1.6x in instructions (4096 ellipsoid pairs, 1 thread). Flushes when a pair is not the next one
+/// and on destruction; one block per task range.
+class StoreBlock {
+ public:
+  explicit StoreBlock(DerivativeResults& d) : d(d) {}
+  StoreBlock(const StoreBlock&) = delete;
+  StoreBlock& operator=(const StoreBlock&) = delete;
+  ~StoreBlock() { flush(); }
+  void add(std::size_t i, const PairJacobians& J);
+  void flush();
+
+  DerivativeResults& d;
+
+ private:
+  static constexpr std::size_t kPairs = 8;
+  PairJacobians J_[kPairs];
+  std::size_t first_ = 0, count_ = 0;
+};
+
 /// Stores one pair's Jacobians.
-void store(DerivativeResults& d, std::size_t i, const PairJacobians& J);
+inline void store(StoreBlock& out, std::size_t i, const PairJacobians& J) { out.add(i, J); }
+
+/// Stores NaN everywhere for pair i (the smoothed values too when present) and status no_witness.
+void store_nothing(StoreBlock& out, std::size_t i);
+
+/// Sizes `d` for n pairs (the smoothed arrays only when `smoothed`) without filling it: the callers write every
+/// entry of every pair (store() or store_nothing()), so a reused result is not written twice.
+void size_for(DerivativeResults& d, std::size_t n, bool smoothed);
 
 /// The 0th-order estimator (derivative_smoothed0.cpp); `results` holds the unperturbed query.
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,

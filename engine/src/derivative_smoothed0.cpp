@@ -85,12 +85,13 @@ bool sample_values(const PairResults& r, std::size_t k, Values& v) {
 
 void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                  const DerivativeOptions& o, std::size_t i, const PairResults& samples, std::size_t first_sample,
-                 const double* noise, DerivativeResults& d) {
+                 const double* noise, StoreBlock& out) {
+  DerivativeResults& d = out.d;
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;
-  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return;
+  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return store_nothing(out, i);
   const Noise s = noise_of(shapes, batch.shape_b[i], o);
-  if (!(s.translation > 0.0)) return;
+  if (!(s.translation > 0.0)) return store_nothing(out, i);
   Values g0, v, mean = Values::Zero();
   g0 << g.distance, g.witness_a, g.witness_b, g.normal;
   Eigen::Matrix<double, 10, 6> G = Eigen::Matrix<double, 10, 6>::Zero();
@@ -105,7 +106,7 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
     G += (v - g0) * score;
     ++valid;
   }
-  if (valid == 0) return;
+  if (valid == 0) return store_nothing(out, i);
   mean /= valid;
   G /= valid;
   // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
@@ -121,7 +122,7 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
   J.witness_a_a = rigid_motion(xa) - J.witness_a_b;
   J.witness_b_a = rigid_motion(xb) - J.witness_b_b;
   J.normal_a = (Mat36() << Eigen::Matrix3d::Zero(), -skew(n)).finished() - J.normal_b;
-  store(d, i, J);
+  store(out, i, J);
   d.smoothed_distance[i] = mean(0);
   d.smoothed_witness_a.set(i, xa);
   d.smoothed_witness_b.set(i, xb);
@@ -134,7 +135,7 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                const DerivativeOptions& o, const PairResults& results, DerivativeResults& d) {
   const std::size_t n = batch.size(), M = static_cast<std::size_t>(o.samples);
-  d.resize(n, true);
+  size_for(d, n, true);  // every pair writes all its entries
   const std::size_t chunk = std::max<std::size_t>(1, kSamplesPerCall / M);
   PairBatch samples;
   PairResults sample_results;
@@ -144,8 +145,9 @@ void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOpti
     build_samples(shapes, batch, results, o, query.threads, first, count, samples, noise);
     collide(shapes, samples, query, sample_results);
     for_pairs(query.threads, count, [&](std::size_t begin, std::size_t end) {
+      StoreBlock out(d);
       for (std::size_t p = begin; p < end; ++p)
-        reduce_pair(shapes, batch, results, o, first + p, sample_results, p * M, &noise[6 * p * M], d);
+        reduce_pair(shapes, batch, results, o, first + p, sample_results, p * M, &noise[6 * p * M], out);
     });
   }
 }

@@ -76,8 +76,11 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   SupportJacobian J;
   const double r = round_radius(s);
   const Eigen::Vector3d p = witness - r * u;  // the witness on the core
-  const double tol = kExactFeature * s.bounding_radius(), curved_tol = kCurvedFeature * s.bounding_radius();
-  const double rho = std::hypot(u.x(), u.y()), rho_p = std::hypot(p.x(), p.y());
+  // Computed only for the types that test features (spheres and ellipsoids, the smooth common case, skip them).
+  const bool features = s.type != ShapeType::sphere && s.type != ShapeType::ellipsoid;
+  const double radius_b = features ? s.bounding_radius() : 0.0;
+  const double tol = kExactFeature * radius_b, curved_tol = kCurvedFeature * radius_b;
+  const double rho = features ? std::hypot(u.x(), u.y()) : 0.0, rho_p = features ? std::hypot(p.x(), p.y()) : 0.0;
   const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
   switch (s.type) {
     case ShapeType::sphere: break;
