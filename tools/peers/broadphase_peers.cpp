@@ -26,7 +26,8 @@ namespace {
 constexpr std::size_t kMaxFclSapObjects = 200000;
 
 /// Median wall time of run(r) over `runs` runs; `before(r)`, when given, runs untimed before each run.
-double median_ms(int runs, const std::function<void(int)>& run, const std::function<void(int)>& before = {}) {
+[[maybe_unused]] double median_ms(int runs, const std::function<void(int)>& run,
+                                 const std::function<void(int)>& before = {}) {  // unused without FCL and Bullet
   std::vector<double> ms;
   for (int r = 0; r < runs; ++r) {
     if (before) before(r);
