@@ -14,7 +14,7 @@ namespace batchcol::kernels {
 
 /// Hulls with at least this many vertices use hill climbing over the vertex adjacency instead of a linear scan.
 /// A scan costs one dot product per vertex; a climb costs ~ (path length x valence) dot products, which wins
-/// once the hull is larger than a few dozen vertices (measured in the wide-kernel issue; 32 is the scalar choice).
+/// once the hull is larger than a few dozen vertices (32: the crossover found when the climb was added).
 constexpr std::size_t kHillClimbMinVertices = 32;
 
 /// Per-query state of a support function: the last vertex found on a hull, where the next climb starts

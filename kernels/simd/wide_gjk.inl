@@ -9,8 +9,8 @@
 // No include guard: included once per instruction set by isa_*.cpp after wide.hpp, inside the ISA namespace.
 
 // AI: always inline. The loop's small helpers must stay inside it; GCC's own heuristics outline some of them
-// depending on how many callers the loop has (measured: +600 instructions per cylinder pair when drive() gained a
-// second instantiation).
+// depending on how many callers the loop has (a second instantiation of drive() once made a cylinder pair a third
+// more expensive).
 #define AI __attribute__((always_inline))
 
 template <class T> struct WideGjk {

@@ -96,7 +96,7 @@ template <class T> struct WideGjkPairs {
     }
 
     /// One side's core as make_core() builds it, read straight from the Shape record (no ShapeCore, no PairSetup:
-    /// building those per pair cost ~450 of the ~2050 instructions of an ellipsoid pair). `radius` gets the swept
+    /// building those per pair was a fifth of an ellipsoid pair's work). `radius` gets the swept
     /// radius with make_core's roundings: T(inflation), plus T(radius) for spheres and capsules.
     static typename G::SideStart side(const Shape& shape, T& radius) {
       typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};

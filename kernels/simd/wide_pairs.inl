@@ -15,8 +15,8 @@ struct PairLanes {
     real x, y, z;
   };
   /// `real` at any double-aligned address: a plain vector load / store of the lanes (GCC vector types alias their
-  /// element type). Same code as a memcpy into a local where GCC sees through it (measured: within 2 instructions
-  /// per pair); it states the intent and leaves no local in memory for the optimiser to keep.
+  /// element type). The same code as a memcpy into a local where GCC sees through it; it states the intent and
+  /// leaves no local in memory for the optimiser to keep.
   typedef double unaligned_real __attribute__((vector_size(sizeof(double) * W), aligned(alignof(double))));
   static real splat(double v) { return real{} + v; }
   static V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
@@ -60,8 +60,8 @@ struct PairLanes {
     real w, x, y, z, norm;
     mask shape, valid;
   };
-  // Always inlined: with several kernels calling them, GCC stops inlining these on its own (measured: sphere-sphere
-  // 127 -> 175 instructions per pair when the batch-array GJK became a third caller).
+  // Always inlined: with several kernels calling them, GCC stops inlining these on its own, and the closed forms'
+  // per-pair cost grows by a third (the numbers are in the commit that added the attribute).
   template <bool Consecutive>
   __attribute__((always_inline)) static Pose load_pose(const PairView& in, const std::uint32_t* shape_index,
                                                        const double* const t[3], const double* const q[4],
