@@ -94,13 +94,15 @@ struct QueryOptions {
   double margin = 0.0;
   int max_iterations = 128;       // GJK iterations per pair
   int epa_max_iterations = 1000;  // EPA expansions per pair (near-concentric curved pairs need hundreds)
-  bool closed_forms = true;       // analytic kernels for sphere/capsule pairs, sphere-box, box-box boolean
-                                  // (halfspace pairs always use their closed form: they have no support function)
+  bool closed_forms = true;       // analytic kernels for sphere/capsule pairs, sphere against cylinder or cone,
+                                  // sphere-box, box-box boolean (halfspace pairs always use their closed form:
+                                  // they have no support function)
   int threads = 0;                // 0 = all cores, else 1..kMaxThreads
   InstructionSet isa = InstructionSet::automatic;
 };
 /// Which kernel answers pairs of these two shapes under `options`: "closed form" (analytic: in SIMD lanes straight
-/// from the batch arrays for sphere/capsule pairs and box-box boolean, per pair otherwise) or "gjk" (the SIMD GJK,
+/// from the batch arrays for sphere/capsule pairs, sphere-cylinder, sphere-cone and box-box boolean, per pair
+/// otherwise) or "gjk" (the SIMD GJK,
 /// one pair per lane; EPA runs scalar on the overlapping pairs that asked for depth).
 BATCHCOL_API const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options);
 
