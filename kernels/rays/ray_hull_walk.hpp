@@ -32,7 +32,7 @@ template <class T> struct HullWalk {
   std::vector<std::uint32_t> adjacency_begin, adjacency;  // facets sharing an edge (compressed rows)
   // Where climbs start: a cube map of directions (6 faces x kSeedGrid^2 cells) to the facet maximising the polar's
   // linear function at the cell's centre direction, so a climb from the origin's direction starts next to its end.
-  static constexpr int kSeedGrid = 8;
+  static constexpr int kSeedGrid = 16;
   std::vector<std::uint32_t> seeds;
   Vec3<T> p = Vec3<T>::Zero();       // interior point (the vertex mean)
   std::size_t planes() const { return nx.size(); }
@@ -92,7 +92,11 @@ template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
     w.adjacency.insert(w.adjacency.end(), n.begin(), n.end());
     w.adjacency_begin.push_back(static_cast<std::uint32_t>(w.adjacency.size()));
   }
+  // Each cell's facet by hill climbing from the previous cell's (neighbouring directions have neighbouring facets),
+  // exact for a linear function on the convex polar; a seed is only where a climb starts, so a tie broken either
+  // way changes nothing but the climb's length.
   const int n = HullWalk<T>::kSeedGrid;
+  std::uint32_t best = 0;
   for (int face = 0; face < 6; ++face)
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b) {
@@ -101,33 +105,56 @@ template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
         dir[k] = face % 2 ? -1.0 : 1.0;
         dir[(k + 1) % 3] = -1.0 + (2.0 * a + 1.0) / n;
         dir[(k + 2) % 3] = -1.0 + (2.0 * b + 1.0) / n;
-        std::uint32_t best = 0;
-        double best_value = -1e300;
-        for (std::uint32_t i = 0; i < w.planes(); ++i) {
-          const double v = double(w.ux[i]) * dir[0] + double(w.uy[i]) * dir[1] + double(w.uz[i]) * dir[2];
-          if (v > best_value) best_value = v, best = i;
+        const auto value = [&](std::uint32_t i) {
+          return double(w.ux[i]) * dir[0] + double(w.uy[i]) * dir[1] + double(w.uz[i]) * dir[2];
+        };
+        double best_value = value(best);
+        for (bool moved = true; moved;) {
+          moved = false;
+          const std::uint32_t from = best;
+          for (std::uint32_t j = w.adjacency_begin[from]; j < w.adjacency_begin[from + 1]; ++j)
+            if (const double v = value(w.adjacency[j]); v > best_value) best_value = v, best = w.adjacency[j], moved = true;
         }
         w.seeds.push_back(best);
       }
   return w;
 }
 
+/// A start for ray_hull_walk() from the entry `ball_enter` of the ray into the hull's bounding ball about the local
+/// origin (radius `bound`, computed in T): moved back along the ray by 1024 ulps of (|o| + bound), far more than the
+/// rounding of the entry and of o + t d (a few ulps of |o|), so the point is outside the hull even where the hull
+/// touches its ball. Only a start: a shorter or longer walk, the same answer.
+template <class T> T hull_walk_start(T ball_enter, const Vec3<T>& o, const Vec3<T>& d, T bound) {
+  const T scale = std::max(std::abs(o.x()), std::max(std::abs(o.y()), std::abs(o.z()))) + bound;
+  const T dmax = std::max(std::abs(d.x()), std::max(std::abs(d.y()), std::abs(d.z())));
+  return ball_enter - T(1024) * machine_epsilon<T>() * scale / dmax;
+}
+
 /// The entry of the ray o + t d, t in [0, t_max], into the hull; `ok` false when the step budget ran out (the caller
-/// then clips against every plane).
+/// then clips against every plane). `t_start` (>= 0) is a parameter known to lie outside the hull, or at most on its
+/// entry: the walk starts there instead of at the origin. Callers pass the entry into the hull's bounding ball, which
+/// they test first anyway: for a hull close to its ball (points on a sphere) the facet active there is already the
+/// entry facet or next to it, so the climb from the cube-map seed is a move or two and one Newton step reaches the
+/// entry, where starting at the far origin climbs and steps across the hull's side. The answer does not depend on
+/// the start: t is computed from the entry facet's plane and o, d only (a point at t_start found inside the hull, by
+/// rounding, restarts the walk from 0).
 template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>& o, const Vec3<T>& d, T t_max,
-                                             bool& ok) {
+                                             bool& ok, T t_start = T(0)) {
   ok = true;
   LocalHit<T> h;
   const auto value = [&](std::uint32_t i, const Vec3<T>& q) { return (w.ux[i] * q.x() + w.uy[i] * q.y()) + w.uz[i] * q.z(); };
-  Vec3<T> q = o - w.p;  // x - p
+  if (!(t_start > T(0) && t_start <= t_max)) t_start = T(0);
+  T t = t_start;
+  Vec3<T> q = t > T(0) ? Vec3<T>((o + t * d) - w.p) : Vec3<T>(o - w.p);  // x - p
   // The cube-map cell of q's direction (the largest component picks the face).
   const T aq[3] = {std::abs(q.x()), std::abs(q.y()), std::abs(q.z())};
   const int k = aq[0] >= aq[1] ? (aq[0] >= aq[2] ? 0 : 2) : (aq[1] >= aq[2] ? 1 : 2);
   std::uint32_t f = w.seeds[0];
   if (aq[k] > T(0)) {
     const int n = HullWalk<T>::kSeedGrid;
+    const T scale = T(0.5 * n) / aq[k];
     const auto cell = [&](T c) {  // c / |q_k| in [-1, 1] to [0, n)
-      const T x = (c / aq[k] + T(1)) * T(0.5 * n);
+      const T x = c * scale + T(0.5 * n);
       return x <= T(0) ? 0 : x >= T(n - 1) ? n - 1 : static_cast<int>(x);
     };
     const int face = 2 * k + (q[k] < T(0) ? 1 : 0);
@@ -138,7 +165,6 @@ template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>
   const T one = T(1) + T(16) * machine_epsilon<T>();
   const std::size_t budget = 4 * w.planes() + 64;
   std::size_t moves = 0;
-  T t = T(0);
   for (int step = 0; step < 64; ++step) {
     for (bool moved = true; moved;) {  // hill climbing to the active facet at q
       moved = false;
@@ -154,6 +180,7 @@ template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>
       }
     }
     if (best <= one) {  // on or inside the hull
+      if (step == 0 && t > T(0)) return ray_hull_walk(w, o, d, t_max, ok);  // the start was not outside
       h.hit = true;
       h.t = t;
       h.normal = t > T(0) ? Vec3<T>(w.nx[f], w.ny[f], w.nz[f]) : Vec3<T>(-d / norm3(d));
@@ -164,6 +191,7 @@ template <class T> LocalHit<T> ray_hull_walk(const HullWalk<T>& w, const Vec3<T>
     const T next = (w.c[f] - ((w.nx[f] * o.x() + w.ny[f] * o.y()) + w.nz[f] * o.z())) / denom;
     if (next > t_max) return h;
     if (!(next > t)) {  // no progress: q is on the active plane up to rounding
+      if (step == 0 && t > T(0)) return ray_hull_walk(w, o, d, t_max, ok);
       h.hit = true;
       h.t = t;
       h.normal = t > T(0) ? Vec3<T>(w.nx[f], w.ny[f], w.nz[f]) : Vec3<T>(-d / norm3(d));

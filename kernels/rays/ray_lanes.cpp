@@ -28,7 +28,7 @@ __attribute__((noinline)) void hull_lane(const HullPlanes<T>& planes, double bou
   if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return;
   LocalHit<T> h;
   bool ok = false;
-  if (planes.walk.planes() > 0) h = ray_hull_walk(planes.walk, vo, vd, t_max, ok);
+  if (planes.walk.planes() > 0) h = ray_hull_walk(planes.walk, vo, vd, t_max, ok, hull_walk_start(ball.enter, vo, vd, T(bound)));
   if (!ok) h = finish(ray_convex(vo, vd, planes), vd, t_max);
   if (!h.hit) return;
   enter = h.t;

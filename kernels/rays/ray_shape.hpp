@@ -34,8 +34,11 @@ inline bool uses_ray_gjk(const Shape& shape) {
          shape.type != ShapeType::halfspace;
 }
 
+/// `ball_entry`: when the caller has already found that the segment [0, t_max] meets a ball about the local origin of
+/// radius at least `bound` (the scene's world-frame filter), the parameter where the ray enters that ball; hulls
+/// then skip their own ball test and start the walk there. NaN (the default): not known.
 template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d, T t_max,
-                                         const RayGjkSettings& settings) {
+                                         const RayGjkSettings& settings, T ball_entry = quiet_nan<T>()) {
   const ShapeCore<T>& c = s.core;
   if (c.type == ShapeType::halfspace) {
     return finish(ray_halfspace(o, d, c.halfspace_normal, c.halfspace_offset + s.inflation), d, t_max);
@@ -52,12 +55,15 @@ template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o,
     case ShapeType::ellipsoid: return finish(ray_ellipsoid(o, d, c.size), d, t_max);
     case ShapeType::convex: {
       // The bounding ball first: most rays that reach a hull's box in a scene miss the hull, and the ball rejects
-      // them for the cost of one sphere test instead of a pass over every face.
-      const RayInterval<T> ball = ray_sphere(o, d, s.bound * (T(1) + T(64) * machine_epsilon<T>()));
-      if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return {};
+      // them for the cost of one sphere test instead of a pass over every face; the walk starts at the ball's entry.
+      if (!(ball_entry == ball_entry)) {
+        const RayInterval<T> ball = ray_sphere(o, d, s.bound * (T(1) + T(64) * machine_epsilon<T>()));
+        if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return {};
+        ball_entry = hull_walk_start(ball.enter, o, d, s.bound);
+      }
       if (s.planes->walk.planes() > 0) {
         bool ok = false;
-        const LocalHit<T> h = ray_hull_walk(s.planes->walk, o, d, t_max, ok);
+        const LocalHit<T> h = ray_hull_walk(s.planes->walk, o, d, t_max, ok, ball_entry);
         if (ok) return h;
       }
       return finish(ray_convex(o, d, *s.planes), d, t_max);

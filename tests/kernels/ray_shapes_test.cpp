@@ -251,3 +251,54 @@ TEST(RayHullWalk, MatchesClippingEveryPlaneAndSphereTracing) {
 
 }  // namespace
 }  // namespace batchcol
+
+namespace batchcol {
+namespace {
+
+// The walk may start at any parameter outside the hull (ray_local passes the bounding ball's entry, moved back by
+// hull_walk_start()): the answer is the one of the walk from the origin, bit for bit, since t comes from the entry
+// facet's plane and the ray only. A start inside the hull restarts from the origin, also with the same answer.
+TEST(RayHullWalk, StartingAtTheBallEntryGivesTheSameBits) {
+  Rng rng(77);
+  const Shape hull = Shape::convex(testing::random_hull_points(rng, 250, 0.5, 0.5));
+  const kr::HullPlanes<double> planes = kr::make_hull_planes<double>(*hull.hull);
+  ASSERT_GT(planes.walk.planes(), 0u);
+  const double bound = hull.bounding_radius() * (1 + 64 * kernels::machine_epsilon<double>());
+  int from_ball = 0, restarted = 0, hits = 0;
+  for (const Ray& r : random_rays(rng, 3000, 1.0)) {
+    bool ok0 = false, ok1 = false;
+    const kr::LocalHit<double> h0 = kr::ray_hull_walk(planes.walk, r.o, r.d, r.t_max, ok0);
+    const kr::RayInterval<double> ball = kr::ray_sphere(r.o, r.d, bound);
+    if (ball.empty() || ball.exit < 0 || ball.enter > r.t_max) {
+      EXPECT_FALSE(h0.hit);
+      continue;
+    }
+    const double start = kr::hull_walk_start(ball.enter, r.o, r.d, hull.bounding_radius());
+    const kr::LocalHit<double> h1 = kr::ray_hull_walk(planes.walk, r.o, r.d, r.t_max, ok1, start);
+    ASSERT_TRUE(ok0 && ok1);
+    from_ball += start > 0;
+    ASSERT_EQ(h0.hit, h1.hit) << r.o.transpose() << " / " << r.d.transpose();
+    if (!h0.hit) continue;
+    ++hits;
+    EXPECT_EQ(h0.t, h1.t);
+    EXPECT_EQ(h0.normal, h1.normal);
+    // Halfway from the origin to the entry (outside), and halfway through the hull (inside: a restart).
+    const double exit = std::min(r.t_max, kr::ray_convex(r.o, r.d, planes).exit);
+    if (h0.t > 0 && exit - h0.t > 1e-6) {
+      for (const double mid : {0.5 * h0.t, 0.5 * (h0.t + exit)}) {
+        bool ok2 = false;
+        const kr::LocalHit<double> h2 = kr::ray_hull_walk(planes.walk, r.o, r.d, r.t_max, ok2, mid);
+        ASSERT_TRUE(ok2 && h2.hit);
+        EXPECT_EQ(h2.t, h0.t);
+        EXPECT_EQ(h2.normal, h0.normal);
+        ++restarted;
+      }
+    }
+  }
+  EXPECT_GT(from_ball, 400);  // origins in a 6 m cube: some start inside the ball
+  EXPECT_GT(hits, 500);
+  EXPECT_GT(restarted, 500);
+}
+
+}  // namespace
+}  // namespace batchcol
