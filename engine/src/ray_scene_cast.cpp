@@ -29,7 +29,7 @@ struct Hit {
 bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
 
 struct RayContext {
-  Vec3<double> o, d, inv;
+  Vec3<double> o, d, inv;  // inv: set by traverse() for the binary tree only
   double t_max, d2;  // d2 = |d|^2
   bool wide_ok;  // the float test of the wide tree is safe for this ray (else: the binary tree in double)
   WideRay wide;
@@ -57,10 +57,11 @@ class Caster {
 
   // Intersects one object; true on a hit with t <= t_max.
   bool test(const RayObject& obj, const RayContext& r, double t_max, Hit& hit, bool& capped) const {
-    if (ball_misses(obj, r, t_max)) return false;
+    double ball_entry = kernels::quiet_nan<double>();
+    if (ball_misses(obj, r, t_max, ball_entry)) return false;
     const Vec3<double> o = kernels::mul_transposed(obj.R, Vec3<double>(r.o - obj.t));
     const Vec3<double> d = kernels::mul_transposed(obj.R, r.d);
-    const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_);
+    const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_, ball_entry);
     capped = capped || h.status != kr::LocalStatus::converged;
     if (!h.hit) return false;
     hit = {h.t, kernels::mul(obj.R, h.normal), obj.handle};
@@ -70,8 +71,10 @@ class Caster {
   // The object's bounding ball, in the world frame: most leaves a ray reaches miss their object, and this rejects
   // them before the transform to the local frame and the kernel. Only a filter: the radius is widened by 1e-12 of
   // (|o - centre| + radius), a thousand times the rounding of the closest-point form here and of the local-frame
-  // transform (a few 1e-16 of the same lengths), so a ray the exact kernel hits is never rejected.
-  bool ball_misses(const RayObject& obj, const RayContext& r, double t_max) const {
+  // transform (a few 1e-16 of the same lengths), so a ray the exact kernel hits is never rejected. On a pass,
+  // `entry` is where the ray enters the widened ball: every point before it is outside the shape, so hulls start
+  // their walk there (ray_local) instead of testing their ball again in the local frame.
+  bool ball_misses(const RayObject& obj, const RayContext& r, double t_max, double& entry) const {
     const double bound = s_.prepared.shapes[obj.shape].bound;
     if (!(bound > 0.0)) return false;  // halfspaces
     const Vec3<double> oc = r.o - obj.t;
@@ -80,23 +83,27 @@ class Caster {
     const double R = bound + 1e-12 * (oc.cwiseAbs().maxCoeff() + bound), h2 = R * R - p.squaredNorm();
     if (!(h2 >= 0.0)) return true;
     const double half = std::sqrt(h2 / r.d2);
-    return tc + half < 0.0 || tc - half > t_max;
+    entry = tc - half;
+    return tc + half < 0.0 || entry > t_max;
   }
 
   // Visits the leaves whose boxes the ray segment [0, limit()] reaches; visit(leaf) returns false to stop.
   template <class Visit, class Limit> void traverse(const RayContext& r, const Limit& limit, const Visit& visit) const {
     if (r.wide_ok && !s_.wide.nodes().empty()) {
+      double last = limit();
       auto leaf = [&](std::uint32_t k, float& lim) {
         if (!visit(k)) return false;
-        lim = wide_limit(limit());
+        if (const double l = limit(); l != last) last = l, lim = wide_limit(l);  // only a hit moves the limit
         return true;
       };
       using Leaf = decltype(leaf);
-      wide_(s_.wide.nodes().data(), r.wide, wide_limit(limit()),
+      wide_(s_.wide.nodes().data(), r.wide, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
       return;
     }
-    binary_traverse(r, limit, visit);
+    RayContext rb = r;  // the reciprocal only this path reads (three divisions the wide path does not need)
+    rb.inv = Vec3<double>(1.0 / r.d.x(), 1.0 / r.d.y(), 1.0 / r.d.z());
+    binary_traverse(rb, limit, visit);
   }
 
   // The binary tree in double (rays outside the float test's range, and scenes of one object).
@@ -197,7 +204,6 @@ RayContext context(const RayBatch& rays, std::size_t i) {
   RayContext r;
   r.o = Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]);
   r.d = Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]);
-  r.inv = Vec3<double>(1.0 / r.d.x(), 1.0 / r.d.y(), 1.0 / r.d.z());
   r.t_max = rays.t_max[i];
   r.d2 = r.d.squaredNorm();
   r.wide_ok = wide_ray_supported(r.o.data(), r.d.data());

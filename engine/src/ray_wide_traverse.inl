@@ -63,6 +63,14 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       if (!pop()) return;
       continue;
     }
+    float entry[kWideArity];
+    __builtin_memcpy(entry, &tn, sizeof entry);
+    // One child reached (the common case deep in the tree): it is next, no sort and no stack.
+    if ((bits & (bits - 1)) == 0) {
+      const int k = __builtin_ctz(bits);
+      e = Entry{n->child[k], entry[k]};
+      continue;
+    }
     // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
     // keep the slot order (the sort is stable), so the order is a function of the node and the ray only.
     Entry hit[kWideArity];
@@ -70,7 +78,7 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     while (bits != 0) {
       const int k = __builtin_ctz(bits);
       bits &= bits - 1;
-      Entry x{n->child[k], tn[k]};
+      Entry x{n->child[k], entry[k]};
       int j = count++;
       for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
       hit[j] = x;
