@@ -16,19 +16,19 @@
 namespace batchcol::kernels::rays {
 namespace {
 
-// One hull lane in its local frame, exactly as ray_local() does it for an uninflated hull (bounding ball, polar
-// walk, all-plane clipping when the walk gives up). Compiled once, outside the instruction-set regions, and called
-// by every build: the same bits on every set.
+// One hull lane in its local frame, as ray_local() does it for an uninflated hull (polar walk, all-plane clipping
+// when the walk gives up), after the caller's lane-wise bounding-ball test: `ball_enter` is where the ray enters the
+// ball. Compiled once, outside the instruction-set regions, and called by every build: the same bits on every set
+// (and the same as ray_local's: the walk's answer does not depend on where it starts).
 template <class T>
 __attribute__((noinline)) void hull_lane(const HullPlanes<T>& planes, double bound, const T o[3], const T d[3], T t_max,
-                                         T& enter, T nl[3]) {
+                                         T ball_enter, T& enter, T nl[3]) {
   const Vec3<T> vo(o[0], o[1], o[2]), vd(d[0], d[1], d[2]);
   enter = infinity<T>();
-  const RayInterval<T> ball = ray_sphere(vo, vd, T(bound) * (T(1) + T(64) * machine_epsilon<T>()));
-  if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return;
   LocalHit<T> h;
   bool ok = false;
-  if (planes.walk.planes() > 0) h = ray_hull_walk(planes.walk, vo, vd, t_max, ok, hull_walk_start(ball.enter, vo, vd, T(bound)));
+  if (planes.walk.planes() > 0)
+    h = ray_hull_walk(planes.walk, vo, vd, t_max, ok, hull_walk_start(ball_enter, vo, vd, T(bound)));
   if (!ok) h = finish(ray_convex(vo, vd, planes), vd, t_max);
   if (!h.hit) return;
   enter = h.t;

@@ -180,15 +180,21 @@ template <class T> bool cast(const LaneShapeTable& shapes, const LaneRays& r, st
       const V la = (ldx * ldx + ldy * ldy) + ldz * ldz;
       in = capsule(lox, loy, loz, ldx, ldy, ldz, la, A, B);
     } else {
-      // Hulls: lane by lane through the scalar kernel; a hit becomes the interval [t, inf) (t = 0 from inside).
+      // Hulls: the bounding ball (inflated by 64 ulps, as ray_local's) on whole registers, then lane by lane the
+      // scalar walk from the ball's entry; a hit becomes the interval [t, inf) (t = 0 from inside).
+      const V grow = splat<V>(double(T(1) + T(64) * machine_epsilon<T>()));
+      const V la = (ldx * ldx + ldy * ldy) + ldz * ldz;
+      const Interval<V> bl = ball(lox, loy, loz, ldx, ldy, ldz, la, A * grow);
       in.enter = splat<V>(INFINITY);
       in.exit = -in.enter;  // empty unless the lane hits
       in.nx = in.ny = in.nz = splat<V>(0.0);
       for (int l = 0; l < W; ++l) {
+        const T ball_enter = lane_get(bl.enter, l), ball_exit = lane_get(bl.exit, l), tm_l = lane_get(t_max, l);
+        if (!(ball_enter <= ball_exit) || ball_exit < T(0) || ball_enter > tm_l) continue;
         const T o[3] = {lane_get(lox, l), lane_get(loy, l), lane_get(loz, l)};
         const T d[3] = {lane_get(ldx, l), lane_get(ldy, l), lane_get(ldz, l)};
         T enter, nl[3];
-        hull_lane<T>(*hull[l], sa[l], o, d, lane_get(t_max, l), enter, nl);
+        hull_lane<T>(*hull[l], sa[l], o, d, tm_l, ball_enter, enter, nl);
         lane_set(in.enter, l, enter);
         if (enter < infinity<T>()) {
           lane_set(in.exit, l, infinity<T>());
