@@ -46,6 +46,7 @@ template <class T> struct WideGjk {
   // ---- Support functions of the cores, W lanes of one shape type (kernels/support.hpp) ----
   /// Rows of the small-hull table: hulls below kHillClimbMinVertices fit.
   static constexpr int kSmallRows = int(kHillClimbMinVertices) - 1;
+  struct SmallHulls;
   struct Side {
     ShapeType type = ShapeType::sphere;
     real s0{}, s1{}, s2{};                 // ShapeCore::size
@@ -59,7 +60,22 @@ template <class T> struct WideGjk {
     // only grows within a run; lanes are padded up to it when it grows.
     int rows = 0;
     std::uint32_t lane_vertices[W] = {};  // vertex count of the lane's current hull (0: never loaded a hull)
-    real vx[kSmallRows], vy[kSmallRows], vz[kSmallRows];  // written before read: rows [0, rows) of loaded lanes
+    SmallHulls* table = nullptr;  // the rows; set (by Rows) only when the side is convex
+  };
+  /// The rows live outside Side and Lanes: 3 KB per side, written before read (rows [0, rows) of loaded lanes),
+  /// so they are neither zeroed with the lane state at every run() (the run of one type-pair group; a mixed
+  /// batch has ~26 pairs per group) nor interleaved with the loop's hot fields.
+  struct SmallHulls {
+    real vx[kSmallRows], vy[kSmallRows], vz[kSmallRows];
+  };
+  /// Storage for both sides' rows, left unwritten; attach() points the convex sides of L at it.
+  struct Rows {
+    SmallHulls a, b;
+    Rows() {}
+    void attach(Side& A, Side& B) {
+      A.table = A.type == ShapeType::convex ? &a : nullptr;
+      B.table = B.type == ShapeType::convex ? &b : nullptr;
+    }
   };
 
   static V3 support(Side& s, const V3& d, std::uint32_t live) {
@@ -120,10 +136,11 @@ template <class T> struct WideGjk {
       }
       return r;
     }
-    r = {s.vx[0], s.vy[0], s.vz[0]};
+    const SmallHulls& t = *s.table;
+    r = {t.vx[0], t.vy[0], t.vz[0]};
     real best = (r.x * d.x + r.y * d.y) + r.z * d.z;
     for (int i = 1; i < s.rows; ++i) {
-      const real x = s.vx[i], y = s.vy[i], z = s.vz[i];
+      const real x = t.vx[i], y = t.vy[i], z = t.vz[i];
       const real di = (x * d.x + y * d.y) + z * d.z;
       const mask better = di > best;
       best = select(better, di, best);
@@ -137,9 +154,9 @@ template <class T> struct WideGjk {
   static void load_small_hull(Side& s, int l, const ConvexHull& hull) {
     const int count = int(hull.vertices.size());
     // Lane l of row i is element i * W + l of each coordinate array (rows are W contiguous lanes).
-    T* x = reinterpret_cast<T*>(s.vx);
-    T* y = reinterpret_cast<T*>(s.vy);
-    T* z = reinterpret_cast<T*>(s.vz);
+    T* x = reinterpret_cast<T*>(s.table->vx);
+    T* y = reinterpret_cast<T*>(s.table->vy);
+    T* z = reinterpret_cast<T*>(s.table->vz);
     if (count > s.rows) {
       for (int o = 0; o < W; ++o) {
         if (o == l) continue;
@@ -237,7 +254,7 @@ template <class T> struct WideGjk {
     real lambda[3];
     mask use, via_i, via_j;
   };
-  static Face face(const V3& qi, const V3& qj, const V3& qk) {
+  AI static Face face(const V3& qi, const V3& qj, const V3& qk) {
     const real zero = splat(T(0));
     const V3 n = cross(sub(qj, qi), sub(qk, qi));
     const real nn = norm2(n);
@@ -319,12 +336,36 @@ template <class T> struct WideGjk {
     in.contains = splat_mask(-1);
     for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
     if (!any(want & ~inside)) return in;
+    // The visible face whose plane is farthest from the origin first (the reference's rule, same arithmetic):
+    // where the origin's projection lies inside it, that is the answer, in one face instead of one round per
+    // visible face (on smooth shapes the origin sees all three new faces of a flat tent, and some lane of a
+    // register nearly always needs the three rounds).
+    mask cand[3];
+    for (int m = 0; m < 3; ++m) cand[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
+    const int I[3] = {1, 0, 0}, J[3] = {2, 2, 1};
+    real far = zero;
+    mask have_first = splat_mask(0), choice = splat_mask(0);
+    for (int m = 0; m < 3; ++m) {
+      const V3 n = cross(sub(p[I[m]], p[3]), sub(p[J[m]], p[3]));
+      const real nn = norm2(n), s = dot(p[3], n);
+      const real q = select(nn > zero, s * (s / nn), splat(T(-1)));
+      const mask take = cand[m] & (~have_first | (q > far));
+      far = select(take, q, far);
+      choice = select(take, splat_mask(m), choice);
+      have_first |= cand[m];
+    }
+    const mask first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
+    const Face ff = face(pick(first_0, p[1], p[0]), pick(first_2, p[1], p[2]), p[3]);
+    const mask first_ok = have_first & ff.use;
+    const Proj first = face_proj(ff, select(first_0, splat_mask(1), splat_mask(0)),
+                                 select(first_2, splat_mask(1), splat_mask(2)), splat_mask(3));
+    if (!any(want & ~inside & ~first_ok)) return pick(inside, in, first);
     // Edge e joins old vertex e to vertex 3.
     const Edge E[3] = {edge(p[0], p[3], splat_mask(0), splat_mask(3)), edge(p[1], p[3], splat_mask(1), splat_mask(3)),
                        edge(p[2], p[3], splat_mask(2), splat_mask(3))};
     const real En[3] = {norm2(E[0].x), norm2(E[1].x), norm2(E[2].x)};
     mask remaining[3], taken[3];
-    for (int m = 0; m < 3; ++m) remaining[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
+    for (int m = 0; m < 3; ++m) remaining[m] = cand[m] & ~first_ok;  // the closest of every visible face's answer
     // The best answer so far: a face interior (x, weights, old vertices i, j) or an edge (best_edge).
     const real inf = splat(std::numeric_limits<T>::infinity());
     Face bf;  // its x and weights
@@ -356,14 +397,19 @@ template <class T> struct WideGjk {
     Proj best = pick(best_use, face_proj(bf, bi, bj, splat_mask(3)), to_proj(e));
     best.x = pick(have, best.x, V3{inf, inf, inf});  // sees only the old face: no candidate
     best.count = select(have, best.count, splat_mask(0));
-    return pick(inside, in, best);
+    return pick(inside, in, pick(first_ok, first, best));
   }
 
   // ---- The lanes ----
   struct Lanes {
     Side A, B;
     real R[9]{}, t[3]{};
-    V3 w[4], a[4], b[4];
+    V3 w[4];
+    // The points of A and B behind the simplex (witness levels) stay in the fixed slot where they were written;
+    // slot[m] says which slot holds those of simplex vertex m. Only w is compacted after each projection (the
+    // projection reads it in order): moving a and b too was ~120 selects per iteration.
+    V3 a[4], b[4];
+    mask slot[4]{};
     real lambda[4]{};
     mask count{}, k{}, stale{}, max_iterations{};
     V3 x, d_prev, last_s, direction;
@@ -383,7 +429,7 @@ template <class T> struct WideGjk {
     mask m = splat_mask(0);
     for (int l = 0; l < W; ++l) m[l] = (L.fresh >> l & 1u) ? -1 : 0;
     L.w[0] = pick(m, sw, L.w[0]);
-    L.a[0] = pick(m, sa, L.a[0]);
+    L.a[0] = pick(m, sa, L.a[0]);  // start_lane() set slot[0] = 0
     L.b[0] = pick(m, sb, L.b[0]);
     L.x = pick(m, sw, L.x);
     L.last_s = pick(m, sw, L.last_s);
@@ -448,6 +494,7 @@ template <class T> struct WideGjk {
     L.fresh |= 1u << l;
     L.lambda[0][l] = T(1);
     L.count[l] = 1;
+    L.slot[0][l] = 0;
     set_lane(L.d_prev, l, init);
     set_lane(L.direction, l, Vec3<T>::Zero());
     L.lower[l] = -std::numeric_limits<T>::infinity();
@@ -490,8 +537,9 @@ template <class T> struct WideGjk {
     r.simplex.count = int(L.count[l]);
     for (int m = 0; m < 4; ++m) {
       r.simplex.v[m].w = get_lane(L.w[m], l);
-      r.simplex.v[m].a = points ? get_lane(L.a[m], l) : Vec3<T>::Constant(quiet_nan<T>());
-      r.simplex.v[m].b = points ? get_lane(L.b[m], l) : Vec3<T>::Constant(quiet_nan<T>());
+      const int q = int(L.slot[m][l]) & 3;  // slots past count are stale but in range
+      r.simplex.v[m].a = points ? get_lane(L.a[q], l) : Vec3<T>::Constant(quiet_nan<T>());
+      r.simplex.v[m].b = points ? get_lane(L.b[q], l) : Vec3<T>::Constant(quiet_nan<T>());
       r.simplex.lambda[m] = L.lambda[m][l];
     }
     r.x = status == GjkStatus::overlap ? Vec3<T>::Zero() : get_lane(L.x, l);
@@ -536,6 +584,8 @@ template <class T> struct WideGjk {
     Lanes L;
     L.A.type = setups[0].A.type;
     L.B.type = setups[0].B.type;
+    Rows rows;
+    rows.attach(L.A, L.B);
     SetupSource source{setups, n, out, solver, points};
     drive(L, source, solver, points);
   }
@@ -637,14 +687,23 @@ template <class T> struct WideGjk {
       mask ends_contains = splat_mask(0), ends_stall = splat_mask(0), ends_stall_overlap = splat_mask(0);
       if (any(live)) {
         // Add s at slot `count`, project the origin on the simplex, keep the support set.
-        V3 pw[4], pa[4], pb[4];
-        for (int m = 0; m < 4; ++m) {
-          const mask here = live & (L.count == splat_mask(m));
-          pw[m] = pick(here, sw, L.w[m]);
-          if (points) {
-            pa[m] = pick(here, sa, L.a[m]);
-            pb[m] = pick(here, sb, L.b[m]);
+        V3 pw[4];
+        mask pslot[4];
+        for (int m = 0; m < 4; ++m) pw[m] = pick(live & (L.count == splat_mask(m)), sw, L.w[m]);
+        if (points) {
+          // The new vertex's a and b go to the lowest slot no current vertex uses (count <= 3 here: one is free).
+          mask used[4];
+          for (int q = 0; q < 4; ++q) {
+            used[q] = splat_mask(0);
+            for (int m = 0; m < 3; ++m) used[q] |= (L.count > splat_mask(m)) & (L.slot[m] == splat_mask(q));
           }
+          const mask free = select(~used[0], splat_mask(0), select(~used[1], splat_mask(1), select(~used[2], splat_mask(2), splat_mask(3))));
+          for (int q = 0; q < 4; ++q) {
+            const mask here = live & (free == splat_mask(q));
+            L.a[q] = pick(here, sa, L.a[q]);
+            L.b[q] = pick(here, sb, L.b[q]);
+          }
+          for (int m = 0; m < 4; ++m) pslot[m] = select(live & (L.count == splat_mask(m)), free, L.slot[m]);
         }
         const mask n_after = L.count + 1;
         const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
@@ -669,8 +728,9 @@ template <class T> struct WideGjk {
           for (int q = 1; q < 4; ++q) from_q[q] = proj.index[m] == splat_mask(q);
           L.w[m] = pick(moves, from_slot(from_q, pw), L.w[m]);
           if (points) {
-            L.a[m] = pick(moves, from_slot(from_q, pa), L.a[m]);
-            L.b[m] = pick(moves, from_slot(from_q, pb), L.b[m]);
+            mask q = pslot[0];
+            for (int o = 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
+            L.slot[m] = select(moves, q, L.slot[m]);
           }
           L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);
         }

@@ -121,11 +121,30 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   // Outside (or flat): faces m = 0, 1, 2 (face m omits vertex m) that the origin sees, i.e. whose opposite weight
   // has the wrong sign; a flat tetrahedron (total == 0) has no orientation, so all three are candidates.
   const std::array<std::array<int, 2>, 3> old = {{{1, 2}, {0, 2}, {0, 1}}};
+  const auto candidate = [&](int m) { return total == T(0) || opposite_sign(V[m], total); };
+  // First the visible face whose plane is farthest from the origin (squared distance s (s / nn), the first of
+  // equal ones): when the origin's projection on it lies inside it, it is the answer, since the plane of a face
+  // supports the tetrahedron and no point of it is closer than that plane. On smooth shapes the newest vertex
+  // raises a flat tent over the old face and the origin sees all three new faces: this spares the other two.
+  int first = -1;
+  T far = T(0);
+  for (int m = 0; m < 3; ++m) {
+    if (!candidate(m)) continue;
+    const Vec3<T> n = cross3<T>(p[old[m][0]] - p[3], p[old[m][1]] - p[3]);
+    const T nn = norm2(n), s = dot3(p[3], n);
+    const T q = nn > T(0) ? s * (s / nn) : T(-1);
+    if (first < 0 || q > far) first = m, far = q;
+  }
+  if (first >= 0) {
+    const SimplexProjection<T> f = triangle(p, old[first][0], old[first][1], 3);
+    if (f.count == 3) return f;
+  }
+  // Its projection fell outside it: the closest of every visible face's answer.
   SimplexProjection<T> best;
   best.x = Vec3<T>::Constant(std::numeric_limits<T>::infinity());
   bool have = false;
   for (int m = 0; m < 3; ++m) {
-    if (total != T(0) && !opposite_sign(V[m], total)) continue;
+    if (!candidate(m)) continue;
     const SimplexProjection<T> f = triangle(p, old[m][0], old[m][1], 3);
     best = have ? closer(best, f) : f;
     have = true;
