@@ -13,7 +13,7 @@
 // the duality gap (|x|^2 - <x, s>) / |x|.
 #pragma once
 
-#include "batchcol/batch.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/minkowski.hpp"
 
 #include <algorithm>

@@ -5,7 +5,7 @@
 // wide GJK's large-hull lanes call it compiled for that set. Both copies are this text, so they compute the same
 // bits. No lambdas here: GCC does not give a lambda the `#pragma GCC target` of its region.
 
-/// The cell of the hull's direction table (ConvexHull::start_vertices) that direction d falls in, or kNoHullVertex
+/// The cell of the hull's direction table (HullView::start_vertices) that direction d falls in, or kNoHullVertex
 /// when d has no direction (zero, NaN). The table is a cube map: d's largest component picks one of 6 faces, the
 /// other two divided by it pick one of kHullStartGrid^2 cells. A climb started from the support vertex of the
 /// cell's centre direction is a few moves from the answer; started from vertex 0 it crossed half the hull.
@@ -27,7 +27,7 @@ template <class T> inline std::uint32_t start_cell(const Vec3<T>& d) {
   return (face * kHullStartGrid + start_cell_index(u, k, half)) * kHullStartGrid + start_cell_index(v, k, half);
 }
 
-/// Four neighbours' dot products with d at once (a block of ConvexHull::neighbor_block_xyz): GCC vector types, one
+/// Four neighbours' dot products with d at once (a block of HullView::neighbor_block_xyz): GCC vector types, one
 /// register on AVX2 / AVX-512, two SSE registers on the baseline; each lane is dot3's arithmetic in T.
 template <class T> struct HullBlock;
 template <> struct HullBlock<double> {
@@ -44,38 +44,44 @@ template <> struct HullBlock<float> {
   }
 };
 
-template <class T> inline T hull_dot(const ConvexHull& hull, std::uint32_t i, const Vec3<T>& d) {
-  const double* p = hull.vertices[i].data();
+template <class T> inline T hull_dot(const HullView& hull, std::uint32_t i, const Vec3<T>& d) {
+  const double* p = hull.vertices + 3 * std::size_t(i);
   return (T(p[0]) * d.x() + T(p[1]) * d.y()) + T(p[2]) * d.z();
 }
 
-template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d, SupportHint& hint) {
-  const auto& v = hull.vertices;
+/// Vertex i of the hull in precision T.
+template <class T> inline Vec3<T> hull_point(const HullView& hull, std::uint32_t i) {
+  const double* p = hull.vertices + 3 * std::size_t(i);
+  return Vec3<T>(T(p[0]), T(p[1]), T(p[2]));
+}
+
+template <class T> Vec3<T> hull_support(const HullView& hull, const Vec3<T>& d, SupportHint& hint) {
+  const std::uint32_t count = hull.vertex_count;
   std::uint32_t best = 0;
-  constexpr std::uint32_t B = ConvexHull::kNeighborBlock;
+  constexpr std::uint32_t B = kHullNeighborBlock;
   static_assert(B == 4, "HullBlock computes four dot products at once");
   // Small hulls, and a hull without its blocks (Shape::convex builds them for every hull it accepts), are scanned.
-  if (v.size() < kHillClimbMinVertices || hull.neighbor_block_offsets.size() != v.size() + 1) {
+  if (count < kHillClimbMinVertices || hull.neighbor_block_offsets == nullptr) {
     T best_dot = hull_dot(hull, 0, d);
-    for (std::uint32_t i = 1; i < v.size(); ++i) {
+    for (std::uint32_t i = 1; i < count; ++i) {
       const T di = hull_dot(hull, i, d);
       if (di > best_dot) { best_dot = di; best = i; }
     }
-    return v[best].template cast<T>();
+    return hull_point<T>(hull, best);
   }
   // Hill climbing: on a convex polytope a vertex no neighbour improves on is a global maximiser. The strict '>'
   // guarantees termination (the dot product increases at every move).
   // Start from the better of the previous support vertex and the direction table's vertex: GJK's directions
   // swing by up to 180 degrees in the first iterations, and a climb from the previous vertex then crosses the
   // hull, while the table's vertex is within a cell (~7 degrees) of the answer.
-  best = hint.vertex < v.size() ? hint.vertex : 0;
+  best = hint.vertex < count ? hint.vertex : 0;
   T best_dot = hull_dot(hull, best, d);
-  if (hull.start_vertices.size() == kHullStartCells) {
+  if (hull.start_vertices != nullptr) {  // kHullStartCells entries
     const std::uint32_t c = start_cell(d);
-    if (c != kNoHullVertex && hull.start_vertices[c] < v.size()) {
+    if (c != kNoHullVertex && hull.start_vertices[c] < count) {
       const std::uint32_t t = hull.start_vertices[c];
       const T dt = hull_dot(hull, t, d);
-      if (hint.vertex >= v.size() || dt > best_dot) best = t, best_dot = dt;
+      if (hint.vertex >= count || dt > best_dot) best = t, best_dot = dt;
     }
   }
   // Steepest ascent a block of neighbours at a time: the first neighbour with the largest dot product, taken when
@@ -85,9 +91,9 @@ template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d
   using Block = HullBlock<T>;
   const typename Block::V dx = {d.x(), d.x(), d.x(), d.x()}, dy = {d.y(), d.y(), d.y(), d.y()},
                           dz = {d.z(), d.z(), d.z(), d.z()};
-  const std::uint32_t* offsets = hull.neighbor_block_offsets.data();
-  const std::uint32_t* index = hull.neighbor_block_index.data();
-  const double* xyz = hull.neighbor_block_xyz.data();
+  const std::uint32_t* offsets = hull.neighbor_block_offsets;
+  const std::uint32_t* index = hull.neighbor_block_index;
+  const double* xyz = hull.neighbor_block_xyz;
   for (bool moved = true; moved;) {
     moved = false;
     const std::uint32_t from = best;
@@ -111,5 +117,5 @@ template <class T> Vec3<T> hull_support(const ConvexHull& hull, const Vec3<T>& d
     }
   }
   hint.vertex = best;
-  return v[best].template cast<T>();
+  return hull_point<T>(hull, best);
 }

@@ -111,7 +111,8 @@ PairOutput<float> redo_in_double(const PairSetup<float>& s, const GjkResult<floa
 }  // namespace
 
 template <class T>
-void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a, const Eigen::Vector3d& warm_direction,
+void setup_pair_into(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
+                     const Eigen::Vector3d& warm_direction,
                      const QueryOptions& opt, PairSetup<T>& s) {
   s.A = make_core<T>(a);
   s.B = make_core<T>(b);
@@ -135,12 +136,12 @@ void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a,
   }
 
   // GJK on the cores; the swept radii are added afterwards.
-  set_gjk_parameters(s, a.bounding_radius(), b.bounding_radius(), norm3(b_in_a.t), Vec3<T>(warm_direction.cast<T>()),
+  set_gjk_parameters(s, a.bounding_radius, b.bounding_radius, norm3(b_in_a.t), Vec3<T>(warm_direction.cast<T>()),
                      opt);
 }
 
 template <class T>
-PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+PairSetup<T> setup_pair(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
                         const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
   PairSetup<T> s;
   setup_pair_into(a, b, b_in_a, warm_direction, opt, s);
@@ -368,24 +369,24 @@ PairOutput<float> redo_in_double(const PairSetup<float>& s, const GjkResult<floa
 }  // namespace
 
 template <class T>
-PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+PairOutput<T> solve_pair(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
                          const Eigen::Vector3d& warm_direction, const QueryOptions& opt) {
   const PairSetup<T> s = setup_pair<T>(a, b, b_in_a, warm_direction, opt);
   if (s.done) return s.out;
   return complete_pair(s, run_gjk(s), opt);
 }
 
-template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const RelativePose&,
+template PairOutput<double> solve_pair<double>(const ShapeView&, const ShapeView&, const RelativePose&,
                                                const Eigen::Vector3d&, const QueryOptions&);
-template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
+template PairOutput<float> solve_pair<float>(const ShapeView&, const ShapeView&, const RelativePose&,
                                              const Eigen::Vector3d&, const QueryOptions&);
-template void setup_pair_into<double>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
-                                       const QueryOptions&, PairSetup<double>&);
-template void setup_pair_into<float>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
-                                      const QueryOptions&, PairSetup<float>&);
-template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const RelativePose&,
+template void setup_pair_into<double>(const ShapeView&, const ShapeView&, const RelativePose&,
+    const Eigen::Vector3d&, const QueryOptions&, PairSetup<double>&);
+template void setup_pair_into<float>(const ShapeView&, const ShapeView&, const RelativePose&,
+    const Eigen::Vector3d&, const QueryOptions&, PairSetup<float>&);
+template PairSetup<double> setup_pair<double>(const ShapeView&, const ShapeView&, const RelativePose&,
                                               const Eigen::Vector3d&, const QueryOptions&);
-template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,
+template PairSetup<float> setup_pair<float>(const ShapeView&, const ShapeView&, const RelativePose&,
                                             const Eigen::Vector3d&, const QueryOptions&);
 template bool complete_from_gjk<double>(const GjkCompletion<double>&, const GjkResult<double>&, const QueryOptions&,
                                          PairOutput<double>&);
@@ -397,15 +398,3 @@ template PairOutput<float> complete_pair<float>(const PairSetup<float>&, const G
                                                 const QueryOptions&);
 
 }  // namespace batchcol::kernels
-
-namespace batchcol {
-
-const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
-  kernels::RelativePose apart;
-  apart.t = Eigen::Vector3d(1e3, 0, 0);  // the kernel depends on the types and options only, not on the pose
-  if (options.closed_forms && kernels::simd::is_point_solid_pair(a.type, b.type)) return "closed form";  // SIMD only
-  const auto setup = kernels::setup_pair<double>(a, b, apart, Eigen::Vector3d::Zero(), options);
-  return setup.done ? "closed form" : "gjk";
-}
-
-}  // namespace batchcol

@@ -3,7 +3,7 @@
 // the wide (SIMD) kernels are tested against.
 #pragma once
 
-#include "batchcol/batch.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/gjk.hpp"
 #include "kernels/pair_output.hpp"
 
@@ -14,9 +14,10 @@ namespace batchcol::kernels {
 using RelativePose = Transform<double>;
 
 /// Solves one pair in precision T. `warm_direction` (A's frame) seeds GJK when finite and non-zero.
-/// Results are in A's frame.
+/// Results are in A's frame. Shapes come as plain views (batchcol/types.hpp); a convex one's hull view must outlive
+/// the call (and, for setup_pair*, the setup, whose cores point to it).
 template <class T>
-PairOutput<T> solve_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+PairOutput<T> solve_pair(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
                          const Eigen::Vector3d& warm_direction, const QueryOptions& options);
 
 /// Everything GJK needs for one pair, prepared once: the cores, B's pose in A's frame in precision T, the
@@ -35,12 +36,13 @@ template <class T> struct PairSetup {
 };
 
 template <class T>
-PairSetup<T> setup_pair(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+PairSetup<T> setup_pair(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
                         const Eigen::Vector3d& warm_direction, const QueryOptions& options);
 /// setup_pair() written into `s` (the executor's hot path: no 0.5 KB temporary copied per pair). `s.out` is set
 /// only when `s.done`.
 template <class T>
-void setup_pair_into(const Shape& a, const Shape& b, const RelativePose& b_in_a, const Eigen::Vector3d& warm_direction,
+void setup_pair_into(const ShapeView& a, const ShapeView& b, const RelativePose& b_in_a,
+                     const Eigen::Vector3d& warm_direction,
                      const QueryOptions& options, PairSetup<T>& s);
 /// Whether setup_pair_into() may answer a pair of types (a, b) by a closed form under `options` (closed_form()
 /// beside it, and the box-box separating-axis test, which also needs plain boxes). Pairs of other type pairs
@@ -115,21 +117,21 @@ void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, d
   s.initial_direction = use_warm ? warm : s.difference().center();
 }
 
-extern template PairOutput<double> solve_pair<double>(const Shape&, const Shape&, const RelativePose&,
+extern template PairOutput<double> solve_pair<double>(const ShapeView&, const ShapeView&, const RelativePose&,
                                                       const Eigen::Vector3d&, const QueryOptions&);
-extern template PairOutput<float> solve_pair<float>(const Shape&, const Shape&, const RelativePose&,
+extern template PairOutput<float> solve_pair<float>(const ShapeView&, const ShapeView&, const RelativePose&,
                                                     const Eigen::Vector3d&, const QueryOptions&);
 extern template bool complete_from_gjk<double>(const GjkCompletion<double>&, const GjkResult<double>&,
                                                 const QueryOptions&, PairOutput<double>&);
 extern template bool complete_from_gjk<float>(const GjkCompletion<float>&, const GjkResult<float>&,
                                                const QueryOptions&, PairOutput<float>&);
-extern template void setup_pair_into<double>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
-                                              const QueryOptions&, PairSetup<double>&);
-extern template void setup_pair_into<float>(const Shape&, const Shape&, const RelativePose&, const Eigen::Vector3d&,
-                                             const QueryOptions&, PairSetup<float>&);
-extern template PairSetup<double> setup_pair<double>(const Shape&, const Shape&, const RelativePose&,
+extern template void setup_pair_into<double>(const ShapeView&, const ShapeView&, const RelativePose&,
+    const Eigen::Vector3d&, const QueryOptions&, PairSetup<double>&);
+extern template void setup_pair_into<float>(const ShapeView&, const ShapeView&, const RelativePose&,
+    const Eigen::Vector3d&, const QueryOptions&, PairSetup<float>&);
+extern template PairSetup<double> setup_pair<double>(const ShapeView&, const ShapeView&, const RelativePose&,
                                                      const Eigen::Vector3d&, const QueryOptions&);
-extern template PairSetup<float> setup_pair<float>(const Shape&, const Shape&, const RelativePose&,
+extern template PairSetup<float> setup_pair<float>(const ShapeView&, const ShapeView&, const RelativePose&,
                                                    const Eigen::Vector3d&, const QueryOptions&);
 extern template PairOutput<double> complete_pair<double>(const PairSetup<double>&, const GjkResult<double>&,
                                                          const QueryOptions&);

@@ -1,7 +1,7 @@
 // What a narrow-phase kernel returns for one pair, in the local frame of shape A.
 #pragma once
 
-#include "batchcol/batch.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/math.hpp"
 
 namespace batchcol::kernels {

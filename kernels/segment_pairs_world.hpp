@@ -13,14 +13,14 @@ struct WorldSegment {
   double radius = 0;    // sphere / capsule radius + inflation
 };
 
-inline bool is_segment_shape(const Shape& s) { return s.type == ShapeType::sphere || s.type == ShapeType::capsule; }
+inline bool is_segment_shape(ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; }
 
 /// The core of a sphere or capsule under a unit quaternion q and translation t: the capsule's local z axis is the
 /// third column of q's rotation matrix.
-inline WorldSegment world_segment(const Shape& s, const Eigen::Quaterniond& q, const Vec3<double>& t) {
+inline WorldSegment world_segment(const ShapeView& s, const Eigen::Quaterniond& q, const Vec3<double>& t) {
   WorldSegment w;
-  w.radius = s.size.x() + s.inflation;
-  const double h = s.type == ShapeType::capsule ? s.size.y() : 0.0;
+  w.radius = s.size[0] + s.inflation;
+  const double h = s.type == ShapeType::capsule ? s.size[1] : 0.0;
   const Vec3<double> axis(2 * (q.x() * q.z() + q.w() * q.y()), 2 * (q.y() * q.z() - q.w() * q.x()),
                           1 - 2 * (q.x() * q.x() + q.y() * q.y()));
   w.p0 = t - h * axis;

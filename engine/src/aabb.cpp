@@ -2,6 +2,7 @@
 // so six support queries give the tight box of any shape type.
 #include "batchcol/shapes.hpp"
 #include "kernels/support.hpp"
+#include "shape_table_access.hpp"
 
 #include <limits>
 
@@ -12,7 +13,8 @@ Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const 
     const double inf = std::numeric_limits<double>::infinity();
     return {Eigen::Vector3d::Constant(-inf), Eigen::Vector3d::Constant(inf)};
   }
-  const kernels::ShapeCore<double> core = kernels::make_core<double>(shape);
+  const OwnedShapeView view(shape);
+  const kernels::ShapeCore<double> core = kernels::make_core<double>(view.view);
   const Eigen::Matrix3d R = rotation.normalized().toRotationMatrix();
   kernels::SupportHint hint;
   Aabb box;

@@ -4,6 +4,7 @@
 // copy starts GJK from the unperturbed query's final direction.
 #include "counter_rng.hpp"
 #include "derivative_pairs.hpp"
+#include "shape_table_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,7 @@ struct Noise {
 };
 
 Noise noise_of(const ShapeTable& shapes, std::uint32_t b, const DerivativeOptions& o) {
-  const double r = b < shapes.size() ? shapes.bounding_radii()[b] : 1.0;
+  const double r = b < shapes.size() ? ShapeTableAccess::bounding_radii(shapes)[b] : 1.0;
   if (!std::isfinite(r) || !(r > 0.0)) return {0.0, 0.0};  // halfspace b: the pair is not differentiated
   return o.noise_scale == NoiseScale::relative ? Noise{o.noise * r, o.noise} : Noise{o.noise, o.noise / r};
 }

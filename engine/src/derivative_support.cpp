@@ -3,6 +3,7 @@
 #include "counter_rng.hpp"
 #include "kernels/shape_core.hpp"
 #include "kernels/support.hpp"
+#include "shape_table_access.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -141,7 +142,8 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
 }
 
 Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
-  const auto core = kernels::make_core<double>(shape);
+  const OwnedShapeView view(shape);
+  const auto core = kernels::make_core<double>(view.view);
   kernels::SupportHint hint;
   Eigen::Vector3d p = kernels::support(core, u, hint);
   const double n = u.norm();
@@ -151,7 +153,8 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
 
 Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
                                           std::uint64_t seed, std::uint64_t pair, std::uint64_t stream) {
-  const auto core = kernels::make_core<double>(shape);
+  const OwnedShapeView view(shape);
+  const auto core = kernels::make_core<double>(view.view);
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d p = kernels::support(core, d, hint);

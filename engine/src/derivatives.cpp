@@ -4,6 +4,7 @@
 #include "derivative_ift.hpp"
 #include "derivative_pairs.hpp"
 #include "derivative_support.hpp"
+#include "shape_table_access.hpp"
 
 #include <cmath>
 #include <limits>
@@ -17,7 +18,8 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
   if (results.status[i] != Status::converged) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
   if (a >= shapes.size() || b >= shapes.size()) return false;
-  if (shapes.types()[a] == ShapeType::halfspace || shapes.types()[b] == ShapeType::halfspace) return false;
+  const auto& types = ShapeTableAccess::types(shapes);
+  if (types[a] == ShapeType::halfspace || types[b] == ShapeType::halfspace) return false;
   g.witness_a = results.witness_a[i];
   g.witness_b = results.witness_b[i];
   g.normal = results.normal[i];
@@ -26,7 +28,7 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
     return false;
   R_a = batch.rotation_a[i].normalized().toRotationMatrix();
   R_b = batch.rotation_b[i].normalized().toRotationMatrix();
-  g.scale = shapes.bounding_radii()[a] + shapes.bounding_radii()[b];
+  g.scale = ShapeTableAccess::bounding_radii(shapes)[a] + ShapeTableAccess::bounding_radii(shapes)[b];
   return true;
 }
 

@@ -6,7 +6,9 @@
 #include "kernels/segment_pairs_world.hpp"
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
+#include "kernel_views.hpp"
 #include "results_fill.hpp"
+#include "shape_table_access.hpp"
 #include "validate.hpp"
 
 #include <tbb/blocked_range.h>
@@ -61,7 +63,7 @@ void group_by_type(const ShapeTable& shapes, const PairBatchView& batch, std::si
   if (n == 0) return;
   // Plain local pointers: a store through std::uint8_t* may alias anything, so with the vectors' own pointers the
   // compiler reloads every one of them after each key. Types come from the table's contiguous type array.
-  const ShapeType* const type = shapes.types().data();
+  const ShapeType* const type = detail::ShapeTableAccess::types(shapes).data();
   const std::uint32_t* const shape_a = batch.shape_a.data() + begin;
   const std::uint32_t* const shape_b = batch.shape_b.data() + begin;
   std::uint8_t* const key = keys.data();
@@ -74,7 +76,7 @@ void group_by_type(const ShapeTable& shapes, const PairBatchView& batch, std::si
                                            static_cast<std::size_t>(type[b]))
                : std::uint8_t{0};
   };
-  if (shapes.one_type()) {
+  if (detail::ShapeTableAccess::one_type(shapes)) {
     // Every pair is of the table's one type pair, read from no pair (grouping then costs a few instructions per
     // pair instead of a dozen). Pairs with an invalid index join that group; its kernels reject them per pair, as
     // group 0's do below.
@@ -106,19 +108,10 @@ void group_by_type(const ShapeTable& shapes, const PairBatchView& batch, std::si
 ShapeType type_a(std::size_t group) { return static_cast<ShapeType>(group / kShapeTypeCount); }
 ShapeType type_b(std::size_t group) { return static_cast<ShapeType>(group % kShapeTypeCount); }
 
+using kernels::simd::WideClosedForm;
 /// Which SIMD closed form answers a group of this shape-pair type, if any.
-enum class WideClosedForm { none, segments, boxes, point_solids };
 WideClosedForm wide_closed_form(std::size_t group, const QueryOptions& options) {
-  if (!options.closed_forms) return WideClosedForm::none;
-  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
-  if (segment(type_a(group)) && segment(type_b(group))) return WideClosedForm::segments;
-  // A sphere's centre against a cylinder or cone: a 2D distance in the solid's section (wide_point_solids.inl).
-  if (kernels::simd::is_point_solid_pair(type_a(group), type_b(group))) return WideClosedForm::point_solids;
-  // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
-  if (type_a(group) == ShapeType::box && type_b(group) == ShapeType::box && options.level == QueryLevel::boolean &&
-      options.margin == 0.0)
-    return WideClosedForm::boxes;
-  return WideClosedForm::none;
+  return kernels::simd::wide_closed_form(type_a(group), type_b(group), options);
 }
 
 /// Whether a group's pairs run through the SIMD GJK straight from the batch arrays (kernels::simd::gjk_pairs):
@@ -176,7 +169,9 @@ bool prepare_pair(const ShapeTable& shapes, const PairBatchView& batch, const Qu
   b_in_a.t = kernels::mul_transposed<double>(frame.Ra, tb - ta);
   Eigen::Vector3d warm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   if (!batch.warm_start.empty()) warm = kernels::mul_transposed<double>(frame.Ra, batch.warm_start[i]);
-  kernels::setup_pair_into<T>(shapes[ia], shapes[ib], b_in_a, warm, options, setup);
+  // Views into the table: a convex core keeps a pointer to the table's hull view, which outlives the chunk.
+  kernels::setup_pair_into<T>(detail::ShapeTableAccess::view(shapes, ia), detail::ShapeTableAccess::view(shapes, ib),
+                              b_in_a, warm, options, setup);
   return true;
 }
 
@@ -187,9 +182,9 @@ bool solve_segment_pair(const ShapeTable& shapes, const PairBatchView& batch, co
                         PairResults& out) {
   const std::uint32_t ia = batch.shape_a[i], ib = batch.shape_b[i];
   if (ia >= shapes.size() || ib >= shapes.size()) return false;
-  const Shape& a = shapes[ia];
-  const Shape& b = shapes[ib];
-  if (!kernels::is_segment_shape(a) || !kernels::is_segment_shape(b)) return false;
+  const auto& types = detail::ShapeTableAccess::types(shapes);
+  if (!kernels::is_segment_shape(types[ia]) || !kernels::is_segment_shape(types[ib])) return false;
+  const ShapeView a = detail::ShapeTableAccess::view(shapes, ia), b = detail::ShapeTableAccess::view(shapes, ib);
   const auto qa = detail::unit_quaternion(batch.rotation_a[i]);
   const auto qb = detail::unit_quaternion(batch.rotation_b[i]);
   const Eigen::Vector3d ta = batch.translation_a[i], tb = batch.translation_b[i];
@@ -214,7 +209,7 @@ template <class T>
 void run_generic(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& options, InstructionSet isa,
                  std::size_t begin, std::size_t count, ChunkScratch<T>& s, PairResults& out) {
   if (count == 0) return;
-  const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
+  const kernels::simd::ResultView results = detail::result_view(out);
   s.setups.resize(kChunkPairs);
   s.gjk.resize(kChunkPairs);
   s.frames.resize(kChunkPairs);
@@ -266,8 +261,8 @@ void run_tile(const ShapeTable& shapes, const PairBatchView& batch, const QueryO
   // Groups with a SIMD closed form or the batch-array GJK first; the pairs they leave (invalid input, touching
   // cores, inflated boxes, float stalls redone in double) join the generic per-pair path below with every other
   // group.
-  const kernels::simd::PairView view = kernels::simd::PairView::of(shapes, batch);
-  const kernels::simd::ResultView results = kernels::simd::ResultView::of(out);
+  const kernels::simd::PairView view = detail::pair_view(shapes, batch);
+  const kernels::simd::ResultView results = detail::result_view(out);
   const kernels::simd::ClosedFormQuery query{options.level, options.margin};
   s.fallback.resize(end - begin);  // no-ops after the first tile: sizes, not contents, change
   std::size_t kept = 0, fallbacks = 0;
@@ -346,6 +341,17 @@ void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOp
     tbb::task_arena arena(options.threads);
     arena.execute(run_all);
   }
+}
+
+const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
+  // Sphere-cylinder and sphere-cone have a closed form only in SIMD lanes; the others are what the per-pair setup
+  // answers (it also knows that inflated boxes run GJK).
+  if (kernels::simd::wide_closed_form(a.type, b.type, options) == WideClosedForm::point_solids) return "closed form";
+  const OwnedShapeView va(a), vb(b);
+  kernels::RelativePose apart;
+  apart.t = Eigen::Vector3d(1e3, 0, 0);  // the kernel depends on the types and options only, not on the pose
+  const auto setup = kernels::setup_pair<double>(va.view, vb.view, apart, Eigen::Vector3d::Zero(), options);
+  return setup.done ? "closed form" : "gjk";
 }
 
 }  // namespace batchcol

@@ -8,6 +8,7 @@
 
 #include "kernels/rays/ray_lanes.hpp"
 #include "ray_prepared.hpp"
+#include "shape_table_access.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -33,7 +34,8 @@ template <class T> kr::LaneShapeTable lane_shapes(const ShapeTable& table, const
   t.hull_f.assign(table.size(), nullptr);
   for (std::size_t s = 0; s < table.size(); ++s) {
     const Shape& shape = table[s];
-    const kernels::ShapeCore<double> core = kernels::make_core<double>(shape);
+    const OwnedShapeView view(shape);  // the core is read here only
+    const kernels::ShapeCore<double> core = kernels::make_core<double>(view.view);
     kr::LaneKind kind = kr::LaneKind::none;
     double a = 0, b = 0, c = 0;
     if (shape.type == ShapeType::sphere) kind = kr::LaneKind::sphere, a = core.radius;

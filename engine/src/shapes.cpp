@@ -1,5 +1,6 @@
 #include "batchcol/shapes.hpp"
 #include "convex_hull_search.hpp"
+#include "shape_table_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -191,13 +192,23 @@ std::uint32_t ShapeTable::add(Shape shape) {
     throw InputError("shape " + std::to_string(shapes_.size()) + " (" + to_string(type) + "): a size is out of range" +
                      kLimits + " or, for a halfspace, the normal is not unit");
   }
+  const HullView hull = type == ShapeType::convex && shape.hull ? hull_view(*shape.hull) : HullView{};
+  const double size[3] = {shape.size.x(), shape.size.y(), shape.size.z()}, inflation = shape.inflation;
+  const std::size_t before = shapes_.size();
   shapes_.push_back(std::move(shape));
-  try {  // the three arrays grow together: a failed allocation leaves the table as it was
+  try {  // the arrays grow together: a failed allocation leaves the table as it was
     types_.push_back(type);
     bounding_radii_.push_back(radius);
+    for (int k = 0; k < 3; ++k) size_[k].push_back(size[k]);
+    inflation_.push_back(inflation);
+    hulls_.push_back(hull);
   } catch (...) {
+    types_.resize(std::min(types_.size(), before));  // shrinking never allocates
+    bounding_radii_.resize(std::min(bounding_radii_.size(), before));
+    for (auto& a : size_) a.resize(std::min(a.size(), before));
+    inflation_.resize(std::min(inflation_.size(), before));
+    hulls_.resize(std::min(hulls_.size(), before));
     shapes_.pop_back();
-    if (types_.size() > shapes_.size()) types_.pop_back();
     throw;
   }
   mixed_ = shapes_.size() > 1 && (mixed_ || type != types_.front());  // a moved-from table starts afresh
@@ -205,6 +216,48 @@ std::uint32_t ShapeTable::add(Shape shape) {
   smallest_size_ = std::min(smallest_size_, smallest);
   if (type != ShapeType::halfspace) largest_radius_ = std::max(largest_radius_, radius);
   return static_cast<std::uint32_t>(shapes_.size() - 1);
+}
+
+HullView hull_view(const ConvexHull& hull) {
+  // Eigen's fixed-size 3-vectors are three packed doubles and std::array<uint32, 3> three packed indices, so the
+  // hull's vectors are the flat arrays HullView promises.
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "Vector3d must be three packed doubles");
+  static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(std::uint32_t), "faces must be packed");
+  const auto data = [](const auto& v) { return v.empty() ? nullptr : v.data(); };
+  HullView h;
+  h.vertices = hull.vertices.empty() ? nullptr : hull.vertices.front().data();
+  h.vertex_count = static_cast<std::uint32_t>(hull.vertices.size());
+  h.face_count = static_cast<std::uint32_t>(hull.faces.size());
+  h.faces = hull.faces.empty() ? nullptr : hull.faces.front().data();
+  h.face_normals = hull.face_normals.empty() ? nullptr : hull.face_normals.front().data();
+  // The kernels check the optional structures by presence: a table of another size, or blocks that do not cover
+  // every vertex, are as good as none (a linear scan, a climb from vertex 0).
+  h.start_vertices = hull.start_vertices.size() == kHullStartCells ? hull.start_vertices.data() : nullptr;
+  if (hull.neighbor_block_offsets.size() == hull.vertices.size() + 1) {
+    h.neighbor_block_offsets = hull.neighbor_block_offsets.data();
+    h.neighbor_block_index = data(hull.neighbor_block_index);
+    h.neighbor_block_xyz = data(hull.neighbor_block_xyz);
+  }
+  for (int k = 0; k < 3; ++k) h.centroid[k] = hull.centroid[k];
+  h.radius = hull.radius;
+  return h;
+}
+
+ShapeView shape_view(const Shape& shape, const HullView* hull) {
+  return shape_view(shape, hull, shape.bounding_radius());
+}
+
+ShapeView shape_view(const Shape& shape, const HullView* hull, double bounding_radius) {
+  ShapeView v;
+  v.type = shape.type;
+  for (int k = 0; k < 3; ++k) v.size[k] = shape.size[k];
+  v.offset = shape.offset;
+  v.inflation = shape.inflation;
+  v.bounding_radius = bounding_radius;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) v.triangle[i][k] = shape.triangle[i][k];
+  v.hull = shape.type == ShapeType::convex ? hull : nullptr;
+  return v;
 }
 
 }  // namespace batchcol

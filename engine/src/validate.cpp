@@ -1,6 +1,7 @@
 #include "validate.hpp"
 
 #include "results_fill.hpp"
+#include "shape_table_access.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -59,12 +60,14 @@ void validate_batch_layout(const PairBatchView& b) {
 
 void validate_shapes_for(const ShapeTable& shapes, const QueryOptions& options) {
   if (options.precision != Precision::float32 || shapes.size() == 0) return;
-  if (shapes.smallest_size() >= kMinLengthFloat && shapes.largest_radius() <= kMaxLengthFloat) return;
+  const double smallest = ShapeTableAccess::smallest_size(shapes);
+  const double largest = ShapeTableAccess::largest_radius(shapes);
+  if (smallest >= kMinLengthFloat && largest <= kMaxLengthFloat) return;
   char text[200];
   std::snprintf(text, sizeof text,
                 "precision float32 answers shapes of sizes %g to %g m only (the table holds sizes down to %g m and "
                 "bounding radii up to %g m): use precision double",
-                kMinLengthFloat, kMaxLengthFloat, shapes.smallest_size(), shapes.largest_radius());
+                kMinLengthFloat, kMaxLengthFloat, smallest, largest);
   throw InputError(text);
 }
 

@@ -13,8 +13,9 @@
 // vertices, on which hill climbing could stop early.
 #pragma once
 
-#include "batchcol/shapes.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/rays/ray_interval.hpp"
+#include "kernels/shape_core.hpp"
 
 #include <algorithm>
 #include <array>
@@ -43,14 +44,15 @@ inline std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t
   return i;
 }
 
-template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
-  const std::size_t F = hull.faces.size();
-  const auto offset = [&](std::size_t f) { return hull.face_normals[f].dot(hull.vertices[hull.faces[f][0]]); };
+template <class T> HullWalk<T> make_hull_walk(const HullView& hull) {
+  const std::uint32_t F = hull.face_count;
+  const auto normal = [&](std::uint32_t f) { return hull_face_normal(hull, f); };
+  const auto offset = [&](std::uint32_t f) { return normal(f).dot(hull_vertex(hull, hull.faces[3 * f])); };
   // Triangles that share an edge and a plane (within 1e-12 of the hull's size) belong to one facet.
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> edges;
   for (std::uint32_t f = 0; f < F; ++f)
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = hull.faces[f][k], b = hull.faces[f][(k + 1) % 3];
+      const std::uint32_t a = hull.faces[3 * f + k], b = hull.faces[3 * f + (k + 1) % 3];
       edges[{std::min(a, b), std::max(a, b)}].push_back(f);
     }
   std::vector<std::uint32_t> parent(F);
@@ -59,14 +61,14 @@ template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
   for (const auto& [edge, faces] : edges) {
     if (faces.size() != 2) continue;
     const std::uint32_t f = faces[0], g = faces[1];
-    if ((hull.face_normals[f] - hull.face_normals[g]).norm() <= 1e-12 && std::abs(offset(f) - offset(g)) <= tol)
+    if ((normal(f) - normal(g)).norm() <= 1e-12 && std::abs(offset(f) - offset(g)) <= tol)
       parent[find_root(parent, f)] = find_root(parent, g);
   }
   std::vector<std::uint32_t> facet(F, UINT32_MAX);
   HullWalk<T> w;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& v : hull.vertices) p += v;
-  p /= double(hull.vertices.size());
+  for (std::uint32_t v = 0; v < hull.vertex_count; ++v) p += hull_vertex(hull, v);
+  p /= double(hull.vertex_count);
   w.p = p.cast<T>();
   std::vector<std::uint32_t> representative;
   for (std::uint32_t f = 0; f < F; ++f) {
@@ -75,7 +77,7 @@ template <class T> HullWalk<T> make_hull_walk(const ConvexHull& hull) {
     facet[f] = facet[r];
   }
   for (std::uint32_t r : representative) {
-    const Eigen::Vector3d& n = hull.face_normals[r];
+    const Eigen::Vector3d n = normal(r);
     const double c = offset(r), h = c - n.dot(p);
     w.nx.push_back(T(n.x())), w.ny.push_back(T(n.y())), w.nz.push_back(T(n.z())), w.c.push_back(T(c));
     w.ux.push_back(T(n.x() / h)), w.uy.push_back(T(n.y() / h)), w.uz.push_back(T(n.z() / h));

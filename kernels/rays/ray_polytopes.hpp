@@ -2,7 +2,7 @@
 // intersection of its face half-spaces: Cyrus-Beck clipping), triangle (Moeller-Trumbore 1997) and halfspace.
 #pragma once
 
-#include "batchcol/shapes.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/rays/ray_convex_planes.hpp"
 #include "kernels/rays/ray_hull_walk.hpp"
 #include "kernels/rays/ray_interval.hpp"
@@ -62,14 +62,14 @@ template <class T> struct HullPlanes {
 /// Below this many faces the clipping loop over all planes is cheaper than the walk's climbs (a few blocks of 8).
 constexpr std::size_t kHullWalkMinFaces = 48;
 
-template <class T> HullPlanes<T> make_hull_planes(const ConvexHull& hull) {
+template <class T> HullPlanes<T> make_hull_planes(const HullView& hull) {
   HullPlanes<T> p;
-  p.faces = hull.faces.size();
+  p.faces = hull.face_count;
   const std::size_t padded = (p.faces + kHullPlaneBlock - 1) / kHullPlaneBlock * kHullPlaneBlock;
   p.nx.assign(padded, T(0)), p.ny.assign(padded, T(0)), p.nz.assign(padded, T(0)), p.c.assign(padded, T(1));
   for (std::size_t i = 0; i < p.faces; ++i) {
-    const Eigen::Vector3d& n = hull.face_normals[i];
-    const Eigen::Vector3d& v = hull.vertices[hull.faces[i][0]];
+    const Eigen::Vector3d n = hull_face_normal(hull, std::uint32_t(i));
+    const Eigen::Vector3d v = hull_vertex(hull, hull.faces[3 * i]);
     p.nx[i] = T(n.x()), p.ny[i] = T(n.y()), p.nz[i] = T(n.z());
     p.c[i] = T(n.dot(v));
   }

@@ -19,17 +19,18 @@ template <class T> struct RayShape {
   const HullPlanes<T>* planes = nullptr;  // convex only
 };
 
-template <class T> RayShape<T> make_ray_shape(const Shape& shape, const HullPlanes<T>* planes) {
+/// `shape`'s hull view (convex) must outlive the RayShape: its core points to it.
+template <class T> RayShape<T> make_ray_shape(const ShapeView& shape, const HullPlanes<T>* planes) {
   RayShape<T> r;
   r.core = make_core<T>(shape);
   r.inflation = T(shape.inflation);
-  r.bound = shape.type == ShapeType::halfspace ? T(0) : T(shape.bounding_radius());
+  r.bound = shape.type == ShapeType::halfspace ? T(0) : T(shape.bounding_radius);
   r.planes = planes;
   return r;
 }
 
 /// True when the shape's rays go through the GJK ray cast (tolerance-certified) instead of an exact kernel.
-inline bool uses_ray_gjk(const Shape& shape) {
+inline bool uses_ray_gjk(const ShapeView& shape) {
   return shape.inflation > 0.0 && shape.type != ShapeType::sphere && shape.type != ShapeType::capsule &&
          shape.type != ShapeType::halfspace;
 }

@@ -1,12 +1,11 @@
-// Run-time choice of the instruction set: the CPU's best (cpuid through __builtin_cpu_supports), lowered by the
-// environment variable BATCHCOL_ISA, or an explicit request checked against the CPU; and the table of each set's
-// entry points.
+// The CPU's best instruction set (cpuid through __builtin_cpu_supports) and the table of each set's entry points.
+// Lowering it by the environment variable BATCHCOL_ISA, or checking a request against it, is the engine's
+// (engine/src/instruction_set.cpp).
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 
 #include "batchcol/errors.hpp"
 
-#include <cstdlib>
 #include <string>
 
 namespace batchcol::kernels::simd {
@@ -134,30 +133,4 @@ std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a
   return kernels_of(isa).gjk_pairs_float(in, a, b, pairs, n, options, out, fallback);
 }
 
-InstructionSet capped_instruction_set(InstructionSet best, const char* cap) {
-  if (cap == nullptr || *cap == '\0') return best;
-  for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512})
-    if (std::string(cap) == to_string(isa)) return static_cast<int>(isa) < static_cast<int>(best) ? isa : best;
-  throw InputError("environment variable BATCHCOL_ISA='" + std::string(cap) +
-                   "' names no instruction set (valid: scalar, avx2, avx512)");
-}
-
 }  // namespace batchcol::kernels::simd
-
-namespace batchcol {
-
-InstructionSet resolve_instruction_set(InstructionSet requested) {
-  using kernels::simd::cpu_has;
-  // The CPU and the environment are read once per process (the first call), not on every collide().
-  static const InstructionSet detected = kernels::simd::detected_instruction_set();
-  if (requested == InstructionSet::automatic) {
-    static const InstructionSet chosen = kernels::simd::capped_instruction_set(detected, std::getenv("BATCHCOL_ISA"));
-    return chosen;
-  }
-  if (static_cast<int>(requested) > static_cast<int>(detected))
-    throw InputError(std::string("instruction set ") + to_string(requested) + " is not supported by this CPU (best: " +
-                     to_string(detected) + ")");
-  return requested;
-}
-
-}  // namespace batchcol

@@ -57,19 +57,6 @@ template <class M> inline std::uint32_t lane_bits(M m) {
 }
 template <class M> inline bool any(M m) { return lane_bits(m) != 0; }
 
-/// Lane-wise a * b for 64-bit lanes a < 2^32 and b < 2^32 (AVX2 has no 64-bit lane multiply; the 32 x 32 -> 64
-/// multiply is one instruction).
-template <class M> inline M mul_u32(M a, std::uint32_t b) {
-  static_assert(sizeof(a[0]) == 8, "64-bit lanes");
-  if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(M) == 32) {
-    return M(_mm256_mul_epu32(__m256i(a), _mm256_set1_epi64x(std::int64_t(b))));
-  } else if constexpr (BATCHCOL_SIMD_BYTES == 64 && sizeof(M) == 64) {
-    return M(_mm512_mul_epu32(__m512i(a), _mm512_set1_epi64(std::int64_t(b))));
-  } else {
-    return a * std::int64_t(b);
-  }
-}
-
 /// Lane-wise integer -> real.
 template <class T> inline wreal<T> to_real(wmask<T> i) { return __builtin_convertvector(i, wreal<T>); }
 

@@ -34,8 +34,8 @@ struct WideBoxes : PairLanes {
     Pose pb = load_pose<Consecutive>(in, in.shape_b, in.translation_b, in.rotation_b, b.idx);
     const mask answered = pa.valid & pb.valid & (field(in.shape_inflation, pa) == zero) &
                           (field(in.shape_inflation, pb) == zero);
-    const real ha[3] = {field(in.shape_size, pa), field(in.shape_size + 1, pa), field(in.shape_size + 2, pa)};
-    const real hb[3] = {field(in.shape_size, pb), field(in.shape_size + 1, pb), field(in.shape_size + 2, pb)};
+    const real ha[3] = {field(in.shape_size[0], pa), field(in.shape_size[1], pa), field(in.shape_size[2], pa)};
+    const real hb[3] = {field(in.shape_size[0], pb), field(in.shape_size[1], pb), field(in.shape_size[2], pb)};
     normalize(pa);
     normalize(pb);
     // B's rotation in A's frame is that of conj(qa) qb; B's centre in A's frame is d rotated by conj(qa):

@@ -35,6 +35,22 @@ inline bool is_point_solid_pair(ShapeType a, ShapeType b) {
 /// a cylinder; `pairs` ascending), at every query level: the sphere's centre against the solid of revolution in
 /// closed form (wide_point_solids.inl). Writes what segment_pairs writes; returns how many it left to the scalar
 /// path (invalid input, a centre on the solid's boundary to rounding), their indices in fallback[0 .. count).
+/// Which SIMD closed form answers pairs of types (a, b) under `options`, if any: the one rule the executor groups
+/// pairs by, kernel_for() names and the tests exclude from their scalar comparisons. The kernels may still leave
+/// single pairs to the per-pair path (invalid input, touching cores, inflated boxes).
+enum class WideClosedForm { none, segments, boxes, point_solids };
+inline WideClosedForm wide_closed_form(ShapeType a, ShapeType b, const QueryOptions& options) {
+  if (!options.closed_forms) return WideClosedForm::none;
+  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
+  if (segment(a) && segment(b)) return WideClosedForm::segments;
+  // A sphere's centre against a cylinder or cone: a 2D distance in the solid's section (wide_point_solids.inl).
+  if (is_point_solid_pair(a, b)) return WideClosedForm::point_solids;
+  // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
+  if (a == ShapeType::box && b == ShapeType::box && options.level == QueryLevel::boolean && options.margin == 0.0)
+    return WideClosedForm::boxes;
+  return WideClosedForm::none;
+}
+
 std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, bool cone,
                               const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                               const ResultView& out, std::uint32_t* fallback);

@@ -2,7 +2,7 @@
 // once per instruction set (isa_scalar.cpp, isa_avx2.cpp, isa_avx512.cpp) and chosen at run time from the CPU.
 #pragma once
 
-#include "batchcol/batch.hpp"
+#include "batchcol/types.hpp"
 #include "kernels/narrowphase.hpp"
 #include "kernels/simd/pair_views.hpp"
 
@@ -15,9 +15,6 @@ namespace batchcol::kernels::simd {
 InstructionSet detected_instruction_set();
 /// True when this CPU can run `isa`.
 bool cpu_has(InstructionSet isa);
-/// The automatic choice lowered by the value of BATCHCOL_ISA (`cap`: null or empty = no cap; a set above `best`
-/// leaves `best`); InputError when `cap` names no set. resolve_instruction_set() applies it once per process.
-InstructionSet capped_instruction_set(InstructionSet best, const char* cap);
 /// Lanes per register for precision T in instruction set `isa` (1 for scalar).
 int lane_count(InstructionSet isa, Precision precision);
 

@@ -51,7 +51,7 @@ template <class T> struct WideGjk {
     ShapeType type = ShapeType::sphere;
     real s0{}, s1{}, s2{};                 // ShapeCore::size
     real tri[9]{};                         // triangle vertices
-    const ConvexHull* hull[W] = {};
+    const HullView* hull[W] = {};
     SupportHint hint[W] = {};
     std::uint32_t small = 0;  // lanes whose hull has fewer than kHillClimbMinVertices vertices (linear scan)
     // Small hulls, lane-interleaved: row i holds vertex i of every lane's hull (as T), so a support scans its
@@ -151,8 +151,8 @@ template <class T> struct WideGjk {
 
   /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
   /// more vertices than `rows`, the other lanes are padded up to the new row count first.
-  static void load_small_hull(Side& s, int l, const ConvexHull& hull) {
-    const int count = int(hull.vertices.size());
+  static void load_small_hull(Side& s, int l, const HullView& hull) {
+    const int count = int(hull.vertex_count);
     // Lane l of row i is element i * W + l of each coordinate array (rows are W contiguous lanes).
     T* x = reinterpret_cast<T*>(s.table->vx);
     T* y = reinterpret_cast<T*>(s.table->vy);
@@ -168,8 +168,7 @@ template <class T> struct WideGjk {
       }
       s.rows = count;
     }
-    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "vertices are packed xyz triples");
-    const double* v = hull.vertices.front().data();
+    const double* v = hull.vertices;  // packed xyz triples
     for (int i = 0; i < count; ++i) x[i * W + l] = T(v[3 * i]), y[i * W + l] = T(v[3 * i + 1]), z[i * W + l] = T(v[3 * i + 2]);
     const int last = count - 1;
     for (int i = count; i < s.rows; ++i)
@@ -440,7 +439,7 @@ template <class T> struct WideGjk {
   struct SideStart {
     T size[3];
     const std::array<Vec3<T>, 3>* triangle;  // triangle cores only
-    const ConvexHull* hull;                  // convex cores only
+    const HullView* hull;                    // convex cores only
   };
   static SideStart side_start(const ShapeCore<T>& c) {
     return {{c.size.x(), c.size.y(), c.size.z()}, &c.triangle, c.hull};
@@ -457,7 +456,7 @@ template <class T> struct WideGjk {
       s.hull[l] = c.hull;
       s.hint[l] = SupportHint{};
       const std::uint32_t bit = 1u << l;
-      const bool small = c.hull->vertices.size() < kHillClimbMinVertices;
+      const bool small = c.hull->vertex_count < kHillClimbMinVertices;
       s.small = small ? s.small | bit : s.small & ~bit;
       if (small) load_small_hull(s, l, *c.hull);
     }

@@ -103,28 +103,28 @@ template <class T> struct WideGjkPairs {
                           side_a ? in.rotation_a : in.rotation_b, b.idx, b.consecutive);
     }
 
-    /// One side's core as make_core() builds it, read straight from the Shape record (no ShapeCore, no PairSetup:
-    /// building those per pair was a fifth of an ellipsoid pair's work). `radius` gets the swept
-    /// radius with make_core's roundings: T(inflation), plus T(radius) for spheres and capsules.
-    static typename G::SideStart side(const Shape& shape, T& radius) {
+    /// One side's core as make_core() builds it, read straight from the ShapeTable's per-shape arrays (no
+    /// ShapeCore, no PairSetup: building those per pair was a fifth of an ellipsoid pair's work). `radius` gets the
+    /// swept radius with make_core's roundings: T(inflation), plus T(radius) for spheres and capsules.
+    static typename G::SideStart side(const PairView& in, std::uint32_t shape, T& radius) {
       typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
-      radius = T(shape.inflation);
-      switch (shape.type) {
-        case ShapeType::sphere: radius += T(shape.size.x()); break;
+      radius = T(in.shape_inflation[shape]);
+      switch (in.shape_type[shape]) {
+        case ShapeType::sphere: radius += T(in.shape_size[0][shape]); break;
         case ShapeType::capsule:
-          radius += T(shape.size.x());
-          c.size[1] = T(shape.size.y());
+          radius += T(in.shape_size[0][shape]);
+          c.size[1] = T(in.shape_size[1][shape]);
           break;
-        case ShapeType::convex: c.hull = shape.hull.get(); break;
+        case ShapeType::convex: c.hull = &in.shape_hull[shape]; break;
         default:
-          for (int i = 0; i < 3; ++i) c.size[i] = T(shape.size[i]);
+          for (int i = 0; i < 3; ++i) c.size[i] = T(in.shape_size[i][shape]);
           break;
       }
       return c;
     }
     /// ShapeCore::center() of a core (the hull's centroid, the origin for the other types in this path).
     static Vec3<T> center(const typename G::SideStart& c) {
-      return c.hull ? Vec3<T>(c.hull->centroid.template cast<T>()) : Vec3<T>::Zero();
+      return c.hull ? hull_centroid<T>(*c.hull) : Vec3<T>::Zero();
     }
 
     /// setup_pair_into() and set_gjk_parameters() for a pair without closed form or warm start (the same
@@ -138,8 +138,8 @@ template <class T> struct WideGjkPairs {
       const std::uint32_t ia = chunk.shape_a[s], ib = chunk.shape_b[s];
       typename G::LaneStart q;
       T radius_a, radius_b;
-      q.A = side(in.shapes[ia], radius_a);
-      q.B = side(in.shapes[ib], radius_b);
+      q.A = side(in, ia, radius_a);
+      q.B = side(in, ib, radius_b);
       for (int e = 0; e < 9; ++e) q.R[e] = T(chunk.R[e][s]);
       const double tx = chunk.t[0][s], ty = chunk.t[1][s], tz = chunk.t[2][s];
       q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);

@@ -1,7 +1,6 @@
 // Lane helpers shared by the SIMD closed forms (wide_segments.inl, wide_boxes.inl) and the batch-array GJK
-// (wide_gjk_pairs.inl): 3-vectors of lanes, loads and
-// stores at pair indices, shape fields through the ShapeTable's stride, and world poses with the executor's
-// validity rule.
+// (wide_gjk_pairs.inl): 3-vectors of lanes, loads and stores at pair indices, shape fields gathered from the
+// ShapeTable's per-shape arrays, and world poses with the executor's validity rule.
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide.hpp, inside the ISA namespace.
 
@@ -51,10 +50,11 @@ struct PairLanes {
     }
   }
 
-  /// One side of W pairs: the world pose (q as given, with its norm) and the byte offset of the shape in the
-  /// ShapeTable. `valid`: the executor's rule (detail::normalize_unit_quaternion in engine/src/validate.hpp, with
-  /// the same norm): q finite with | |q| - 1 | <= kUnitTolerance (NaN and infinite components fail both
-  /// comparisons), t within the input limit, shape index in range (out-of-range lanes read shape 0).
+  /// One side of W pairs: the world pose (q as given, with its norm) and the byte offset of the shape's entry in
+  /// the ShapeTable's per-shape arrays of doubles (PairView::shape_size, ...). `valid`: the executor's rule
+  /// (detail::normalize_unit_quaternion in engine/src/validate.hpp, with the same norm): q finite with
+  /// | |q| - 1 | <= kUnitTolerance (NaN and infinite components fail both comparisons), t within the input limit,
+  /// shape index in range (out-of-range lanes read shape 0).
   struct Pose {
     V3 t;
     real w, x, y, z, norm;
@@ -86,14 +86,14 @@ struct PairLanes {
     const mask shape = __builtin_convertvector(raw, mask);  // zero-extended to 64-bit lanes
     const mask in_range = shape < (mask{} + Int(in.shape_count));
     p.valid &= in_range;
-    p.shape = mul_u32(select(in_range, shape, mask{}), in.shape_stride);
+    p.shape = select(in_range, shape, mask{}) << 3;  // x sizeof(double)
     return p;
   }
   static Pose load_pose(const PairView& in, const std::uint32_t* shape_index, const double* const t[3],
                         const double* const q[4], const std::uint32_t* idx, bool consecutive) {
     return consecutive ? load_pose<true>(in, shape_index, t, q, idx) : load_pose<false>(in, shape_index, t, q, idx);
   }
-  /// Shape field at `base` (a field of shape 0, e.g. in.shape_size + 1) for each lane's shape.
+  /// A per-shape array's entry (e.g. in.shape_size[1]) for each lane's shape.
   static real field(const double* base, const Pose& p) { return gather_bytes<double>(base, p.shape); }
 
   /// q / |q| (the executor normalises every quaternion it accepts).

@@ -105,8 +105,9 @@ struct WidePointSolids : PairLanes {
                                      SphereA ? in.rotation_a : in.rotation_b, b.idx);
     Pose pc = load_pose<Consecutive>(in, SphereA ? in.shape_b : in.shape_a, SphereA ? in.translation_b : in.translation_a,
                                      SphereA ? in.rotation_b : in.rotation_a, b.idx);
-    const real sphere_radius = field(in.shape_size, ps) + field(in.shape_inflation, ps);
-    const real R = field(in.shape_size, pc), h = field(in.shape_size + 1, pc), inflation = field(in.shape_inflation, pc);
+    const real sphere_radius = field(in.shape_size[0], ps) + field(in.shape_inflation, ps);
+    const real R = field(in.shape_size[0], pc), h = field(in.shape_size[1], pc);
+    const real inflation = field(in.shape_inflation, pc);
     normalize(pc);
     const V3 axis[3] = {column(pc, 0), column(pc, 1), column(pc, 2)};
     const V3 d = sub(ps.t, pc.t);  // the sphere's centre relative to the solid, world axes

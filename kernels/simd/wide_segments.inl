@@ -32,12 +32,12 @@ struct WideSegments : PairLanes {
     Pose p = load_pose<Consecutive>(in, shape_index, t, q, b.idx);
     Side s;
     s.valid = p.valid;
-    s.radius = field(in.shape_size, p) + field(in.shape_inflation, p);
+    s.radius = field(in.shape_size[0], p) + field(in.shape_inflation, p);
     if (!Capsule) {
       s.p0 = s.p1 = p.t;
       return s;
     }
-    const real half = field(in.shape_size + 1, p);
+    const real half = field(in.shape_size[1], p);
     normalize(p);
     const V3 axis = column(p, 2);  // the capsule's local z axis
     s.p0 = sub(p.t, scale(half, axis));

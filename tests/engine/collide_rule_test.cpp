@@ -2,7 +2,7 @@
 // separating plane beyond the margin is certified -- while `distance` is GJK's upper estimate. So a converged pair
 // may report collide = 1 with a distance above the margin, by at most the effective tolerance
 // max(tolerance, relative_tolerance x distance, precision floor); collide = 0 always comes with a distance above the
-// margin. This test checks that documented rule (README "collide and the tolerance", batch.hpp QueryOptions::margin)
+// margin. This test checks that documented rule (README "collide and the tolerance", types.hpp QueryOptions::margin)
 // on the probe's case and on random near-contact pairs.
 #include <batchcol/batchcol.hpp>
 

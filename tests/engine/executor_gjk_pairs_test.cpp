@@ -1,10 +1,12 @@
 // GJK groups answered straight from the batch arrays (kernels::simd::gjk_pairs) give, pair by pair, the bits of the
 // scalar reference: the relative pose as the executor computes it, kernels::solve_pair (scalar GJK), the output
 // mapped to the world frame. Invalid pairs get invalid_input and NaN / 0 everywhere else.
+#include "kernel_views.hpp"  // engine/src: pair_view, result_view
 #include "kernels/math.hpp"
 #include "kernels/narrowphase.hpp"
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
+#include "shape_table_access.hpp"  // engine/src: OwnedShapeView
 #include "support/generators.hpp"
 #include "support/same_results.hpp"
 
@@ -66,14 +68,12 @@ bool unit(double q[4]) {
   return true;
 }
 
-/// Pairs the executor answers by a closed form when closed forms are on and that a scalar solve_pair() does not
-/// reproduce bit for bit (the SIMD closed forms work in the world frame): sphere/capsule pairs, sphere against
-/// cylinder or cone, and box-box at boolean level (the SAT kernel leaves the direction NaN).
+/// Pairs the executor answers by a SIMD closed form (its own rule, kernels::simd::wide_closed_form), which a scalar
+/// solve_pair() does not reproduce bit for bit (they work in the world frame; the box SAT kernel leaves the
+/// direction NaN): sphere/capsule pairs, sphere against cylinder or cone (tests/engine/point_solids_test.cpp),
+/// box-box at boolean level.
 bool simd_closed_form(ShapeType a, ShapeType b, const QueryOptions& o) {
-  const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
-  if (!o.closed_forms) return false;
-  return (segment(a) && segment(b)) || (a == ShapeType::box && b == ShapeType::box && o.level == QueryLevel::boolean) ||
-         kernels::simd::is_point_solid_pair(a, b);  // sphere-cylinder, sphere-cone: tests/engine/point_solids_test.cpp
+  return kernels::simd::wide_closed_form(a, b, o) != kernels::simd::WideClosedForm::none;
 }
 
 /// Entry i of a result array, NaN when the level left the array empty.
@@ -110,8 +110,9 @@ template <class T> PairResults reference(const Scene& s, const QueryOptions& o, 
     kernels::RelativePose X;
     X.R = kernels::transposed_product(Ra, kernels::rotation_matrix(qb[0], qb[1], qb[2], qb[3]));
     X.t = kernels::mul_transposed<double>(Ra, tb - ta);
-    const kernels::PairOutput<T> p = kernels::solve_pair<T>(s.shapes[b.shape_a[i]], s.shapes[b.shape_b[i]], X,
-                                                             Eigen::Vector3d::Constant(kNan), o);
+    const OwnedShapeView va(s.shapes[b.shape_a[i]]), vb(s.shapes[b.shape_b[i]]);
+    const kernels::PairOutput<T> p =
+        kernels::solve_pair<T>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
     r.status[i] = p.status;
     r.collide[i] = p.collide ? 1 : 0;
     r.iterations[i] = p.iterations;
@@ -187,9 +188,9 @@ template <class T> void expect_kernel_answers_valid_pairs(InstructionSet isa, Qu
   got.resize(n);
   std::vector<std::uint32_t> pairs(n), fallback(n);
   for (std::size_t i = 0; i < n; ++i) pairs[i] = static_cast<std::uint32_t>(i);
-  const std::size_t left = kernels::simd::gjk_pairs<T>(isa, kernels::simd::PairView::of(s.shapes, s.batch),
+  const std::size_t left = kernels::simd::gjk_pairs<T>(isa, detail::pair_view(s.shapes, s.batch),
                                                       ShapeType::convex, ShapeType::convex, pairs.data(), n, o,
-                                                      kernels::simd::ResultView::of(got), fallback.data());
+                                                      detail::result_view(got), fallback.data());
   fallback.resize(left);
   std::sort(fallback.begin(), fallback.end());
   // Double never stalls above its floor here; float may hand back a stalled pair (redone in double elsewhere).

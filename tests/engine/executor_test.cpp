@@ -1,5 +1,7 @@
 // The batch executor: results in input order, bitwise identical for any thread count, per-pair statuses for bad
 // pairs, exceptions only for a malformed call, warm start.
+#include "instruction_set.hpp"  // engine/src: capped_instruction_set
+#include "shape_table_access.hpp"  // engine/src: ShapeTableAccess::one_type
 #include "kernels/simd/wide_gjk.hpp"
 #include "support/generators.hpp"
 #include "support/same_results.hpp"
@@ -90,7 +92,7 @@ TEST(Executor, BitwiseIdenticalForEveryInstructionSetThisCpuRuns) {
 // BATCHCOL_ISA lowers the automatic choice; a value naming no set is an input error. The environment is read
 // once per process (resolve_instruction_set), so the rule is tested on the function that applies it.
 TEST(Executor, EnvironmentVariableLowersTheInstructionSet) {
-  using kernels::simd::capped_instruction_set;
+  using detail::capped_instruction_set;
   const InstructionSet best = resolve_instruction_set();
   EXPECT_NE(best, InstructionSet::automatic);
   EXPECT_EQ(capped_instruction_set(best, std::getenv("BATCHCOL_ISA")), best);  // what the first call applied
@@ -254,7 +256,7 @@ TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
   }
 }
 
-// A table of one shape type takes the executor's shortcut (ShapeTable::one_type(): the types are not read per
+// A table of one shape type takes the executor's shortcut (ShapeTableAccess::one_type(): the types are not read per
 // pair); the same pairs in a table that also holds another type go through the per-pair grouping. Both must give
 // the same bits. Pairs with an invalid index (999, 2^31, 2^32 - 1) go to group 0 (sphere-sphere) in the mixed
 // table and to the table's own type pair in the one-type table, whose kernels (box SAT, batch-array GJK,
@@ -270,8 +272,8 @@ TEST(Executor, OneTypeTableGivesTheResultsOfTheGeneralGrouping) {
       mixed.add(shape);
     }
     mixed.add(type == ShapeType::sphere ? Shape::box(0.1, 0.1, 0.1) : Shape::sphere(0.1));  // index 5: never used
-    ASSERT_TRUE(one.one_type()) << to_string(type);
-    ASSERT_FALSE(mixed.one_type()) << to_string(type);
+    ASSERT_TRUE(detail::ShapeTableAccess::one_type(one)) << to_string(type);
+    ASSERT_FALSE(detail::ShapeTableAccess::one_type(mixed)) << to_string(type);
     PairBatch batch;
     const std::uint32_t invalid[] = {999, 0x80000000u, 0xffffffffu};
     for (std::size_t i = 0; i < 3000; ++i) {

@@ -1,5 +1,6 @@
 // Shape factories validate their sizes; AABBs are tight (they equal the extent formula along each world axis);
 // bounding radii contain the shape; hulls keep only their vertices, with consistent faces and adjacency.
+#include "shape_table_access.hpp"  // engine/src: the table's per-shape arrays
 #include "support/generators.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 
 namespace batchcol {
 namespace {
@@ -84,32 +86,66 @@ TEST(Shapes, TableStoresEachShapeOnceAndHullsAreShared) {
   EXPECT_EQ(table[a].hull.get(), table[b].hull.get());
 }
 
-TEST(Shapes, TableKeepsTypesAndBoundingRadiiInStep) {
-  ShapeTable table;
+// The per-shape arrays the kernels read (engine/src/shape_table_access.hpp) hold each shape's fields, in step with
+// the Shape records, and a convex shape's hull view covers its hull's arrays; a copy of the table stays valid after
+// the original is gone (the views point into the shared hulls, not into the table).
+TEST(Shapes, TableKeepsItsPerShapeArraysInStep) {
+  using Access = detail::ShapeTableAccess;
+  auto table = std::make_unique<ShapeTable>();
+  testing::Rng rng(5);
   const Shape shapes[] = {Shape::sphere(0.5), Shape::box(0.1, 0.2, 0.3).inflated(0.05), Shape::cylinder(0.2, 0.4),
-                          Shape::halfspace({0, 0, 1}, 0.0)};
-  for (const Shape& s : shapes) table.add(s);
-  ASSERT_EQ(table.types().size(), table.size());
-  ASSERT_EQ(table.bounding_radii().size(), table.size());
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    EXPECT_EQ(table.types()[i], shapes[i].type) << i;
-    EXPECT_EQ(table.bounding_radii()[i], shapes[i].bounding_radius()) << i;  // the same function: the same bits
+                          Shape::halfspace({0, 0, 1}, 0.0),
+                          Shape::convex(testing::random_hull_points(rng, 200, 0.05, 0.4)).inflated(0.01)};
+  for (const Shape& s : shapes) table->add(s);
+  const ShapeTable copy = *table;
+  table.reset();
+  ASSERT_EQ(Access::types(copy).size(), copy.size());
+  ASSERT_EQ(Access::bounding_radii(copy).size(), copy.size());
+  ASSERT_EQ(Access::inflations(copy).size(), copy.size());
+  ASSERT_EQ(Access::hulls(copy).size(), copy.size());
+  for (std::size_t i = 0; i < copy.size(); ++i) {
+    EXPECT_EQ(Access::types(copy)[i], shapes[i].type) << i;
+    EXPECT_EQ(Access::bounding_radii(copy)[i], shapes[i].bounding_radius()) << i;  // the same function, bits
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(Access::sizes(copy, k)[i], shapes[i].size[k]) << i;
+    EXPECT_EQ(Access::inflations(copy)[i], shapes[i].inflation) << i;
+    const ShapeView v = Access::view(copy, i);
+    EXPECT_EQ(v.type, shapes[i].type);
+    EXPECT_EQ(v.bounding_radius, Access::bounding_radii(copy)[i]);
+    EXPECT_EQ(v.hull != nullptr, shapes[i].type == ShapeType::convex) << i;
   }
-  EXPECT_DOUBLE_EQ(table.bounding_radii()[1], std::sqrt(0.01 + 0.04 + 0.09) + 0.05);
-  EXPECT_EQ(table.bounding_radii()[3], std::numeric_limits<double>::infinity());
+  EXPECT_DOUBLE_EQ(Access::bounding_radii(copy)[1], std::sqrt(0.01 + 0.04 + 0.09) + 0.05);
+  EXPECT_EQ(Access::bounding_radii(copy)[3], std::numeric_limits<double>::infinity());
+  const ConvexHull& hull = *copy[4].hull;
+  const HullView& h = Access::hulls(copy)[4];
+  ASSERT_EQ(h.vertex_count, hull.vertices.size());
+  ASSERT_EQ(h.face_count, hull.faces.size());
+  for (std::uint32_t v = 0; v < h.vertex_count; ++v)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(h.vertices[3 * v + k], hull.vertices[v][k]) << v;
+  for (std::uint32_t f = 0; f < h.face_count; ++f)
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(h.faces[3 * f + k], hull.faces[f][k]) << f;
+      ASSERT_EQ(h.face_normals[3 * f + k], hull.face_normals[f][k]) << f;
+    }
+  EXPECT_EQ(h.start_vertices, hull.start_vertices.data());
+  EXPECT_EQ(h.neighbor_block_offsets, hull.neighbor_block_offsets.data());
+  EXPECT_EQ(h.neighbor_block_xyz, hull.neighbor_block_xyz.data());
+  EXPECT_EQ(h.radius, hull.radius);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(h.centroid[k], hull.centroid[k]);
+  EXPECT_EQ(Access::hulls(copy)[0].vertices, nullptr);  // not convex: an empty view
 }
 
 TEST(Shapes, TableKnowsWhenItHoldsOneType) {
   ShapeTable table;
-  EXPECT_FALSE(table.one_type());  // empty: no type at all
+  const auto one_type = [&] { return detail::ShapeTableAccess::one_type(table); };
+  EXPECT_FALSE(one_type());  // empty: no type at all
   table.add(Shape::capsule(0.1, 0.2));
-  EXPECT_TRUE(table.one_type());
+  EXPECT_TRUE(one_type());
   table.add(Shape::capsule(0.3, 0.1).inflated(0.01));  // inflation does not change the type
-  EXPECT_TRUE(table.one_type());
+  EXPECT_TRUE(one_type());
   table.add(Shape::sphere(0.1));
-  EXPECT_FALSE(table.one_type());
+  EXPECT_FALSE(one_type());
   table.add(Shape::capsule(0.1, 0.2));
-  EXPECT_FALSE(table.one_type());  // once mixed, always mixed: shapes are never removed
+  EXPECT_FALSE(one_type());  // once mixed, always mixed: shapes are never removed
 }
 
 }  // namespace

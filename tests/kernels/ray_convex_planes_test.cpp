@@ -1,6 +1,7 @@
 // The hull clipping loop (kernels/rays/ray_convex_planes.*) compiled for each instruction set gives the baseline
 // build's bits: enter, exit, entry face and the parallel-outside flag, in double and float, on random hulls and on
 // a box-shaped hull whose axis-aligned faces meet axis-parallel rays (denominators exactly 0) and origins on planes.
+#include "shape_table_access.hpp"  // engine/src: hull_view, OwnedShapeView
 #include "support/generators.hpp"
 
 #include "kernels/rays/ray_polytopes.hpp"
@@ -23,7 +24,7 @@ template <class T> bool same(const kr::PlaneClip<T>& a, const kr::PlaneClip<T>& 
 }
 
 template <class T> void check_hull(const Shape& hull, Rng& rng, int rays, int& compared, int& entered, int& parallel) {
-  const kr::HullPlanes<T> p = kr::make_hull_planes<T>(*hull.hull);
+  const kr::HullPlanes<T> p = kr::make_hull_planes<T>(hull_view(*hull.hull));
   const double r = hull.bounding_radius();
   for (int i = 0; i < rays; ++i) {
     Eigen::Vector3d o = 2.0 * r * testing::random_unit_vector(rng);

@@ -2,6 +2,7 @@
 // for every ray, cast_rays gives the same bits whether a ray ran in a full register or alone (next to invalid
 // rays), and the answers agree with the general per-shape kernels (ray_local in the shape's frame), which the
 // sphere-tracing tests check against the shape definitions.
+#include "shape_table_access.hpp"  // engine/src: hull_view, OwnedShapeView
 #include "support/generators.hpp"
 
 #include "batchcol/rays.hpp"
@@ -30,8 +31,8 @@ struct World {
   void prepare() {
     for (std::size_t s = 0; s < table.size(); ++s) {
       const bool hull = table[s].type == ShapeType::convex;
-      planes_d.push_back(hull ? kr::make_hull_planes<double>(*table[s].hull) : kr::HullPlanes<double>{});
-      planes_f.push_back(hull ? kr::make_hull_planes<float>(*table[s].hull) : kr::HullPlanes<float>{});
+      planes_d.push_back(hull ? kr::make_hull_planes<double>(hull_view(*table[s].hull)) : kr::HullPlanes<double>{});
+      planes_f.push_back(hull ? kr::make_hull_planes<float>(hull_view(*table[s].hull)) : kr::HullPlanes<float>{});
     }
   }
 };
@@ -183,7 +184,8 @@ TEST(RayLanes, CastRaysIsTheSameAloneOrInARegisterAndMatchesTheGeneralKernels) {
       const Eigen::Matrix3d R = q.toRotationMatrix();
       const Eigen::Vector3d ol = R.transpose() * (b.rays.origin[i] - b.translation[i]);
       const Eigen::Vector3d dl = R.transpose() * b.rays.direction[i];
-      const kr::RayShape<double> rs = kr::make_ray_shape<double>(shape, &w.planes_d[b.shape[i]]);
+      const OwnedShapeView view(shape);
+      const kr::RayShape<double> rs = kr::make_ray_shape<double>(view.view, &w.planes_d[b.shape[i]]);
       const kr::LocalHit<double> h = kr::ray_local(rs, ol, dl, b.rays.t_max[i], kr::RayGjkSettings{1e-9, 64});
       const double scale = 1.0 + (b.rays.origin[i] - b.translation[i]).norm() / b.rays.direction[i].norm();
       if (h.hit != bool(full.hit[i])) {

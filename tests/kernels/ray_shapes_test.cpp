@@ -2,6 +2,7 @@
 // of each shape's signed distance (tests/support/ray_reference.hpp). Every type, with and without inflation; rays
 // from outside and inside, all directions, finite and infinite t_max. Exact kernels must agree to ~1e-9 m; the GJK
 // ray cast (inflated shapes) must return a lower bound of t whose point lies within the tolerance of the surface.
+#include "shape_table_access.hpp"  // engine/src: hull_view, OwnedShapeView
 #include "support/generators.hpp"
 #include "support/ray_reference.hpp"
 
@@ -53,9 +54,10 @@ struct Tally {
 Tally check_shape(const Shape& shape, int n, std::uint64_t seed, double tolerance = 1e-9) {
   Rng rng(seed);
   kr::HullPlanes<double> planes;
-  if (shape.type == ShapeType::convex) planes = kr::make_hull_planes<double>(*shape.hull);
-  const kr::RayShape<double> prepared = kr::make_ray_shape<double>(shape, &planes);
-  const bool gjk = kr::uses_ray_gjk(shape);
+  if (shape.type == ShapeType::convex) planes = kr::make_hull_planes<double>(hull_view(*shape.hull));
+  const OwnedShapeView view(shape);
+  const kr::RayShape<double> prepared = kr::make_ray_shape<double>(view.view, &planes);
+  const bool gjk = kr::uses_ray_gjk(view.view);
   kr::RayGjkSettings settings;
   settings.tolerance = tolerance;
   settings.max_iterations = 200;
@@ -152,7 +154,8 @@ TEST(RayShapesClosedForm, SphereBoxAndInsideConvention) {
   const kr::RayGjkSettings settings;
   kr::HullPlanes<double> none;
   const auto cast = [&](const Shape& s, Eigen::Vector3d o, Eigen::Vector3d d, double t_max) {
-    return kr::ray_local(kr::make_ray_shape<double>(s, &none), o, d, t_max, settings);
+    const OwnedShapeView view(s);
+    return kr::ray_local(kr::make_ray_shape<double>(view.view, &none), o, d, t_max, settings);
   };
   // A unit sphere from 5 m away along x with a direction of length 2: t is in units of |d|.
   kr::LocalHit<double> h = cast(Shape::sphere(1.0), {-5, 0, 0}, {2, 0, 0}, 10.0);
@@ -185,9 +188,11 @@ TEST(RayShapesClosedForm, FloatKernelsAgreeWithDouble) {
     const Shape s = testing::random_shape(rng, type, 0.3, 1.2);
     kr::HullPlanes<double> pd;
     kr::HullPlanes<float> pf;
-    if (type == ShapeType::convex) pd = kr::make_hull_planes<double>(*s.hull), pf = kr::make_hull_planes<float>(*s.hull);
-    const auto sd = kr::make_ray_shape<double>(s, &pd);
-    const auto sf = kr::make_ray_shape<float>(s, &pf);
+    if (type == ShapeType::convex)
+      pd = kr::make_hull_planes<double>(hull_view(*s.hull)), pf = kr::make_hull_planes<float>(hull_view(*s.hull));
+    const OwnedShapeView view(s);
+    const auto sd = kr::make_ray_shape<double>(view.view, &pd);
+    const auto sf = kr::make_ray_shape<float>(view.view, &pf);
     int agree = 0, total = 0;
     for (const Ray& r : random_rays(rng, 500, 1.0)) {
       const auto hd = kr::ray_local(sd, r.o, r.d, r.t_max, {});
@@ -225,8 +230,9 @@ TEST(RayHullWalk, MatchesClippingEveryPlaneAndSphereTracing) {
         if (i % 4 == 0 || j % 4 == 0 || k % 4 == 0) cube.push_back(Eigen::Vector3d(i, j, k) / 4.0 - Eigen::Vector3d(0.5, 0.5, 0.5));
   hulls.push_back(Shape::convex(cube));
   for (const Shape& hull : hulls) {
-    kr::HullPlanes<double> planes = kr::make_hull_planes<double>(*hull.hull);
-    planes.walk = kr::make_hull_walk<double>(*hull.hull);  // also below kHullWalkMinFaces (the cube has 12 faces)
+    kr::HullPlanes<double> planes = kr::make_hull_planes<double>(hull_view(*hull.hull));
+    // Also below kHullWalkMinFaces (the cube has 12 faces).
+    planes.walk = kr::make_hull_walk<double>(hull_view(*hull.hull));
     int hits = 0;
     for (const Ray& r : random_rays(rng, 3000, 1.0)) {
       bool ok = false;
@@ -245,8 +251,8 @@ TEST(RayHullWalk, MatchesClippingEveryPlaneAndSphereTracing) {
   // qhull keeps the cube's 8 corners and triangulates each square: 12 triangles, merged into 6 facets. The large hull
   // takes the walk in ray_local.
   EXPECT_EQ(hulls[2].hull->faces.size(), 12u);
-  EXPECT_EQ(kr::make_hull_walk<double>(*hulls[2].hull).planes(), 6u);
-  EXPECT_GT(kr::make_hull_planes<double>(*hulls[0].hull).walk.planes(), 0u);
+  EXPECT_EQ(kr::make_hull_walk<double>(hull_view(*hulls[2].hull)).planes(), 6u);
+  EXPECT_GT(kr::make_hull_planes<double>(hull_view(*hulls[0].hull)).walk.planes(), 0u);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // (tests/support/generators.cpp), and hill climbing on large hulls against a linear scan.
 #include "batchcol/errors.hpp"
 #include "kernels/support.hpp"
+#include "shape_table_access.hpp"  // engine/src: OwnedShapeView
 #include "support/generators.hpp"
 
 #include <gtest/gtest.h>
@@ -20,7 +21,8 @@ TEST(Support, EveryCoreReachesItsExtent) {
   for (ShapeType t : batchcol::testing::bounded_shape_types())
     for (int trial = 0; trial < 200; ++trial) {
       const Shape s = batchcol::testing::random_shape(rng, t);
-      const ShapeCore<double> core = make_core<double>(s);
+      const OwnedShapeView view(s);
+      const ShapeCore<double> core = make_core<double>(view.view);
       Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
       if (trial % 10 == 0) d = Eigen::Vector3d::Unit(trial % 3);  // axis directions hit the tie branches
       SupportHint hint;
@@ -35,7 +37,8 @@ TEST(Support, HillClimbingOnLargeHullsEqualsALinearScan) {
   for (int n : {40, 250, 940, 3000}) {
     const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
     ASSERT_GE(s.hull->vertices.size(), kHillClimbMinVertices);
-    const ShapeCore<double> core = make_core<double>(s);
+    const OwnedShapeView view(s);
+      const ShapeCore<double> core = make_core<double>(view.view);
     SupportHint hint;  // kept across queries, as inside one GJK run
     for (int q = 0; q < 2000; ++q) {
       const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
@@ -53,7 +56,8 @@ TEST(Support, ClimbsFromTheDirectionTableEqualALinearScan) {
   for (int n : {40, 250, 940}) {
     const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
     ASSERT_EQ(s.hull->start_vertices.size(), kHullStartCells);
-    const ShapeCore<double> core = make_core<double>(s);
+    const OwnedShapeView view(s);
+      const ShapeCore<double> core = make_core<double>(view.view);
     for (int q = 0; q < 3000; ++q) {
       Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
       if (q % 7 == 0) d = Eigen::Vector3d::Unit(q % 3) * (q % 2 ? -1.0 : 1.0);
@@ -85,7 +89,8 @@ TEST(Support, HandBuiltHullsGetTheirSearchStructures) {
   EXPECT_EQ(rebuilt.hull->neighbor_block_xyz, full.hull->neighbor_block_xyz);
   EXPECT_EQ(rebuilt.hull->start_vertices, full.hull->start_vertices);
   EXPECT_EQ(Shape::convex(full.hull).hull, full.hull);  // a complete hull is shared, not copied
-  const ShapeCore<double> a = make_core<double>(full), b = make_core<double>(rebuilt);
+  const OwnedShapeView full_view(full), rebuilt_view(rebuilt);
+  const ShapeCore<double> a = make_core<double>(full_view.view), b = make_core<double>(rebuilt_view.view);
   for (int q = 0; q < 500; ++q) {
     const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
     SupportHint ha, hb;
@@ -129,8 +134,9 @@ TEST(Support, FloatCoresStayWithinFloatRounding) {
       const Shape s = batchcol::testing::random_shape(rng, t);
       const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
       SupportHint h1, h2;
-      const Eigen::Vector3d pd = support(make_core<double>(s), d, h1);
-      const Eigen::Vector3f pf = support(make_core<float>(s), Eigen::Vector3f(d.cast<float>()), h2);
+      const OwnedShapeView view(s);
+      const Eigen::Vector3d pd = support(make_core<double>(view.view), d, h1);
+      const Eigen::Vector3f pf = support(make_core<float>(view.view), Eigen::Vector3f(d.cast<float>()), h2);
       EXPECT_NEAR(pf.cast<double>().dot(d), pd.dot(d), 1e-6) << to_string(t);
     }
 }

@@ -4,6 +4,7 @@
 #include "kernels/closed_forms.hpp"
 #include "kernels/segment_pairs_world.hpp"
 #include "kernels/simd/wide_gjk.hpp"
+#include "shape_table_access.hpp"  // engine/src: OwnedShapeView
 #include "support/generators.hpp"
 #include "support/same_results.hpp"
 
@@ -82,9 +83,10 @@ TEST(WideClosedForms, SphereCapsuleLanesEqualTheScalarClosedForm) {
         ++invalid;
         continue;
       }
-      if (!kernels::is_segment_shape(b.shapes[ia]) || !kernels::is_segment_shape(b.shapes[ib])) continue;
-      const kernels::WorldSegment A = kernels::world_segment(b.shapes[ia], qa.normalized(), ta);
-      const kernels::WorldSegment B = kernels::world_segment(b.shapes[ib], qb.normalized(), tb);
+      if (!kernels::is_segment_shape(b.shapes[ia].type) || !kernels::is_segment_shape(b.shapes[ib].type)) continue;
+      const OwnedShapeView va(b.shapes[ia]), vb(b.shapes[ib]);
+      const kernels::WorldSegment A = kernels::world_segment(va.view, qa.normalized(), ta);
+      const kernels::WorldSegment B = kernels::world_segment(vb.view, qb.normalized(), tb);
       const kernels::PairOutput<double> ref =
           kernels::segments_with_radii<double>(A.p0, A.p1, B.p0, B.p1, A.radius, B.radius, tb - ta);
       ASSERT_EQ(r.status[i], Status::converged) << "pair " << i;

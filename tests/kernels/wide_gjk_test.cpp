@@ -1,7 +1,9 @@
 // The SIMD GJK against the scalar reference, lane by lane: for every shape-pair type, solver, precision, query
 // kind (distance or boolean) and every instruction set this CPU runs, each pair's GjkResult must be bitwise the
 // reference gjk()'s (status, iterations, simplex, x, lower bound, direction).
+#include "kernel_views.hpp"  // engine/src: pair_view, result_view
 #include "kernels/simd/wide_gjk.hpp"
+#include "shape_table_access.hpp"  // engine/src: OwnedShapeView
 #include "support/generators.hpp"
 #include "support/reference_gjk.hpp"
 #include "support/same_results.hpp"
@@ -10,6 +12,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <stdexcept>
 #include <string>
 
@@ -50,15 +53,15 @@ std::string compare(const kernels::GjkResult<T>& want, const kernels::GjkResult<
 /// Pairs of types (ta, tb): B around A at centre distances from overlapping to ~0.5 m, random rotations.
 template <class T>
 std::vector<kernels::PairSetup<T>> make_setups(Rng& rng, ShapeType ta, ShapeType tb, int count,
-                                               const QueryOptions& options, std::vector<Shape>& keep) {
+                                               const QueryOptions& options, std::deque<OwnedShapeView>& keep) {
   std::vector<kernels::PairSetup<T>> setups;
   for (int i = 0; setups.size() < std::size_t(count) && i < 20 * count; ++i) {
-    keep.push_back(ta == ShapeType::convex && i % 3 == 0
-                       ? Shape::convex(testing::random_hull_points(rng, 120, 0.05, 0.3))  // hill climbing
-                       : testing::random_shape(rng, ta));
-    const Shape& a = keep.back();
-    keep.push_back(testing::random_shape(rng, tb));
-    const Shape& b = keep.back();
+    keep.emplace_back(ta == ShapeType::convex && i % 3 == 0
+                          ? Shape::convex(testing::random_hull_points(rng, 120, 0.05, 0.3))  // hill climbing
+                          : testing::random_shape(rng, ta));
+    const ShapeView& a = keep.back().view;
+    keep.emplace_back(testing::random_shape(rng, tb));
+    const ShapeView& b = keep.back().view;
     kernels::RelativePose X;
     X.R = testing::random_rotation(rng).toRotationMatrix();
     X.t = testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.9);
@@ -81,8 +84,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   int compared = 0, spread = 0;
   for (const ShapeType ta : testing::bounded_shape_types()) {
     for (const ShapeType tb : testing::bounded_shape_types()) {
-      std::vector<Shape> keep;
-      keep.reserve(4000);
+      std::deque<OwnedShapeView> keep;  // the setups' cores point into it: a deque never moves its elements
       const auto setups = make_setups<T>(rng, ta, tb, 37, options, keep);
       if (setups.empty()) continue;  // closed forms only (sphere / capsule pairs, sphere-box)
       std::vector<kernels::GjkResult<T>> want;
@@ -131,8 +133,7 @@ TEST(WideGjk, EqualsReferenceBitwiseFloat) {
 TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   Rng rng(77);
   QueryOptions options;  // solver automatic: setup_pair resolves it into the parameters
-  std::vector<Shape> keep;
-  keep.reserve(400);  // make_setups keeps references into it: no reallocation
+  std::deque<OwnedShapeView> keep;  // the setups' cores point into it: a deque never moves its elements
   const auto setups = make_setups<double>(rng, ShapeType::cylinder, ShapeType::box, 8, options, keep);
   ASSERT_FALSE(setups.empty());
   for (const auto& s : setups) EXPECT_EQ(s.params.solver, Solver::gjk);  // witness level: gjk
@@ -149,9 +150,9 @@ TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   results.resize(1);
   const std::uint32_t pair = 0;
   std::uint32_t fallback = 0;
-  EXPECT_THROW(kernels::simd::gjk_pairs<double>(InstructionSet::scalar, kernels::simd::PairView::of(table, batch),
+  EXPECT_THROW(kernels::simd::gjk_pairs<double>(InstructionSet::scalar, detail::pair_view(table, batch),
                                                 ShapeType::cylinder, ShapeType::cylinder, &pair, 1, options,
-                                                kernels::simd::ResultView::of(results), &fallback),
+                                                detail::result_view(results), &fallback),
                InputError);
 }
 

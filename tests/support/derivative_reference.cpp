@@ -2,6 +2,7 @@
 
 #include "kernels/shape_core.hpp"
 #include "kernels/support.hpp"
+#include "shape_table_access.hpp"  // engine/src: OwnedShapeView, ShapeTableAccess
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,8 @@ namespace batchcol::testing {
 namespace {
 
 Eigen::Vector3d world_support(const Shape& shape, const Pose& pose, const Eigen::Vector3d& u) {
-  const auto core = kernels::make_core<double>(shape);
+  const OwnedShapeView view(shape);
+  const auto core = kernels::make_core<double>(view.view);
   kernels::SupportHint hint;
   const Eigen::Matrix3d R = pose.rotation.toRotationMatrix();
   const Eigen::Vector3d d = R.transpose() * u;
@@ -114,10 +116,11 @@ PairResults exact_witness(const ShapeTable& shapes, const PairBatch& batch) {
 }
 
 FiniteDifferences finite_differences(const ShapeTable& shapes, const PairBatch& batch, const std::vector<double>& h) {
+  const std::vector<double>& radii = detail::ShapeTableAccess::bounding_radii(shapes);
   const std::size_t n = batch.size();
   PairBatch perturbed;
   for (std::size_t i = 0; i < n; ++i) {
-    const double scale = shapes.bounding_radii()[batch.shape_a[i]] + shapes.bounding_radii()[batch.shape_b[i]];
+    const double scale = radii[batch.shape_a[i]] + radii[batch.shape_b[i]];
     for (int body = 0; body < 2; ++body)
       for (int k = 0; k < 6; ++k)
         for (int sign = -1; sign <= 1; sign += 2) {
@@ -134,7 +137,7 @@ FiniteDifferences finite_differences(const ShapeTable& shapes, const PairBatch& 
   for (auto* m : {&fd.witness_a_a, &fd.witness_a_b, &fd.witness_b_a, &fd.witness_b_b, &fd.normal_a, &fd.normal_b})
     m->resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double scale = shapes.bounding_radii()[batch.shape_a[i]] + shapes.bounding_radii()[batch.shape_b[i]];
+    const double scale = radii[batch.shape_a[i]] + radii[batch.shape_b[i]];
     for (int body = 0; body < 2; ++body)
       for (int k = 0; k < 6; ++k) {
         const std::size_t minus = 24 * i + 12 * body + 2 * k, plus = minus + 1;
@@ -153,6 +156,7 @@ FiniteDifferences finite_differences(const ShapeTable& shapes, const PairBatch& 
 }
 
 PairBatch random_separated_pairs(Rng& rng, ShapeTable& shapes, const std::vector<ShapeType>& types, int count) {
+  const std::vector<double>& radii = detail::ShapeTableAccess::bounding_radii(shapes);  // grows with the table
   PairBatch batch;
   while (static_cast<int>(batch.size()) < count) {
     PairBatch trial;
@@ -162,7 +166,7 @@ PairBatch random_separated_pairs(Rng& rng, ShapeTable& shapes, const std::vector
       Shape sa = random_shape(rng, ta, 0.05, 0.4), sb = random_shape(rng, tb, 0.05, 0.4);
       if (uniform(rng, 0, 1) < 0.25) sa = sa.inflated(uniform(rng, 0.01, 0.05));
       const std::uint32_t a = shapes.add(sa), b = shapes.add(sb);
-      const double sum = shapes.bounding_radii()[a] + shapes.bounding_radii()[b];
+      const double sum = radii[a] + radii[b];
       const Pose pa{random_unit_vector(rng) * uniform(rng, 0.0, 1.0), random_rotation(rng)};
       const Pose pb{pa.translation + random_unit_vector(rng) * sum * uniform(rng, 0.8, 2.0), random_rotation(rng)};
       trial.add(a, pa, b, pb);
@@ -170,7 +174,7 @@ PairBatch random_separated_pairs(Rng& rng, ShapeTable& shapes, const std::vector
     PairResults r;
     collide(shapes, trial, tight_query(), r);
     for (std::size_t i = 0; i < trial.size() && static_cast<int>(batch.size()) < count; ++i) {
-      const double sum = shapes.bounding_radii()[trial.shape_a[i]] + shapes.bounding_radii()[trial.shape_b[i]];
+      const double sum = radii[trial.shape_a[i]] + radii[trial.shape_b[i]];
       if (r.status[i] == Status::converged && r.distance[i] > 0.02 * sum)
         batch.add(trial.shape_a[i], trial.pose_a(i), trial.shape_b[i], trial.pose_b(i));
     }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "batchcol/export.hpp"
+#include "batchcol/types.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -12,9 +13,7 @@
 
 namespace batchcol {
 
-/// Quaternions and rotation matrices within this of unit norm / orthonormality are normalised; beyond it they are
-/// rejected as input errors (a typo, not rounding).
-constexpr double kUnitTolerance = 1e-6;
+// kUnitTolerance (how far from unit norm a quaternion may be): batchcol/types.hpp.
 
 /// True when q is finite and | |q| - 1 | <= kUnitTolerance.
 BATCHCOL_API bool is_unit_quaternion(const Eigen::Quaterniond& q);

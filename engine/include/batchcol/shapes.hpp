@@ -9,6 +9,7 @@
 #include "batchcol/export.hpp"
 
 #include "batchcol/errors.hpp"
+#include "batchcol/types.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -22,30 +23,10 @@
 
 namespace batchcol {
 
-/// Input limits (README "Input limits"), chosen so that no product of four lengths, the highest power the kernels
-/// form (|x|^2 of a cross product, squared norms of products), overflows or underflows: in double every shape
-/// length (radius, half length, half extent, convex or triangle coordinate, inflation, halfspace offset) is at most
-/// kMaxLength and every size at least kMinLength, and pose translations are at most kMaxLength per component
-/// (beyond it a pair is Status::invalid_input). Measured: uniformly scaled problems are answered right from 1e-70
-/// to 1e70 in double and fail from 1e+-80; the limits keep 20 orders of magnitude of room for mixed scales.
-constexpr double kMaxLength = 1e50;
-constexpr double kMinLength = 1e-50;
-/// Precision::float32 computes in float: sizes and bounding radii of every shape of the table within
-/// [kMinLengthFloat, kMaxLengthFloat] (else collide() throws InputError), and the translation between the two
-/// shapes of a pair at most kMaxLengthFloat per component (else the pair is Status::invalid_input). Measured:
-/// right from 1e-9 to 1e9, wrong from 1e+-10 (float overflows at 3.4e38 = (4.3e9)^4); 3 orders of room.
-constexpr double kMaxLengthFloat = 1e6;
-constexpr double kMinLengthFloat = 1e-6;
-
-enum class ShapeType : std::uint8_t { sphere, capsule, box, cylinder, cone, ellipsoid, convex, triangle, halfspace };
-constexpr int kShapeTypeCount = 9;
+// The input limits (kMaxLength, kMinLength, their float32 versions), ShapeType and the hull constants are plain
+// types shared with the kernels: batchcol/types.hpp.
 
 BATCHCOL_API const char* to_string(ShapeType type);
-
-/// Cells per cube-face side of ConvexHull::start_vertices (kernels/support.hpp, start_cell).
-constexpr std::uint32_t kHullStartGrid = 16;
-constexpr std::uint32_t kHullStartCells = 6 * kHullStartGrid * kHullStartGrid;
-constexpr std::uint32_t kNoHullVertex = 0xffffffffu;
 
 /// A convex polytope computed by qhull: only the hull vertices are kept, with triangulated faces (outward normals)
 /// and vertex adjacency (compressed rows) for hill-climbing support queries on large hulls.
@@ -65,7 +46,7 @@ struct ConvexHull {
   /// blocks are [neighbor_block_offsets[v], neighbor_block_offsets[v + 1]); block b's indices are
   /// neighbor_block_index[kNeighborBlock b ...] and its coordinates neighbor_block_xyz[3 kNeighborBlock b ...]
   /// (x of each, then y, then z). A short last block repeats the vertex's first neighbour.
-  static constexpr std::uint32_t kNeighborBlock = 4;
+  static constexpr std::uint32_t kNeighborBlock = kHullNeighborBlock;
   std::vector<std::uint32_t> neighbor_block_offsets;
   std::vector<std::uint32_t> neighbor_block_index;
   std::vector<double> neighbor_block_xyz;
@@ -118,6 +99,10 @@ struct Aabb {
 /// Tight world AABB of `shape` under the pose (rotation, translation); infinite extents for halfspaces.
 BATCHCOL_API Aabb compute_aabb(const Shape& shape, const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
 
+namespace detail {
+struct ShapeTableAccess;  // engine/src/shape_table_access.hpp: what the executor and the kernels read of a table
+}
+
 /// Stores each shape once; pairs refer to shapes by index, so many instances of one mesh cost one mesh.
 class BATCHCOL_API ShapeTable {
  public:
@@ -125,22 +110,19 @@ class BATCHCOL_API ShapeTable {
   std::size_t size() const { return shapes_.size(); }
   const Shape& operator[](std::size_t i) const { return shapes_[i]; }
   const std::vector<Shape>& shapes() const { return shapes_; }
-  /// Per shape, kept at add() (shapes never change afterwards): its type, and its bounding_radius(). The executor
-  /// reads these contiguous arrays per pair instead of the Shape records.
-  const std::vector<ShapeType>& types() const { return types_; }
-  const std::vector<double>& bounding_radii() const { return bounding_radii_; }
-  /// True when the table is not empty and all its shapes have one type: every valid pair is then of one type pair,
-  /// and the executor skips reading the two types of each pair.
-  bool one_type() const { return !shapes_.empty() && !mixed_; }
-  /// The smallest smallest_size() and the largest finite bounding_radius() of the table's shapes (the float32
-  /// limits apply to them); +inf and 0 for an empty table.
-  double smallest_size() const { return smallest_size_; }
-  double largest_radius() const { return largest_radius_; }
 
  private:
+  friend struct detail::ShapeTableAccess;
   std::vector<Shape> shapes_;
+  // Per shape, kept at add() (shapes never change afterwards), in structure-of-arrays form: what the executor and
+  // the batch kernels read per pair instead of the Shape records (one array per field: a lane gathers from one
+  // contiguous array, and no kernel depends on Shape's layout). Hull views point into the shapes' hulls, which the
+  // table shares (shared_ptr), so copies of the table stay valid.
   std::vector<ShapeType> types_;
   std::vector<double> bounding_radii_;
+  std::vector<double> size_[3];
+  std::vector<double> inflation_;
+  std::vector<HullView> hulls_;  // zeros for shapes other than convex
   bool mixed_ = false;
   double smallest_size_ = std::numeric_limits<double>::infinity(), largest_radius_ = 0.0;
 };

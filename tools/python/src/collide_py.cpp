@@ -25,7 +25,7 @@ std::string pose_text(const double* v, int n) {
   return s.str() + "]";
 }
 
-/// Why pair i was rejected, with the engine's rules (pose.hpp: kUnitTolerance), naming the argument.
+/// Why pair i was rejected, with the engine's rules (types.hpp: kUnitTolerance), naming the argument.
 std::string invalid_reason(const ShapeTable& shapes, const PairBatchView& b, std::size_t i) {
   const std::string at = "[" + std::to_string(i) + "]";
   const ConstSpan<std::uint32_t>* index[2] = {&b.shape_a, &b.shape_b};
