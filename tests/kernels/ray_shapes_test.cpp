@@ -267,7 +267,7 @@ namespace {
 TEST(RayHullWalk, StartingAtTheBallEntryGivesTheSameBits) {
   Rng rng(77);
   const Shape hull = Shape::convex(testing::random_hull_points(rng, 250, 0.5, 0.5));
-  const kr::HullPlanes<double> planes = kr::make_hull_planes<double>(*hull.hull);
+  const kr::HullPlanes<double> planes = kr::make_hull_planes<double>(hull_view(*hull.hull));
   ASSERT_GT(planes.walk.planes(), 0u);
   const double bound = hull.bounding_radius() * (1 + 64 * kernels::machine_epsilon<double>());
   int from_ball = 0, restarted = 0, hits = 0;
