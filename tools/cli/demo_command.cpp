@@ -1,6 +1,6 @@
 // `batchcol demo`: runs the embedded scene and prints a throughput summary (one warm-up, median of 5 timed runs).
 #include "cli/commands.hpp"
-#include "cli/demo_scene.hpp"
+#include "testkit/demo_scene.hpp"
 
 #include <batchcol/batch.hpp>
 #include <batchcol/io.hpp>
@@ -18,6 +18,9 @@
 
 namespace batchcol::cli {
 namespace {
+
+using testkit::DemoScene;
+using testkit::make_demo_scene;
 
 struct DemoSettings {
   std::size_t pairs = 200000;

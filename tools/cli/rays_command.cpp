@@ -4,8 +4,8 @@
 // (sphere, box, capsule, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
 #include "cli/atomic_output.hpp"
 #include "cli/commands.hpp"
-#include "cli/portable_random.hpp"
-#include "cli/rays_scene.hpp"
+#include "testkit/portable_random.hpp"
+#include "testkit/rays_scene.hpp"
 
 #include "peers/embree_rays.hpp"
 
@@ -25,6 +25,13 @@
 
 namespace batchcol::cli {
 namespace {
+
+using testkit::make_crossing_rays;
+using testkit::make_rays_scene;
+using testkit::move_objects;
+using testkit::PortableRandom;
+using testkit::RaysScene;
+using testkit::RaysSceneSpec;
 
 struct RaysSettings {
   RaysSceneSpec scene;

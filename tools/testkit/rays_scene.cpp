@@ -1,10 +1,10 @@
-#include "cli/rays_scene.hpp"
+#include "testkit/rays_scene.hpp"
 
-#include "cli/portable_random.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <cmath>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 RaysScene make_rays_scene(const RaysSceneSpec& spec) {
   PortableRandom rng(spec.seed);
@@ -63,4 +63,4 @@ void move_objects(RaysScene& s, double step, std::uint64_t seed) {
   }
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

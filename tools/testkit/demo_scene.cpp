@@ -1,12 +1,12 @@
-#include "cli/demo_scene.hpp"
-#include "cli/portable_random.hpp"
+#include "testkit/demo_scene.hpp"
+#include "testkit/portable_random.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 namespace {
 
 using Random = PortableRandom;
@@ -106,4 +106,4 @@ DemoScene make_demo_scene(std::size_t pair_count, std::uint64_t seed) {
   return scene;
 }
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 struct DemoScene {
   ShapeTable shapes;
@@ -18,4 +18,4 @@ struct DemoScene {
 
 DemoScene make_demo_scene(std::size_t pair_count, std::uint64_t seed = 20240601);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace batchcol::cli {
+namespace batchcol::testkit {
 
 struct RaysSceneSpec {
   std::int64_t objects = 10000;
@@ -34,4 +34,4 @@ RayBatch make_crossing_rays(std::int64_t n, double half_extent, std::uint64_t se
 /// Moves every object by up to `step` metres and a small rotation (the refit benchmark's frame).
 void move_objects(RaysScene& s, double step, std::uint64_t seed);
 
-}  // namespace batchcol::cli
+}  // namespace batchcol::testkit
