@@ -8,46 +8,121 @@
 namespace batchcol::detail {
 namespace {
 
+PairJacobians constrained_jacobians(const PairGeometry& g);
+
 void set_nan(PairJacobians& J) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (Mat36* m : {&J.witness_a_a, &J.witness_a_b, &J.witness_b_a, &J.witness_b_b, &J.normal_a, &J.normal_b})
     m->setConstant(nan);
 }
 
-// Separated pairs without flats (the smooth common case, every ellipsoid pair): sd I + H_a + H_b >= sd I is
-// symmetric positive definite, so K is its explicit 3x3 inverse (cofactors over the determinant, which is
-// >= sd^3 > 0) and everything stays in fixed-size matrices; the general path below sizes its saddle-point system
-// at run time, which cost more than the rest of the pair together. Same formulas as that path with k = 0.
-void smooth_jacobians(const PairGeometry& g, const Eigen::Matrix3d& M0, PairJacobians& J) {
-  const Eigen::Matrix3d K = M0.inverse();
-  const Eigen::Vector3d& n = g.normal;
-  const Eigen::Matrix3d n_x = skew(n);
-  const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
-  // F_a = [I, -[x_a]x + H_a [n]x], F_b = [-I, [x_b]x + H_b [n]x]; y = K F.
-  const Eigen::Matrix3d Fa_w = g.H_a * n_x - skew(g.witness_a), Fb_w = g.H_b * n_x + skew(g.witness_b);
-  const Eigen::Matrix3d HaK = g.H_a * K, HbK = g.H_b * K, TK = tangent * K;
-  // Twist of a: y = [K, K Fa_w].
-  J.witness_a_a << Eigen::Matrix3d::Identity() - HaK, Fa_w - HaK * Fa_w;
-  J.witness_b_a << HbK, HbK * Fa_w;
-  J.normal_a << -TK, -TK * Fa_w;
-  // Twist of b: y = [-K, K Fb_w].
-  J.witness_a_b << HaK, -HaK * Fb_w;
-  J.witness_b_b << Eigen::Matrix3d::Identity() - HbK, HbK * Fb_w - Fb_w;
-  J.normal_b << TK, -TK * Fb_w;
+// Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
+// symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
+// Written out in scalars straight into the output slot: Eigen's fixed-size products with their temporaries, a
+// PairJacobians copy and twelve 3x3 products cost ~1150 instructions per pair. Only the twist of a is solved,
+// y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
+//   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
+//   I - sd K),   dn/dxi_a = -(I - n n^T) y;
+// the twist of b follows from the rigid-motion identity (J_a + J_b = [I, -[x]x] for a point, [0, -[n]x] for the
+// normal), which the formulas of the header satisfy exactly when z = sd n (GJK's witness points to rounding).
+void smooth_jacobians(const PairGeometry& g, double* s, std::size_t st) {
+  const double sd = g.distance;
+  const double n[3] = {g.normal.x(), g.normal.y(), g.normal.z()};
+  const double xa[3] = {g.witness_a.x(), g.witness_a.y(), g.witness_a.z()};
+  const double xb[3] = {g.witness_b.x(), g.witness_b.y(), g.witness_b.z()};
+  const Eigen::Matrix3d& Ha = g.H_a;
+  const Eigen::Matrix3d& Hb = g.H_b;
+  // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
+  const double m00 = sd + Ha(0, 0) + Hb(0, 0), m11 = sd + Ha(1, 1) + Hb(1, 1), m22 = sd + Ha(2, 2) + Hb(2, 2);
+  const double m01 = Ha(0, 1) + Hb(0, 1), m02 = Ha(0, 2) + Hb(0, 2), m12 = Ha(1, 2) + Hb(1, 2);
+  const double c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
+  const double c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
+  const double inv = 1.0 / (m00 * c00 + m01 * c01 + m02 * c02);
+  const double K[3][3] = {{c00 * inv, c01 * inv, c02 * inv}, {c01 * inv, c11 * inv, c12 * inv},
+                          {c02 * inv, c12 * inv, c22 * inv}};
+  // Fa_w: row i of H_a [n]x is (row i of H_a) x n; minus [x_a]x.
+  double F[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const double h0 = Ha(i, 0), h1 = Ha(i, 1), h2 = Ha(i, 2);
+    F[i][0] = h1 * n[2] - h2 * n[1];
+    F[i][1] = h2 * n[0] - h0 * n[2];
+    F[i][2] = h0 * n[1] - h1 * n[0];
+  }
+  F[0][1] += xa[2], F[0][2] -= xa[1], F[1][0] -= xa[2], F[1][2] += xa[0], F[2][0] += xa[1], F[2][1] -= xa[0];
+  double Y[3][6];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Y[i][j] = K[i][j];
+      Y[i][3 + j] = K[i][0] * F[0][j] + K[i][1] * F[1][j] + K[i][2] * F[2][j];
+    }
+  double nY[6];
+  for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
+  s[0] = -n[0], s[st] = -n[1], s[2 * st] = -n[2];
+  s[3 * st] = n[1] * xa[2] - n[2] * xa[1];
+  s[4 * st] = n[2] * xa[0] - n[0] * xa[2];
+  s[5 * st] = n[0] * xa[1] - n[1] * xa[0];
+  s[6 * st] = n[0], s[7 * st] = n[1], s[8 * st] = n[2];
+  s[9 * st] = xb[1] * n[2] - xb[2] * n[1];
+  s[10 * st] = xb[2] * n[0] - xb[0] * n[2];
+  s[11 * st] = xb[0] * n[1] - xb[1] * n[0];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const std::size_t e = 6 * i + j;
+      const double wb = Hb(i, 0) * Y[0][j] + Hb(i, 1) * Y[1][j] + Hb(i, 2) * Y[2][j];
+      const double wa = wb + sd * Y[i][j];
+      const double dn = n[i] * nY[j] - Y[i][j];
+      s[(12 + e) * st] = wa;   // witness_a_a
+      s[(30 + e) * st] = -wa;  // witness_a_b, plus x_a's rigid motion below
+      s[(48 + e) * st] = wb;   // witness_b_a
+      s[(66 + e) * st] = -wb;  // witness_b_b, plus x_b's
+      s[(84 + e) * st] = dn;   // normal_a
+      s[(102 + e) * st] = -dn; // normal_b, plus the normal's
+    }
+  // The rigid motions [I, -[x]x] of x_a (block 30), x_b (66) and [0, -[n]x] of the normal (102): -[x]x has x_2 at
+  // (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+  const auto add_rigid = [&](std::size_t block, const double* x, bool point) {
+    if (point)
+      for (std::size_t i = 0; i < 3; ++i) s[(block + 7 * i) * st] += 1.0;
+    s[(block + 4) * st] += x[2], s[(block + 5) * st] -= x[1], s[(block + 9) * st] -= x[2];
+    s[(block + 11) * st] += x[0], s[(block + 15) * st] += x[1], s[(block + 16) * st] -= x[0];
+  };
+  add_rigid(30, xa, true);
+  add_rigid(66, xb, true);
+  add_rigid(102, n, false);
 }
 
 }  // namespace
 
-PairJacobians implicit_jacobians(const PairGeometry& g) {
+void write_jacobians(const PairJacobians& J, double* s, std::size_t stride) {
+  for (int k = 0; k < 6; ++k) {
+    s[k * stride] = J.distance_a(k);
+    s[(6 + k) * stride] = J.distance_b(k);
+  }
+  std::size_t e = 12;
+  for (const Mat36* m : {&J.witness_a_a, &J.witness_a_b, &J.witness_b_a, &J.witness_b_b, &J.normal_a, &J.normal_b})
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 6; ++c) s[(e++) * stride] = (*m)(r, c);
+}
+
+IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride) {
+  if (g.flats_a + g.flats_b == 0 && g.distance > 1e-9 * g.scale) {
+    smooth_jacobians(g, slot, stride);
+    return {};
+  }
+  const PairJacobians J = constrained_jacobians(g);
+  write_jacobians(J, slot, stride);
+  return {J.singular, J.dependent};
+}
+
+namespace {
+
+// The general case: flats, touching or penetrating pairs.
+PairJacobians constrained_jacobians(const PairGeometry& g) {
   PairJacobians J;
   distance_gradients(g, J.distance_a, J.distance_b);
   const Eigen::Vector3d& n = g.normal;
   const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
   const Eigen::Matrix3d M0 = g.distance * Eigen::Matrix3d::Identity() + g.H_a + g.H_b;
-  if (k == 0 && g.distance > 1e-9 * g.scale) {
-    smooth_jacobians(g, M0, J);
-    return J;
-  }
   if (k > 3) {  // four flat directions in 3-D are dependent
     J.dependent = true;
     set_nan(J);
@@ -141,4 +216,5 @@ PairJacobians implicit_jacobians(const PairGeometry& g) {
   return J;
 }
 
+}  // namespace
 }  // namespace batchcol::detail

@@ -28,6 +28,8 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
+
 namespace batchcol::detail {
 
 using Mat36 = Eigen::Matrix<double, 3, 6>;
@@ -69,9 +71,19 @@ inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b
   grad_b << g.normal.transpose(), g.witness_b.cross(g.normal).transpose();
 }
 
-/// Everything above for one pair; `singular` (Jacobians left NaN) when the system (its constraint rows scaled to
-/// lengths) has an eigenvalue within 1e-9 of the problem's length scale: its inverse would magnify the witness
-/// points' own error (~1e-8 of that scale at the default GJK tolerance) beyond any meaning.
-PairJacobians implicit_jacobians(const PairGeometry& g);
+/// Writes J's 120 entries to `slot` (entry e at slot[e * stride], in StoreBlock's order: the distance gradients
+/// of a and b, then witness_a_a, witness_a_b, witness_b_a, witness_b_b, normal_a, normal_b, row-major).
+void write_jacobians(const PairJacobians& J, double* slot, std::size_t stride);
+
+struct IftFlags {
+  bool singular = false;   // see PairJacobians
+  bool dependent = false;
+};
+
+/// Everything above for one pair, written to `slot` as by write_jacobians(); `singular` (Jacobians left NaN) when
+/// the system (its constraint rows scaled to lengths) has an eigenvalue within 1e-9 of the problem's length scale:
+/// its inverse would magnify the witness points' own error (~1e-8 of that scale at the default GJK tolerance)
+/// beyond any meaning.
+IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride);
 
 }  // namespace batchcol::detail
