@@ -16,15 +16,50 @@ void set_nan(PairJacobians& J) {
     m->setConstant(nan);
 }
 
+// Writes a pair's 120 entries from the derivatives with respect to the twist of a (wa = dx_a/dxi_a, wb =
+// dx_b/dxi_a, dn = dn/dxi_a): the distance gradients by the envelope theorem and the twist of b by the rigid-motion
+// identity J_a + J_b = [I, -[x]x] (points), [0, -[n]x] (normal), which the implicit-function formulas satisfy
+// exactly when z = sd n (GJK's witness points, to rounding): half the products of solving for b as well.
+void write_from_twist_a(const double n[3], const double xa[3], const double xb[3], const double wa[3][6],
+                        const double wb[3][6], const double dn[3][6], double* s, std::size_t st) {
+  s[0] = -n[0], s[st] = -n[1], s[2 * st] = -n[2];
+  s[3 * st] = n[1] * xa[2] - n[2] * xa[1];
+  s[4 * st] = n[2] * xa[0] - n[0] * xa[2];
+  s[5 * st] = n[0] * xa[1] - n[1] * xa[0];
+  s[6 * st] = n[0], s[7 * st] = n[1], s[8 * st] = n[2];
+  s[9 * st] = xb[1] * n[2] - xb[2] * n[1];
+  s[10 * st] = xb[2] * n[0] - xb[0] * n[2];
+  s[11 * st] = xb[0] * n[1] - xb[1] * n[0];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const std::size_t e = 6 * i + j;
+      s[(12 + e) * st] = wa[i][j];    // witness_a_a
+      s[(30 + e) * st] = -wa[i][j];   // witness_a_b, plus x_a's rigid motion below
+      s[(48 + e) * st] = wb[i][j];    // witness_b_a
+      s[(66 + e) * st] = -wb[i][j];   // witness_b_b, plus x_b's
+      s[(84 + e) * st] = dn[i][j];    // normal_a
+      s[(102 + e) * st] = -dn[i][j];  // normal_b, plus the normal's
+    }
+  // The rigid motions [I, -[x]x] of x_a (block 30), x_b (66) and [0, -[n]x] of the normal (102): -[x]x has x_2 at
+  // (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+  const auto add_rigid = [&](std::size_t block, const double* x, bool point) {
+    if (point)
+      for (std::size_t i = 0; i < 3; ++i) s[(block + 7 * i) * st] += 1.0;
+    s[(block + 4) * st] += x[2], s[(block + 5) * st] -= x[1], s[(block + 9) * st] -= x[2];
+    s[(block + 11) * st] += x[0], s[(block + 15) * st] += x[1], s[(block + 16) * st] -= x[0];
+  };
+  add_rigid(30, xa, true);
+  add_rigid(66, xb, true);
+  add_rigid(102, n, false);
+}
+
 // Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
 // symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
 // Written out in scalars straight into the output slot: Eigen's fixed-size products with their temporaries, a
-// PairJacobians copy and twelve 3x3 products cost ~1150 instructions per pair. Only the twist of a is solved,
-// y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
+// PairJacobians copy and twelve 3x3 products cost ~1150 instructions per pair. Only the twist of a is solved
+// (write_from_twist_a() does b), y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
 //   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
-//   I - sd K),   dn/dxi_a = -(I - n n^T) y;
-// the twist of b follows from the rigid-motion identity (J_a + J_b = [I, -[x]x] for a point, [0, -[n]x] for the
-// normal), which the formulas of the header satisfy exactly when z = sd n (GJK's witness points to rounding).
+//   I - sd K),   dn/dxi_a = -(I - n n^T) y.
 void smooth_jacobians(const PairGeometry& g, double* s, std::size_t st) {
   const double sd = g.distance;
   const double n[3] = {g.normal.x(), g.normal.y(), g.normal.z()};
@@ -57,38 +92,71 @@ void smooth_jacobians(const PairGeometry& g, double* s, std::size_t st) {
     }
   double nY[6];
   for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-  s[0] = -n[0], s[st] = -n[1], s[2 * st] = -n[2];
-  s[3 * st] = n[1] * xa[2] - n[2] * xa[1];
-  s[4 * st] = n[2] * xa[0] - n[0] * xa[2];
-  s[5 * st] = n[0] * xa[1] - n[1] * xa[0];
-  s[6 * st] = n[0], s[7 * st] = n[1], s[8 * st] = n[2];
-  s[9 * st] = xb[1] * n[2] - xb[2] * n[1];
-  s[10 * st] = xb[2] * n[0] - xb[0] * n[2];
-  s[11 * st] = xb[0] * n[1] - xb[1] * n[0];
+  double wa[3][6], wb[3][6], dn[3][6];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 6; ++j) {
-      const std::size_t e = 6 * i + j;
-      const double wb = Hb(i, 0) * Y[0][j] + Hb(i, 1) * Y[1][j] + Hb(i, 2) * Y[2][j];
-      const double wa = wb + sd * Y[i][j];
-      const double dn = n[i] * nY[j] - Y[i][j];
-      s[(12 + e) * st] = wa;   // witness_a_a
-      s[(30 + e) * st] = -wa;  // witness_a_b, plus x_a's rigid motion below
-      s[(48 + e) * st] = wb;   // witness_b_a
-      s[(66 + e) * st] = -wb;  // witness_b_b, plus x_b's
-      s[(84 + e) * st] = dn;   // normal_a
-      s[(102 + e) * st] = -dn; // normal_b, plus the normal's
+      wb[i][j] = Hb(i, 0) * Y[0][j] + Hb(i, 1) * Y[1][j] + Hb(i, 2) * Y[2][j];
+      wa[i][j] = wb[i][j] + sd * Y[i][j];
+      dn[i][j] = n[i] * nY[j] - Y[i][j];
     }
-  // The rigid motions [I, -[x]x] of x_a (block 30), x_b (66) and [0, -[n]x] of the normal (102): -[x]x has x_2 at
-  // (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
-  const auto add_rigid = [&](std::size_t block, const double* x, bool point) {
-    if (point)
-      for (std::size_t i = 0; i < 3; ++i) s[(block + 7 * i) * st] += 1.0;
-    s[(block + 4) * st] += x[2], s[(block + 5) * st] -= x[1], s[(block + 9) * st] -= x[2];
-    s[(block + 11) * st] += x[0], s[(block + 15) * st] += x[1], s[(block + 16) * st] -= x[0];
-  };
-  add_rigid(30, xa, true);
-  add_rigid(66, xb, true);
-  add_rigid(102, n, false);
+  write_from_twist_a(n, xa, xb, wa, wb, dn, s, st);
+}
+
+// Polytopes without inflation (H_a = H_b = 0) separated, with one or two independent flats (vertex-face, vertex-edge,
+// edge-edge; the hull pairs' common case): the saddle-point system has M0 = sd I, so with P the projector on the
+// flats' span (in the tangent plane) its solution for the twist of a is y = (I - P) F_a / sd + G, G the
+// constraint part in the flats' span (C^T G = c), and C mu = F_a - sd y. Closed forms, per case:
+//   a has no flats (a vertex against b's edge or face): G = 0, dx_a = F_a (rigid), dx_b = dx_a - sd y = P F_a;
+//   b has none: G = [0, P [n]x], dx_b = 0, dx_a = sd y;
+//   edge A of a against edge B of b: G = [0, B' (A x n)^T / (A . B')] (B' = n x B, so B^T G = 0 and
+//   A^T G = A^T [0, [n]x]), dx_b = B (A'^T (F_a - sd y)) / (B . A') (the B part of C mu, A' = n x A),
+//   dx_a = dx_b + sd y;
+// and dn = -(I - n n^T) y. The general elimination below (Gram-Schmidt, an eigenvalue test, two 3x6 solves)
+// cost ~2500 instructions per hull pair. Returns false (the general path decides) for dependent flats.
+bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
+  const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
+  const double sd = g.distance;
+  if (k == 0 || k > 2 || !(sd > 1e-9 * g.scale) || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0)) return false;
+  const Eigen::Vector3d& n = g.normal;
+  Eigen::Vector3d c[2];
+  for (int j = 0; j < ka; ++j) c[j] = g.flat_a.col(j);
+  for (int j = 0; j < kb; ++j) c[ka + j] = g.flat_b.col(j);
+  const Eigen::Vector3d q0 = c[0].normalized();
+  Eigen::Matrix3d P = q0 * q0.transpose();
+  if (k == 2) {
+    const Eigen::Vector3d r = c[1] - q0.dot(c[1]) * q0;
+    if (!(r.norm() > 1e-6)) return false;  // the general path's independence test (its columns are scale * flat)
+    const Eigen::Vector3d q1 = r.normalized();
+    P += q1 * q1.transpose();
+  }
+  Mat36 F;
+  F << Eigen::Matrix3d::Identity(), -skew(g.witness_a);
+  Mat36 y = ((Eigen::Matrix3d::Identity() - P) * F) / sd;
+  Mat36 wa, wb;
+  if (ka == 0) {
+    wa = F;
+    wb = F - sd * y;
+  } else if (kb == 0) {
+    y.rightCols<3>() += P * skew(n);
+    wb.setZero();
+    wa = sd * y;
+  } else {
+    const Eigen::Vector3d& A = c[0];
+    const Eigen::Vector3d& B = c[1];
+    const Eigen::Vector3d A_perp = n.cross(A), B_perp = n.cross(B);
+    y.rightCols<3>() += B_perp * (A.cross(n).transpose() / A.dot(B_perp));
+    wb = B * ((A_perp.transpose() * (F - sd * y)) / B.dot(A_perp));
+    wa = wb + sd * y;
+  }
+  const Mat36 dn = n * (n.transpose() * y) - y;
+  double n_[3] = {n.x(), n.y(), n.z()}, xa[3], xb[3], wa_[3][6], wb_[3][6], dn_[3][6];
+  for (int i = 0; i < 3; ++i) {
+    xa[i] = g.witness_a(i);
+    xb[i] = g.witness_b(i);
+    for (int j = 0; j < 6; ++j) wa_[i][j] = wa(i, j), wb_[i][j] = wb(i, j), dn_[i][j] = dn(i, j);
+  }
+  write_from_twist_a(n_, xa, xb, wa_, wb_, dn_, s, st);
+  return true;
 }
 
 }  // namespace
@@ -109,6 +177,7 @@ IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t str
     smooth_jacobians(g, slot, stride);
     return {};
   }
+  if (polytope_jacobians(g, slot, stride)) return {};
   const PairJacobians J = constrained_jacobians(g);
   write_jacobians(J, slot, stride);
   return {J.singular, J.dependent};
