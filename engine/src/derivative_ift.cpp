@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace batchcol::detail {
@@ -53,54 +54,112 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
   add_rigid(102, n, false);
 }
 
+}  // namespace
+
 // Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
 // symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
-// Written out in scalars straight into the output slot: Eigen's fixed-size products with their temporaries, a
-// PairJacobians copy and twelve 3x3 products cost ~1150 instructions per pair. Only the twist of a is solved
-// (write_from_twist_a() does b), y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
+// Only the twist of a is solved, y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
 //   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
-//   I - sd K),   dn/dxi_a = -(I - n n^T) y.
-void smooth_jacobians(const PairGeometry& g, double* s, std::size_t st) {
-  const double sd = g.distance;
-  const double n[3] = {g.normal.x(), g.normal.y(), g.normal.z()};
-  const double xa[3] = {g.witness_a.x(), g.witness_a.y(), g.witness_a.z()};
-  const double xb[3] = {g.witness_b.x(), g.witness_b.y(), g.witness_b.z()};
-  const Eigen::Matrix3d& Ha = g.H_a;
-  const Eigen::Matrix3d& Hb = g.H_b;
-  // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
-  const double m00 = sd + Ha(0, 0) + Hb(0, 0), m11 = sd + Ha(1, 1) + Hb(1, 1), m22 = sd + Ha(2, 2) + Hb(2, 2);
-  const double m01 = Ha(0, 1) + Hb(0, 1), m02 = Ha(0, 2) + Hb(0, 2), m12 = Ha(1, 2) + Hb(1, 2);
-  const double c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
-  const double c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
-  const double inv = 1.0 / (m00 * c00 + m01 * c01 + m02 * c02);
-  const double K[3][3] = {{c00 * inv, c01 * inv, c02 * inv}, {c01 * inv, c11 * inv, c12 * inv},
-                          {c02 * inv, c12 * inv, c22 * inv}};
-  // Fa_w: row i of H_a [n]x is (row i of H_a) x n; minus [x_a]x.
-  double F[3][3];
-  for (int i = 0; i < 3; ++i) {
-    const double h0 = Ha(i, 0), h1 = Ha(i, 1), h2 = Ha(i, 2);
-    F[i][0] = h1 * n[2] - h2 * n[1];
-    F[i][1] = h2 * n[0] - h0 * n[2];
-    F[i][2] = h0 * n[1] - h1 * n[0];
+//   I - sd K),   dn/dxi_a = -(I - n n^T) y;
+// the twist of b by the rigid-motion identity (as write_from_twist_a()). One loop over the lanes of a block of
+// pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
+// whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
+// per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
+void SmoothLanes::solve(double (*out)[kLanes]) const {
+  // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
+  // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
+  using V = double __attribute__((vector_size(16)));
+  using Mask = long long __attribute__((vector_size(16)));
+  const auto load = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  for (std::size_t l = 0; l < kLanes; l += 2) {
+    const Mask on = {active[l] ? -1LL : 0LL, active[l + 1] ? -1LL : 0LL};
+    if (!on[0] && !on[1]) continue;
+    const V d = load(&sd[l]);
+    const V n[3] = {load(&this->n[0][l]), load(&this->n[1][l]), load(&this->n[2][l])};
+    const V xa[3] = {load(&this->xa[0][l]), load(&this->xa[1][l]), load(&this->xa[2][l])};
+    const V xb[3] = {load(&this->xb[0][l]), load(&this->xb[1][l]), load(&this->xb[2][l])};
+    V Ha[3][3], Hb[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) Ha[i][j] = load(&H_a[3 * i + j][l]), Hb[i][j] = load(&H_b[3 * i + j][l]);
+    // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
+    const V m00 = d + Ha[0][0] + Hb[0][0], m11 = d + Ha[1][1] + Hb[1][1], m22 = d + Ha[2][2] + Hb[2][2];
+    const V m01 = Ha[0][1] + Hb[0][1], m02 = Ha[0][2] + Hb[0][2], m12 = Ha[1][2] + Hb[1][2];
+    const V c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
+    const V c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
+    const V inv = 1.0 / (m00 * c00 + m01 * c01 + m02 * c02);
+    const V K[3][3] = {{c00 * inv, c01 * inv, c02 * inv}, {c01 * inv, c11 * inv, c12 * inv},
+                       {c02 * inv, c12 * inv, c22 * inv}};
+    // Fa_w: row i of H_a [n]x is (row i of H_a) x n; minus [x_a]x.
+    V F[3][3];
+    for (int i = 0; i < 3; ++i) {
+      F[i][0] = Ha[i][1] * n[2] - Ha[i][2] * n[1];
+      F[i][1] = Ha[i][2] * n[0] - Ha[i][0] * n[2];
+      F[i][2] = Ha[i][0] * n[1] - Ha[i][1] * n[0];
+    }
+    F[0][1] += xa[2], F[0][2] -= xa[1], F[1][0] -= xa[2], F[1][2] += xa[0], F[2][0] += xa[1], F[2][1] -= xa[0];
+    V Y[3][6];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        Y[i][j] = K[i][j];
+        Y[i][3 + j] = K[i][0] * F[0][j] + K[i][1] * F[1][j] + K[i][2] * F[2][j];
+      }
+    V nY[6];
+    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
+    const bool both = on[0] && on[1];  // the common case: plain stores, no blend with what the slots hold
+    const auto put = [&](int e, V v) {
+      const V merged = both ? v : (on ? v : load(&out[e][l]));
+      std::memcpy(&out[e][l], &merged, sizeof merged);
+    };
+    put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
+    put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
+    put(6, n[0]), put(7, n[1]), put(8, n[2]);
+    put(9, xb[1] * n[2] - xb[2] * n[1]), put(10, xb[2] * n[0] - xb[0] * n[2]), put(11, xb[0] * n[1] - xb[1] * n[0]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const int e = 6 * i + j;
+        const V wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
+        const V wa = wb + d * Y[i][j];
+        const V dn = n[i] * nY[j] - Y[i][j];
+        put(12 + e, wa);  // witness_a_a
+        put(48 + e, wb);  // witness_b_a
+        put(84 + e, dn);  // normal_a
+        // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
+        if (j < 3) {
+          const double one = i == j ? 1.0 : 0.0;
+          put(30 + e, one - wa), put(66 + e, one - wb), put(102 + e, 0.0 - dn);
+        } else if (j - 3 == i) {
+          put(30 + e, 0.0 - wa), put(66 + e, 0.0 - wb), put(102 + e, 0.0 - dn);
+        } else {
+          const int k = j - 3, other = 3 - i - k;
+          // -[x]x(i, k) = eps(i, k, other) x_other
+          if ((i + 1) % 3 == k) {
+            put(30 + e, xa[other] - wa), put(66 + e, xb[other] - wb), put(102 + e, n[other] - dn);
+          } else {
+            put(30 + e, -xa[other] - wa), put(66 + e, -xb[other] - wb), put(102 + e, -n[other] - dn);
+          }
+        }
+      }
   }
-  F[0][1] += xa[2], F[0][2] -= xa[1], F[1][0] -= xa[2], F[1][2] += xa[0], F[2][0] += xa[1], F[2][1] -= xa[0];
-  double Y[3][6];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      Y[i][j] = K[i][j];
-      Y[i][3 + j] = K[i][0] * F[0][j] + K[i][1] * F[1][j] + K[i][2] * F[2][j];
-    }
-  double nY[6];
-  for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-  double wa[3][6], wb[3][6], dn[3][6];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 6; ++j) {
-      wb[i][j] = Hb(i, 0) * Y[0][j] + Hb(i, 1) * Y[1][j] + Hb(i, 2) * Y[2][j];
-      wa[i][j] = wb[i][j] + sd * Y[i][j];
-      dn[i][j] = n[i] * nY[j] - Y[i][j];
-    }
-  write_from_twist_a(n, xa, xb, wa, wb, dn, s, st);
 }
+
+void SmoothLanes::set(std::size_t l, const PairGeometry& g) {
+  active[l] = true;
+  sd[l] = g.distance;
+  for (int i = 0; i < 3; ++i) {
+    n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+    for (int j = 0; j < 3; ++j) H_a[3 * i + j][l] = g.H_a(i, j), H_b[3 * i + j][l] = g.H_b(i, j);
+  }
+}
+
+void SmoothLanes::clear() {
+  for (std::size_t l = 0; l < kLanes; ++l) active[l] = false;
+}
+
+namespace {
 
 // Polytopes without inflation (H_a = H_b = 0) separated, with one or two independent flats (vertex-face, vertex-edge,
 // edge-edge; the hull pairs' common case): the saddle-point system has M0 = sd I, so with P the projector on the
@@ -173,8 +232,13 @@ void write_jacobians(const PairJacobians& J, double* s, std::size_t stride) {
 }
 
 IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride) {
-  if (g.flats_a + g.flats_b == 0 && g.distance > 1e-9 * g.scale) {
-    smooth_jacobians(g, slot, stride);
+  if (smooth_pair(g)) {
+    SmoothLanes lanes{};  // one lane; differentiate_results() batches its smooth pairs through StoreBlock instead
+    lanes.clear();
+    lanes.set(0, g);
+    double out[StoreEntries][SmoothLanes::kLanes] = {};
+    lanes.solve(out);
+    for (int e = 0; e < StoreEntries; ++e) slot[e * stride] = out[e][0];
     return {};
   }
   if (polytope_jacobians(g, slot, stride)) return {};

@@ -71,6 +71,27 @@ inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b
   grad_b << g.normal.transpose(), g.witness_b.cross(g.normal).transpose();
 }
 
+/// Entries per pair of the derivative outputs (2 x 6 + 6 x 18).
+constexpr int StoreEntries = 120;
+
+/// The separated pairs without flats (the smooth common case) of a block of up to kLanes pairs, in
+/// structure-of-arrays order (lane l of every array), so that their implicit-function Jacobians are computed
+/// across the lanes in SIMD registers. Inactive lanes are computed on whatever they hold and not written.
+struct SmoothLanes {
+  static constexpr std::size_t kLanes = 8;
+  alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes], H_a[9][kLanes], H_b[9][kLanes];
+  bool active[kLanes];
+  void clear();
+  void set(std::size_t lane, const PairGeometry& g);
+  /// Writes the 120 entries of every active lane l to out[e][l] (write_jacobians()'s order).
+  void solve(double (*out)[kLanes]) const;
+};
+
+/// True when the pair takes SmoothLanes: no flats and separated beyond the singularity threshold.
+inline bool smooth_pair(const PairGeometry& g) {
+  return g.flats_a + g.flats_b == 0 && g.distance > 1e-9 * g.scale;
+}
+
 /// Writes J's 120 entries to `slot` (entry e at slot[e * stride], in StoreBlock's order: the distance gradients
 /// of a and b, then witness_a_a, witness_a_b, witness_b_a, witness_b_b, normal_a, normal_b, row-major).
 void write_jacobians(const PairJacobians& J, double* slot, std::size_t stride);

@@ -43,8 +43,8 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
 /// task range.
 class StoreBlock {
  public:
-  static constexpr int kEntries = 120;
-  static constexpr std::size_t kStride = 8;  // slot entries are kStride doubles apart
+  static constexpr int kEntries = StoreEntries;
+  static constexpr std::size_t kStride = SmoothLanes::kLanes;  // slot entries are kStride doubles apart
   explicit StoreBlock(DerivativeResults& d) : d(d) {}
   StoreBlock(const StoreBlock&) = delete;
   StoreBlock& operator=(const StoreBlock&) = delete;
@@ -56,12 +56,20 @@ class StoreBlock {
     return &buf_[0][count_++];
   }
   void add(std::size_t i, const PairJacobians& J);
+  /// Queues pair i (smooth_pair(g)) for the block's SIMD solve at the flush.
+  void add_smooth(std::size_t i, const PairGeometry& g) {
+    slot(i);
+    smooth_.set(count_ - 1, g);
+    any_smooth_ = true;
+  }
   void flush();
 
   DerivativeResults& d;
 
  private:
-  alignas(64) double buf_[kEntries][kStride];
+  alignas(64) double buf_[kEntries][kStride] = {};
+  SmoothLanes smooth_{};  // value-initialised: inactive lanes are computed (not written) on initialised numbers
+  bool any_smooth_ = false;
   std::size_t first_ = 0, count_ = 0;
 };
 

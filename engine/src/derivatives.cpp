@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -35,6 +36,11 @@ void StoreBlock::add(std::size_t i, const PairJacobians& J) { write_jacobians(J,
 
 void StoreBlock::flush() {
   if (count_ == 0) return;
+  if (any_smooth_) {
+    smooth_.solve(buf_);
+    smooth_.clear();
+    any_smooth_ = false;
+  }
   const std::size_t n = d.status.size();
   double* arrays[kEntries / 6] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
                                   d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
@@ -47,8 +53,8 @@ void StoreBlock::flush() {
     const int rows = a < 2 ? 6 : 18;
     for (int k = 0; k < rows; ++k, ++e) {
       double* out = arrays[a] + k * n + first_;
-      if (count_ == kStride) {  // the common full block: a fixed-length copy, not a memcpy call per entry
-        for (std::size_t j = 0; j < kStride; ++j) out[j] = buf_[e][j];
+      if (count_ == kStride) {  // the common full block: a fixed-size copy the compiler inlines as vector moves
+        std::memcpy(out, buf_[e], sizeof buf_[e]);
       } else {
         std::copy_n(buf_[e], count_, out);
       }
@@ -133,6 +139,11 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     };
     g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1) * R_a.transpose();
     g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2) * R_b.transpose();
+  }
+  if (smooth_pair(g)) {
+    out.add_smooth(i, g);
+    d.status[i] = status;
+    return;
   }
   const IftFlags J = implicit_jacobians(g, out.slot(i), StoreBlock::kStride);
   d.status[i] = J.dependent ? DerivativeStatus::nonsmooth : J.singular ? DerivativeStatus::singular : status;
