@@ -65,7 +65,7 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
 // pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
 // whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
 // per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
-void SmoothLanes::solve(double (*out)[kLanes]) const {
+void SmoothLanes::solve(double* const* out) const {
   // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
   // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
   using V = double __attribute__((vector_size(16)));
@@ -82,9 +82,29 @@ void SmoothLanes::solve(double (*out)[kLanes]) const {
     const V n[3] = {load(&this->n[0][l]), load(&this->n[1][l]), load(&this->n[2][l])};
     const V xa[3] = {load(&this->xa[0][l]), load(&this->xa[1][l]), load(&this->xa[2][l])};
     const V xb[3] = {load(&this->xb[0][l]), load(&this->xb[1][l]), load(&this->xb[2][l])};
+    // The support-map Jacobians (world_support_jacobian()'s formula and order of operations; it is even in n).
+    const auto curvature = [&](const Side& side, V (&H)[3][3]) {
+      V R[3][3], B[3][3], Bn[3];
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) R[i][k] = load(&side.R[3 * i + k][l]);
+      const V D[3] = {load(&side.radii2[0][l]), load(&side.radii2[1][l]), load(&side.radii2[2][l])};
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+          B[i][j] = B[j][i] = R[i][0] * D[0] * R[j][0] + R[i][1] * D[1] * R[j][1] + R[i][2] * D[2] * R[j][2];
+      for (int i = 0; i < 3; ++i) Bn[i] = B[i][0] * n[0] + B[i][1] * n[1] + B[i][2] * n[2];
+      const V m2 = n[0] * Bn[0] + n[1] * Bn[1] + n[2] * Bn[2];
+      const V m = {std::sqrt(m2[0]), std::sqrt(m2[1])};
+      const V zero = {0.0, 0.0};
+      const V inv_m = m2 > 0.0 ? 1.0 / m : zero, inv_m3 = inv_m * inv_m * inv_m;
+      const V r = load(&side.round[l]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          H[i][j] = load(&side.H0[3 * i + j][l]) + B[i][j] * inv_m - Bn[i] * Bn[j] * inv_m3 +
+                    r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
+    };
     V Ha[3][3], Hb[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) Ha[i][j] = load(&H_a[3 * i + j][l]), Hb[i][j] = load(&H_b[3 * i + j][l]);
+    curvature(a, Ha);
+    curvature(b, Hb);
     // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
     const V m00 = d + Ha[0][0] + Hb[0][0], m11 = d + Ha[1][1] + Hb[1][1], m22 = d + Ha[2][2] + Hb[2][2];
     const V m01 = Ha[0][1] + Hb[0][1], m02 = Ha[0][2] + Hb[0][2], m12 = Ha[1][2] + Hb[1][2];
@@ -146,13 +166,23 @@ void SmoothLanes::solve(double (*out)[kLanes]) const {
   }
 }
 
-void SmoothLanes::set(std::size_t l, const PairGeometry& g) {
+void SmoothLanes::set(std::size_t l, const PairGeometry& g, const CurvedSide* curved_a,
+                      const CurvedSide* curved_b) {
   active[l] = true;
   sd[l] = g.distance;
-  for (int i = 0; i < 3; ++i) {
-    n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
-    for (int j = 0; j < 3; ++j) H_a[3 * i + j][l] = g.H_a(i, j), H_b[3 * i + j][l] = g.H_b(i, j);
-  }
+  for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+  const auto side = [&](Side& s, const CurvedSide* c, const Eigen::Matrix3d& H) {
+    for (int i = 0; i < 3; ++i) {
+      s.radii2[i][l] = c ? c->radii2(i) : 0.0;
+      for (int j = 0; j < 3; ++j) {
+        s.H0[3 * i + j][l] = c ? 0.0 : H(i, j);
+        s.R[3 * i + j][l] = c ? (*c->R)(i, j) : 0.0;
+      }
+    }
+    s.round[l] = c ? c->round : 0.0;
+  };
+  side(a, curved_a, g.H_a);
+  side(b, curved_b, g.H_b);
 }
 
 void SmoothLanes::clear() {
@@ -237,7 +267,9 @@ IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t str
     lanes.clear();
     lanes.set(0, g);
     double out[StoreEntries][SmoothLanes::kLanes] = {};
-    lanes.solve(out);
+    double* rows[StoreEntries];
+    for (int e = 0; e < StoreEntries; ++e) rows[e] = out[e];
+    lanes.solve(rows);
     for (int e = 0; e < StoreEntries; ++e) slot[e * stride] = out[e][0];
     return {};
   }

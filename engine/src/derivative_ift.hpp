@@ -74,17 +74,35 @@ inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b
 /// Entries per pair of the derivative outputs (2 x 6 + 6 x 18).
 constexpr int StoreEntries = 120;
 
+/// A sphere's or an ellipsoid's support-map Jacobian left to SmoothLanes to compute (world_support_jacobian()'s
+/// formula): the shape's rotation, its squared radii (zero for a sphere) and its round radius (sphere radius plus
+/// inflation, or the ellipsoid's inflation).
+struct CurvedSide {
+  const Eigen::Matrix3d* R = nullptr;
+  Eigen::Vector3d radii2 = Eigen::Vector3d::Zero();
+  double round = 0.0;
+};
+
 /// The separated pairs without flats (the smooth common case) of a block of up to kLanes pairs, in
 /// structure-of-arrays order (lane l of every array), so that their implicit-function Jacobians are computed
 /// across the lanes in SIMD registers. Inactive lanes are computed on whatever they hold and not written.
 struct SmoothLanes {
   static constexpr std::size_t kLanes = 8;
-  alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes], H_a[9][kLanes], H_b[9][kLanes];
+  // Per side (a, b): H = H0 + B / m - (B n)(B n)^T / m^3 + round (I - n n^T) with B = R diag(radii2) R^T and
+  // m = sqrt(n^T B n) (0 / 0 taken as 0): a sphere or ellipsoid, or the given H0 (radii2 = round = 0).
+  struct Side {
+    alignas(64) double H0[9][kLanes], R[9][kLanes], radii2[3][kLanes], round[kLanes];
+  };
+  alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes];
+  Side a, b;
   bool active[kLanes];
   void clear();
-  void set(std::size_t lane, const PairGeometry& g);
-  /// Writes the 120 entries of every active lane l to out[e][l] (write_jacobians()'s order).
-  void solve(double (*out)[kLanes]) const;
+  /// Lane `lane` takes pair g; a null side uses g.H_a / g.H_b.
+  void set(std::size_t lane, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
+           const CurvedSide* curved_b = nullptr);
+  /// Writes the 120 entries of every active lane l to out[e][l] (write_jacobians()'s order; out[e] points to lane 0
+  /// of entry e: a block buffer's row or the output array itself).
+  void solve(double* const* out) const;
 };
 
 /// True when the pair takes SmoothLanes: no flats and separated beyond the singularity threshold.

@@ -57,10 +57,11 @@ class StoreBlock {
   }
   void add(std::size_t i, const PairJacobians& J);
   /// Queues pair i (smooth_pair(g)) for the block's SIMD solve at the flush.
-  void add_smooth(std::size_t i, const PairGeometry& g) {
+  void add_smooth(std::size_t i, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
+                  const CurvedSide* curved_b = nullptr) {
     slot(i);
-    smooth_.set(count_ - 1, g);
-    any_smooth_ = true;
+    smooth_.set(count_ - 1, g, curved_a, curved_b);
+    ++smooth_count_;
   }
   void flush();
 
@@ -69,7 +70,7 @@ class StoreBlock {
  private:
   alignas(64) double buf_[kEntries][kStride] = {};
   SmoothLanes smooth_{};  // value-initialised: inactive lanes are computed (not written) on initialised numbers
-  bool any_smooth_ = false;
+  std::size_t smooth_count_ = 0;
   std::size_t first_ = 0, count_ = 0;
 };
 

@@ -36,30 +36,29 @@ void StoreBlock::add(std::size_t i, const PairJacobians& J) { write_jacobians(J,
 
 void StoreBlock::flush() {
   if (count_ == 0) return;
-  if (any_smooth_) {
-    smooth_.solve(buf_);
-    smooth_.clear();
-    any_smooth_ = false;
-  }
   const std::size_t n = d.status.size();
-  double* arrays[kEntries / 6] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
-                                  d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
-                                  d.witness_b_wrt_a.data.data(),     d.witness_b_wrt_b.data.data(),
-                                  d.normal_wrt_a.data.data(),        d.normal_wrt_b.data.data()};
+  double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
+                             d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
+                             d.witness_b_wrt_a.data.data(),     d.witness_b_wrt_b.data.data(),
+                             d.normal_wrt_a.data.data(),        d.normal_wrt_b.data.data()};
   // Entries 0-11 are the two 6-vectors, then 18 per matrix: entry e is row e % 6 (vectors) or e - start of the
   // matrix's (6 r + c), which is exactly the SoA index k of data[k * n + i].
+  double* rows[kEntries];
   int e = 0;
-  for (int a = 0; a < 8; ++a) {
-    const int rows = a < 2 ? 6 : 18;
-    for (int k = 0; k < rows; ++k, ++e) {
-      double* out = arrays[a] + k * n + first_;
-      if (count_ == kStride) {  // the common full block: a fixed-size copy the compiler inlines as vector moves
-        std::memcpy(out, buf_[e], sizeof buf_[e]);
-      } else {
-        std::copy_n(buf_[e], count_, out);
-      }
+  for (int a = 0; a < 8; ++a)
+    for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
+  if (smooth_count_ == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
+    smooth_.solve(rows);
+  } else {
+    if (smooth_count_ > 0) {
+      double* buffer_rows[kEntries];
+      for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
+      smooth_.solve(buffer_rows);
     }
+    for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
   }
+  if (smooth_count_ > 0) smooth_.clear();
+  smooth_count_ = 0;
   count_ = 0;
 }
 
@@ -108,12 +107,18 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   const Shape& b = shapes[batch.shape_b[i]];
   DerivativeStatus status = DerivativeStatus::smooth;
   if (o.method == DerivativeMethod::analytic) {
-    // Spheres and ellipsoids (no features, no flats) straight in the world frame; the others through their local
-    // frame, where the features are tested.
+    // Spheres and ellipsoids (no features, no flats): their support-map Jacobian is left to the lanes of
+    // SmoothLanes (or computed below when the other side has flats); the others go through their local frame,
+    // where the features are tested.
     const auto side = [&](const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& witness,
                           const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H, int& flats,
-                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, bool& approximate) {
-      if (world_support_jacobian(s, R, g.normal, H)) return;
+                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, bool& approximate, CurvedSide& curved) {
+      if (s.type == ShapeType::sphere || s.type == ShapeType::ellipsoid) {
+        curved.R = &R;
+        if (s.type == ShapeType::ellipsoid) curved.radii2 = s.size.cwiseProduct(s.size);
+        curved.round = s.inflation + (s.type == ShapeType::sphere ? s.size.x() : 0.0);
+        return;
+      }
       const Eigen::Vector3d u = sign * (R.transpose() * g.normal), p = R.transpose() * (witness - t);
       const SupportJacobian J = support_jacobian(s, u, p);
       // Polytopes without inflation have no curvature: skip the two 3x3 products.
@@ -125,13 +130,23 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
       approximate = J.approximate;
     };
     bool zero_a = false, zero_b = false, approximate_a = false, approximate_b = false;
-    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, approximate_a);
-    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, approximate_b);
+    CurvedSide curved_a, curved_b;
+    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, approximate_a,
+         curved_a);
+    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, approximate_b,
+         curved_b);
     if (approximate_a || approximate_b) {
       status = DerivativeStatus::nonsmooth;
     } else if (zero_a || zero_b) {
       status = DerivativeStatus::zero_curvature;
     }
+    if (smooth_pair(g)) {
+      out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);
+      d.status[i] = status;
+      return;
+    }
+    if (curved_a.R) world_support_jacobian(a, R_a, g.normal, g.H_a);
+    if (curved_b.R) world_support_jacobian(b, R_b, g.normal, g.H_b);
   } else {
     const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
     const auto direction_noise = [&](const Shape& s) {
