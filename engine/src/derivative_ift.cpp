@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace batchcol::detail {
 namespace {
@@ -69,15 +70,20 @@ void SmoothLanes::solve(double* const* out) const {
   // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
   // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
   using V = double __attribute__((vector_size(16)));
-  using Mask = long long __attribute__((vector_size(16)));
   const auto load = [](const double* p) {
     V v;
     std::memcpy(&v, p, sizeof v);
     return v;
   };
-  for (std::size_t l = 0; l < kLanes; l += 2) {
-    const Mask on = {active[l] ? -1LL : 0LL, active[l + 1] ? -1LL : 0LL};
-    if (!on[0] && !on[1]) continue;
+  bool columns_in_order = count == kLanes;
+  for (std::size_t l = 0; l < count; ++l) columns_in_order = columns_in_order && column[l] == l;
+  // Compiled twice, so that the common case (a full block of whole registers to consecutive columns) has a fixed
+  // trip count and no per-store test.
+  const auto run = [&](auto in_order_tag) {
+  constexpr bool in_order = decltype(in_order_tag)::value;
+  const std::size_t lanes = in_order ? kLanes : count;
+  for (std::size_t l = 0; l < lanes; l += 2) {
+    const bool both = in_order || l + 1 < count;
     const V d = load(&sd[l]);
     const V n[3] = {load(&this->n[0][l]), load(&this->n[1][l]), load(&this->n[2][l])};
     const V xa[3] = {load(&this->xa[0][l]), load(&this->xa[1][l]), load(&this->xa[2][l])};
@@ -129,10 +135,13 @@ void SmoothLanes::solve(double* const* out) const {
       }
     V nY[6];
     for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    const bool both = on[0] && on[1];  // the common case: plain stores, no blend with what the slots hold
     const auto put = [&](int e, V v) {
-      const V merged = both ? v : (on ? v : load(&out[e][l]));
-      std::memcpy(&out[e][l], &merged, sizeof merged);
+      if (in_order && both) {
+        std::memcpy(&out[e][l], &v, sizeof v);
+      } else {
+        out[e][column[l]] = v[0];
+        if (both) out[e][column[l + 1]] = v[1];
+      }
     };
     put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
     put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
@@ -164,11 +173,15 @@ void SmoothLanes::solve(double* const* out) const {
         }
       }
   }
+  };
+  if (columns_in_order) run(std::true_type{});
+  else run(std::false_type{});
 }
 
-void SmoothLanes::set(std::size_t l, const PairGeometry& g, const CurvedSide* curved_a,
+void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,
                       const CurvedSide* curved_b) {
-  active[l] = true;
+  const std::size_t l = count++;
+  column[l] = col;
   sd[l] = g.distance;
   for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
   const auto side = [&](Side& s, const CurvedSide* c, const Eigen::Matrix3d& H) {
@@ -185,14 +198,10 @@ void SmoothLanes::set(std::size_t l, const PairGeometry& g, const CurvedSide* cu
   side(b, curved_b, g.H_b);
 }
 
-void SmoothLanes::clear() {
-  for (std::size_t l = 0; l < kLanes; ++l) active[l] = false;
-}
-
 namespace {
 
-// Polytopes without inflation (H_a = H_b = 0) separated, with one or two independent flats (vertex-face, vertex-edge,
-// edge-edge; the hull pairs' common case): the saddle-point system has M0 = sd I, so with P the projector on the
+// Polytopes without inflation (H_a = H_b = 0) separated, with up to two independent flats (vertex-vertex,
+// vertex-face, vertex-edge, edge-edge: the hull pairs): the saddle-point system has M0 = sd I, so with P the projector on the
 // flats' span (in the tangent plane) its solution for the twist of a is y = (I - P) F_a / sd + G, G the
 // constraint part in the flats' span (C^T G = c), and C mu = F_a - sd y. Closed forms, per case:
 //   a has no flats (a vertex against b's edge or face): G = 0, dx_a = F_a (rigid), dx_b = dx_a - sd y = P F_a;
@@ -202,11 +211,23 @@ namespace {
 //   dx_a = dx_b + sd y;
 // and dn = -(I - n n^T) y. The general elimination below (Gram-Schmidt, an eigenvalue test, two 3x6 solves)
 // cost ~2500 instructions per hull pair. Returns false (the general path decides) for dependent flats.
+void write_polytope(const PairGeometry& g, const Mat36& y, const Mat36& wa, const Mat36& wb, double* s,
+                    std::size_t st);
+
 bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
   const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
   const double sd = g.distance;
-  if (k == 0 || k > 2 || !(sd > 1e-9 * g.scale) || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0)) return false;
+  if (k > 2 || !(sd > 1e-9 * g.scale) || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0)) return false;
   const Eigen::Vector3d& n = g.normal;
+  Mat36 F;
+  F << Eigen::Matrix3d::Identity(), -skew(g.witness_a);
+  Mat36 y, wa, wb;
+  if (k == 0) {  // vertex against vertex: both points move rigidly, the normal turns (y = F_a / sd)
+    y = F / sd;
+    wa = F;
+    wb.setZero();
+    return write_polytope(g, y, wa, wb, s, st), true;
+  }
   Eigen::Vector3d c[2];
   for (int j = 0; j < ka; ++j) c[j] = g.flat_a.col(j);
   for (int j = 0; j < kb; ++j) c[ka + j] = g.flat_b.col(j);
@@ -218,10 +239,7 @@ bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
     const Eigen::Vector3d q1 = r.normalized();
     P += q1 * q1.transpose();
   }
-  Mat36 F;
-  F << Eigen::Matrix3d::Identity(), -skew(g.witness_a);
-  Mat36 y = ((Eigen::Matrix3d::Identity() - P) * F) / sd;
-  Mat36 wa, wb;
+  y = ((Eigen::Matrix3d::Identity() - P) * F) / sd;
   if (ka == 0) {
     wa = F;
     wb = F - sd * y;
@@ -237,6 +255,13 @@ bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
     wb = B * ((A_perp.transpose() * (F - sd * y)) / B.dot(A_perp));
     wa = wb + sd * y;
   }
+  write_polytope(g, y, wa, wb, s, st);
+  return true;
+}
+
+void write_polytope(const PairGeometry& g, const Mat36& y, const Mat36& wa, const Mat36& wb, double* s,
+                    std::size_t st) {
+  const Eigen::Vector3d& n = g.normal;
   const Mat36 dn = n * (n.transpose() * y) - y;
   double n_[3] = {n.x(), n.y(), n.z()}, xa[3], xb[3], wa_[3][6], wb_[3][6], dn_[3][6];
   for (int i = 0; i < 3; ++i) {
@@ -245,7 +270,6 @@ bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
     for (int j = 0; j < 6; ++j) wa_[i][j] = wa(i, j), wb_[i][j] = wb(i, j), dn_[i][j] = dn(i, j);
   }
   write_from_twist_a(n_, xa, xb, wa_, wb_, dn_, s, st);
-  return true;
 }
 
 }  // namespace
@@ -262,10 +286,10 @@ void write_jacobians(const PairJacobians& J, double* s, std::size_t stride) {
 }
 
 IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride) {
+  if (polytope_jacobians(g, slot, stride)) return {};
   if (smooth_pair(g)) {
     SmoothLanes lanes{};  // one lane; differentiate_results() batches its smooth pairs through StoreBlock instead
-    lanes.clear();
-    lanes.set(0, g);
+    lanes.add(0, g);
     double out[StoreEntries][SmoothLanes::kLanes] = {};
     double* rows[StoreEntries];
     for (int e = 0; e < StoreEntries; ++e) rows[e] = out[e];
@@ -273,7 +297,6 @@ IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t str
     for (int e = 0; e < StoreEntries; ++e) slot[e * stride] = out[e][0];
     return {};
   }
-  if (polytope_jacobians(g, slot, stride)) return {};
   const PairJacobians J = constrained_jacobians(g);
   write_jacobians(J, slot, stride);
   return {J.singular, J.dependent};

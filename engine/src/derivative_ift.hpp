@@ -85,7 +85,8 @@ struct CurvedSide {
 
 /// The separated pairs without flats (the smooth common case) of a block of up to kLanes pairs, in
 /// structure-of-arrays order (lane l of every array), so that their implicit-function Jacobians are computed
-/// across the lanes in SIMD registers. Inactive lanes are computed on whatever they hold and not written.
+/// across the lanes in SIMD registers. Lanes are filled in order (lane l goes to output column column[l]); a
+/// register half past `count` is computed on whatever it holds and not written.
 struct SmoothLanes {
   static constexpr std::size_t kLanes = 8;
   // Per side (a, b): H = H0 + B / m - (B n)(B n)^T / m^3 + round (I - n n^T) with B = R diag(radii2) R^T and
@@ -95,13 +96,15 @@ struct SmoothLanes {
   };
   alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes];
   Side a, b;
-  bool active[kLanes];
-  void clear();
-  /// Lane `lane` takes pair g; a null side uses g.H_a / g.H_b.
-  void set(std::size_t lane, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
+  std::size_t column[kLanes];
+  std::size_t count = 0;
+  void clear() { count = 0; }
+  /// The next lane takes pair g, for output column `column`; a null side uses g.H_a / g.H_b.
+  void add(std::size_t column, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
            const CurvedSide* curved_b = nullptr);
-  /// Writes the 120 entries of every active lane l to out[e][l] (write_jacobians()'s order; out[e] points to lane 0
-  /// of entry e: a block buffer's row or the output array itself).
+  /// Writes the 120 entries of every lane l < count to out[e][column[l]] (write_jacobians()'s order; out[e] points
+  /// to column 0 of entry e: a block buffer's row or the output array itself). Whole registers are stored when
+  /// the columns are 0, 1, 2, ... (a block of smooth pairs only), single lanes otherwise.
   void solve(double* const* out) const;
 };
 

@@ -60,8 +60,7 @@ class StoreBlock {
   void add_smooth(std::size_t i, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
                   const CurvedSide* curved_b = nullptr) {
     slot(i);
-    smooth_.set(count_ - 1, g, curved_a, curved_b);
-    ++smooth_count_;
+    smooth_.add(count_ - 1, g, curved_a, curved_b);
   }
   void flush();
 
@@ -69,8 +68,7 @@ class StoreBlock {
 
  private:
   alignas(64) double buf_[kEntries][kStride] = {};
-  SmoothLanes smooth_{};  // value-initialised: inactive lanes are computed (not written) on initialised numbers
-  std::size_t smooth_count_ = 0;
+  SmoothLanes smooth_{};  // value-initialised: an unused register half is computed (not written) on initialised numbers
   std::size_t first_ = 0, count_ = 0;
 };
 

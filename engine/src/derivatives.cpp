@@ -47,18 +47,21 @@ void StoreBlock::flush() {
   int e = 0;
   for (int a = 0; a < 8; ++a)
     for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
-  if (smooth_count_ == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
+  if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
     smooth_.solve(rows);
   } else {
-    if (smooth_count_ > 0) {
+    if (smooth_.count > 0) {
       double* buffer_rows[kEntries];
       for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
       smooth_.solve(buffer_rows);
     }
-    for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
+    if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
+      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
+    } else {
+      for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
+    }
   }
-  if (smooth_count_ > 0) smooth_.clear();
-  smooth_count_ = 0;
+  smooth_.clear();
   count_ = 0;
 }
 
@@ -140,7 +143,8 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     } else if (zero_a || zero_b) {
       status = DerivativeStatus::zero_curvature;
     }
-    if (smooth_pair(g)) {
+    // Two polytope vertices (no curvature, no flats): polytope_jacobians' closed form, cheaper than a lane.
+    if (smooth_pair(g) && (curved_a.R || curved_b.R || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
       out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);
       d.status[i] = status;
       return;
