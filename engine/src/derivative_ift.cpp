@@ -3,10 +3,14 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace batchcol::detail {
 namespace {
+
+PairJacobians constrained_jacobians(const PairGeometry& g);
 
 void set_nan(PairJacobians& J) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -14,40 +18,299 @@ void set_nan(PairJacobians& J) {
     m->setConstant(nan);
 }
 
-// Separated pairs without flats (the smooth common case, every ellipsoid pair): sd I + H_a + H_b >= sd I is
-// symmetric positive definite, so K is its explicit 3x3 inverse (cofactors over the determinant, which is
-// >= sd^3 > 0) and everything stays in fixed-size matrices; the general path below sizes its saddle-point system
-// at run time, which cost more than the rest of the pair together. Same formulas as that path with k = 0.
-void smooth_jacobians(const PairGeometry& g, const Eigen::Matrix3d& M0, PairJacobians& J) {
-  const Eigen::Matrix3d K = M0.inverse();
-  const Eigen::Vector3d& n = g.normal;
-  const Eigen::Matrix3d n_x = skew(n);
-  const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
-  // F_a = [I, -[x_a]x + H_a [n]x], F_b = [-I, [x_b]x + H_b [n]x]; y = K F.
-  const Eigen::Matrix3d Fa_w = g.H_a * n_x - skew(g.witness_a), Fb_w = g.H_b * n_x + skew(g.witness_b);
-  const Eigen::Matrix3d HaK = g.H_a * K, HbK = g.H_b * K, TK = tangent * K;
-  // Twist of a: y = [K, K Fa_w].
-  J.witness_a_a << Eigen::Matrix3d::Identity() - HaK, Fa_w - HaK * Fa_w;
-  J.witness_b_a << HbK, HbK * Fa_w;
-  J.normal_a << -TK, -TK * Fa_w;
-  // Twist of b: y = [-K, K Fb_w].
-  J.witness_a_b << HaK, -HaK * Fb_w;
-  J.witness_b_b << Eigen::Matrix3d::Identity() - HbK, HbK * Fb_w - Fb_w;
-  J.normal_b << TK, -TK * Fb_w;
+// Writes a pair's 120 entries from the derivatives with respect to the twist of a (wa = dx_a/dxi_a, wb =
+// dx_b/dxi_a, dn = dn/dxi_a): the distance gradients by the envelope theorem and the twist of b by the rigid-motion
+// identity J_a + J_b = [I, -[x]x] (points), [0, -[n]x] (normal), which the implicit-function formulas satisfy
+// exactly when z = sd n (GJK's witness points, to rounding): half the products of solving for b as well.
+void write_from_twist_a(const double n[3], const double xa[3], const double xb[3], const double wa[3][6],
+                        const double wb[3][6], const double dn[3][6], double* s, std::size_t st) {
+  s[0] = -n[0], s[st] = -n[1], s[2 * st] = -n[2];
+  s[3 * st] = n[1] * xa[2] - n[2] * xa[1];
+  s[4 * st] = n[2] * xa[0] - n[0] * xa[2];
+  s[5 * st] = n[0] * xa[1] - n[1] * xa[0];
+  s[6 * st] = n[0], s[7 * st] = n[1], s[8 * st] = n[2];
+  s[9 * st] = xb[1] * n[2] - xb[2] * n[1];
+  s[10 * st] = xb[2] * n[0] - xb[0] * n[2];
+  s[11 * st] = xb[0] * n[1] - xb[1] * n[0];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const std::size_t e = 6 * i + j;
+      s[(12 + e) * st] = wa[i][j];    // witness_a_a
+      s[(30 + e) * st] = -wa[i][j];   // witness_a_b, plus x_a's rigid motion below
+      s[(48 + e) * st] = wb[i][j];    // witness_b_a
+      s[(66 + e) * st] = -wb[i][j];   // witness_b_b, plus x_b's
+      s[(84 + e) * st] = dn[i][j];    // normal_a
+      s[(102 + e) * st] = -dn[i][j];  // normal_b, plus the normal's
+    }
+  // The rigid motions [I, -[x]x] of x_a (block 30), x_b (66) and [0, -[n]x] of the normal (102): -[x]x has x_2 at
+  // (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+  const auto add_rigid = [&](std::size_t block, const double* x, bool point) {
+    if (point)
+      for (std::size_t i = 0; i < 3; ++i) s[(block + 7 * i) * st] += 1.0;
+    s[(block + 4) * st] += x[2], s[(block + 5) * st] -= x[1], s[(block + 9) * st] -= x[2];
+    s[(block + 11) * st] += x[0], s[(block + 15) * st] += x[1], s[(block + 16) * st] -= x[0];
+  };
+  add_rigid(30, xa, true);
+  add_rigid(66, xb, true);
+  add_rigid(102, n, false);
 }
 
 }  // namespace
 
-PairJacobians implicit_jacobians(const PairGeometry& g) {
+// Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
+// symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
+// Only the twist of a is solved, y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
+//   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
+//   I - sd K),   dn/dxi_a = -(I - n n^T) y;
+// the twist of b by the rigid-motion identity (as write_from_twist_a()). One loop over the lanes of a block of
+// pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
+// whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
+// per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
+void SmoothLanes::solve(double* const* out) const {
+  // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
+  // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
+  using V = double __attribute__((vector_size(16)));
+  const auto load = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  bool columns_in_order = count == kLanes;
+  for (std::size_t l = 0; l < count; ++l) columns_in_order = columns_in_order && column[l] == l;
+  // Compiled twice, so that the common case (a full block of whole registers to consecutive columns) has a fixed
+  // trip count and no per-store test.
+  const auto run = [&](auto in_order_tag) {
+  constexpr bool in_order = decltype(in_order_tag)::value;
+  const std::size_t lanes = in_order ? kLanes : count;
+  for (std::size_t l = 0; l < lanes; l += 2) {
+    const bool both = in_order || l + 1 < count;
+    const V d = load(&sd[l]);
+    const V n[3] = {load(&this->n[0][l]), load(&this->n[1][l]), load(&this->n[2][l])};
+    const V xa[3] = {load(&this->xa[0][l]), load(&this->xa[1][l]), load(&this->xa[2][l])};
+    const V xb[3] = {load(&this->xb[0][l]), load(&this->xb[1][l]), load(&this->xb[2][l])};
+    // The support-map Jacobians (world_support_jacobian()'s formula and order of operations; it is even in n).
+    const auto curvature = [&](const Side& side, V (&H)[3][3]) {
+      V R[3][3], B[3][3], Bn[3];
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) R[i][k] = load(&side.R[3 * i + k][l]);
+      const V D[3] = {load(&side.radii2[0][l]), load(&side.radii2[1][l]), load(&side.radii2[2][l])};
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+          B[i][j] = B[j][i] = R[i][0] * D[0] * R[j][0] + R[i][1] * D[1] * R[j][1] + R[i][2] * D[2] * R[j][2];
+      for (int i = 0; i < 3; ++i) Bn[i] = B[i][0] * n[0] + B[i][1] * n[1] + B[i][2] * n[2];
+      const V m2 = n[0] * Bn[0] + n[1] * Bn[1] + n[2] * Bn[2];
+      const V m = {std::sqrt(m2[0]), std::sqrt(m2[1])};
+      const V zero = {0.0, 0.0};
+      const V inv_m = m2 > 0.0 ? 1.0 / m : zero, inv_m3 = inv_m * inv_m * inv_m;
+      const V r = load(&side.round[l]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          H[i][j] = load(&side.H0[3 * i + j][l]) + B[i][j] * inv_m - Bn[i] * Bn[j] * inv_m3 +
+                    r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
+    };
+    V Ha[3][3], Hb[3][3];
+    curvature(a, Ha);
+    curvature(b, Hb);
+    // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
+    const V m00 = d + Ha[0][0] + Hb[0][0], m11 = d + Ha[1][1] + Hb[1][1], m22 = d + Ha[2][2] + Hb[2][2];
+    const V m01 = Ha[0][1] + Hb[0][1], m02 = Ha[0][2] + Hb[0][2], m12 = Ha[1][2] + Hb[1][2];
+    const V c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
+    const V c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
+    const V inv = 1.0 / (m00 * c00 + m01 * c01 + m02 * c02);
+    const V K[3][3] = {{c00 * inv, c01 * inv, c02 * inv}, {c01 * inv, c11 * inv, c12 * inv},
+                       {c02 * inv, c12 * inv, c22 * inv}};
+    // Fa_w: row i of H_a [n]x is (row i of H_a) x n; minus [x_a]x.
+    V F[3][3];
+    for (int i = 0; i < 3; ++i) {
+      F[i][0] = Ha[i][1] * n[2] - Ha[i][2] * n[1];
+      F[i][1] = Ha[i][2] * n[0] - Ha[i][0] * n[2];
+      F[i][2] = Ha[i][0] * n[1] - Ha[i][1] * n[0];
+    }
+    F[0][1] += xa[2], F[0][2] -= xa[1], F[1][0] -= xa[2], F[1][2] += xa[0], F[2][0] += xa[1], F[2][1] -= xa[0];
+    V Y[3][6];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        Y[i][j] = K[i][j];
+        Y[i][3 + j] = K[i][0] * F[0][j] + K[i][1] * F[1][j] + K[i][2] * F[2][j];
+      }
+    V nY[6];
+    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
+    const auto put = [&](int e, V v) {
+      if (in_order && both) {
+        std::memcpy(&out[e][l], &v, sizeof v);
+      } else {
+        out[e][column[l]] = v[0];
+        if (both) out[e][column[l + 1]] = v[1];
+      }
+    };
+    put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
+    put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
+    put(6, n[0]), put(7, n[1]), put(8, n[2]);
+    put(9, xb[1] * n[2] - xb[2] * n[1]), put(10, xb[2] * n[0] - xb[0] * n[2]), put(11, xb[0] * n[1] - xb[1] * n[0]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const int e = 6 * i + j;
+        const V wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
+        const V wa = wb + d * Y[i][j];
+        const V dn = n[i] * nY[j] - Y[i][j];
+        put(12 + e, wa);  // witness_a_a
+        put(48 + e, wb);  // witness_b_a
+        put(84 + e, dn);  // normal_a
+        // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
+        if (j < 3) {
+          const double one = i == j ? 1.0 : 0.0;
+          put(30 + e, one - wa), put(66 + e, one - wb), put(102 + e, 0.0 - dn);
+        } else if (j - 3 == i) {
+          put(30 + e, 0.0 - wa), put(66 + e, 0.0 - wb), put(102 + e, 0.0 - dn);
+        } else {
+          const int k = j - 3, other = 3 - i - k;
+          // -[x]x(i, k) = eps(i, k, other) x_other
+          if ((i + 1) % 3 == k) {
+            put(30 + e, xa[other] - wa), put(66 + e, xb[other] - wb), put(102 + e, n[other] - dn);
+          } else {
+            put(30 + e, -xa[other] - wa), put(66 + e, -xb[other] - wb), put(102 + e, -n[other] - dn);
+          }
+        }
+      }
+  }
+  };
+  if (columns_in_order) run(std::true_type{});
+  else run(std::false_type{});
+}
+
+void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,
+                      const CurvedSide* curved_b) {
+  const std::size_t l = count++;
+  column[l] = col;
+  sd[l] = g.distance;
+  for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+  const auto side = [&](Side& s, const CurvedSide* c, const Eigen::Matrix3d& H) {
+    for (int i = 0; i < 3; ++i) {
+      s.radii2[i][l] = c ? c->radii2(i) : 0.0;
+      for (int j = 0; j < 3; ++j) {
+        s.H0[3 * i + j][l] = c ? 0.0 : H(i, j);
+        s.R[3 * i + j][l] = c ? (*c->R)(i, j) : 0.0;
+      }
+    }
+    s.round[l] = c ? c->round : 0.0;
+  };
+  side(a, curved_a, g.H_a);
+  side(b, curved_b, g.H_b);
+}
+
+namespace {
+
+// Polytopes without inflation (H_a = H_b = 0) separated, with up to two independent flats (vertex-vertex,
+// vertex-face, vertex-edge, edge-edge: the hull pairs): the saddle-point system has M0 = sd I, so with P the projector on the
+// flats' span (in the tangent plane) its solution for the twist of a is y = (I - P) F_a / sd + G, G the
+// constraint part in the flats' span (C^T G = c), and C mu = F_a - sd y. Closed forms, per case:
+//   a has no flats (a vertex against b's edge or face): G = 0, dx_a = F_a (rigid), dx_b = dx_a - sd y = P F_a;
+//   b has none: G = [0, P [n]x], dx_b = 0, dx_a = sd y;
+//   edge A of a against edge B of b: G = [0, B' (A x n)^T / (A . B')] (B' = n x B, so B^T G = 0 and
+//   A^T G = A^T [0, [n]x]), dx_b = B (A'^T (F_a - sd y)) / (B . A') (the B part of C mu, A' = n x A),
+//   dx_a = dx_b + sd y;
+// and dn = -(I - n n^T) y. The general elimination below (Gram-Schmidt, an eigenvalue test, two 3x6 solves)
+// cost ~2500 instructions per hull pair. Returns false (the general path decides) for dependent flats.
+void write_polytope(const PairGeometry& g, const Mat36& y, const Mat36& wa, const Mat36& wb, double* s,
+                    std::size_t st);
+
+bool polytope_jacobians(const PairGeometry& g, double* s, std::size_t st) {
+  const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
+  const double sd = g.distance;
+  if (k > 2 || !(sd > 1e-9 * g.scale) || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0)) return false;
+  const Eigen::Vector3d& n = g.normal;
+  Mat36 F;
+  F << Eigen::Matrix3d::Identity(), -skew(g.witness_a);
+  Mat36 y, wa, wb;
+  if (k == 0) {  // vertex against vertex: both points move rigidly, the normal turns (y = F_a / sd)
+    y = F / sd;
+    wa = F;
+    wb.setZero();
+    return write_polytope(g, y, wa, wb, s, st), true;
+  }
+  Eigen::Vector3d c[2];
+  for (int j = 0; j < ka; ++j) c[j] = g.flat_a.col(j);
+  for (int j = 0; j < kb; ++j) c[ka + j] = g.flat_b.col(j);
+  const Eigen::Vector3d q0 = c[0].normalized();
+  Eigen::Matrix3d P = q0 * q0.transpose();
+  if (k == 2) {
+    const Eigen::Vector3d r = c[1] - q0.dot(c[1]) * q0;
+    if (!(r.norm() > 1e-6)) return false;  // the general path's independence test (its columns are scale * flat)
+    const Eigen::Vector3d q1 = r.normalized();
+    P += q1 * q1.transpose();
+  }
+  y = ((Eigen::Matrix3d::Identity() - P) * F) / sd;
+  if (ka == 0) {
+    wa = F;
+    wb = F - sd * y;
+  } else if (kb == 0) {
+    y.rightCols<3>() += P * skew(n);
+    wb.setZero();
+    wa = sd * y;
+  } else {
+    const Eigen::Vector3d& A = c[0];
+    const Eigen::Vector3d& B = c[1];
+    const Eigen::Vector3d A_perp = n.cross(A), B_perp = n.cross(B);
+    y.rightCols<3>() += B_perp * (A.cross(n).transpose() / A.dot(B_perp));
+    wb = B * ((A_perp.transpose() * (F - sd * y)) / B.dot(A_perp));
+    wa = wb + sd * y;
+  }
+  write_polytope(g, y, wa, wb, s, st);
+  return true;
+}
+
+void write_polytope(const PairGeometry& g, const Mat36& y, const Mat36& wa, const Mat36& wb, double* s,
+                    std::size_t st) {
+  const Eigen::Vector3d& n = g.normal;
+  const Mat36 dn = n * (n.transpose() * y) - y;
+  double n_[3] = {n.x(), n.y(), n.z()}, xa[3], xb[3], wa_[3][6], wb_[3][6], dn_[3][6];
+  for (int i = 0; i < 3; ++i) {
+    xa[i] = g.witness_a(i);
+    xb[i] = g.witness_b(i);
+    for (int j = 0; j < 6; ++j) wa_[i][j] = wa(i, j), wb_[i][j] = wb(i, j), dn_[i][j] = dn(i, j);
+  }
+  write_from_twist_a(n_, xa, xb, wa_, wb_, dn_, s, st);
+}
+
+}  // namespace
+
+void write_jacobians(const PairJacobians& J, double* s, std::size_t stride) {
+  for (int k = 0; k < 6; ++k) {
+    s[k * stride] = J.distance_a(k);
+    s[(6 + k) * stride] = J.distance_b(k);
+  }
+  std::size_t e = 12;
+  for (const Mat36* m : {&J.witness_a_a, &J.witness_a_b, &J.witness_b_a, &J.witness_b_b, &J.normal_a, &J.normal_b})
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 6; ++c) s[(e++) * stride] = (*m)(r, c);
+}
+
+IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride) {
+  if (polytope_jacobians(g, slot, stride)) return {};
+  if (smooth_pair(g)) {
+    SmoothLanes lanes{};  // one lane; differentiate_results() batches its smooth pairs through StoreBlock instead
+    lanes.add(0, g);
+    double out[StoreEntries][SmoothLanes::kLanes] = {};
+    double* rows[StoreEntries];
+    for (int e = 0; e < StoreEntries; ++e) rows[e] = out[e];
+    lanes.solve(rows);
+    for (int e = 0; e < StoreEntries; ++e) slot[e * stride] = out[e][0];
+    return {};
+  }
+  const PairJacobians J = constrained_jacobians(g);
+  write_jacobians(J, slot, stride);
+  return {J.singular, J.dependent};
+}
+
+namespace {
+
+// The general case: flats, touching or penetrating pairs.
+PairJacobians constrained_jacobians(const PairGeometry& g) {
   PairJacobians J;
   distance_gradients(g, J.distance_a, J.distance_b);
   const Eigen::Vector3d& n = g.normal;
   const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
   const Eigen::Matrix3d M0 = g.distance * Eigen::Matrix3d::Identity() + g.H_a + g.H_b;
-  if (k == 0 && g.distance > 1e-9 * g.scale) {
-    smooth_jacobians(g, M0, J);
-    return J;
-  }
   if (k > 3) {  // four flat directions in 3-D are dependent
     J.dependent = true;
     set_nan(J);
@@ -141,4 +404,5 @@ PairJacobians implicit_jacobians(const PairGeometry& g) {
   return J;
 }
 
+}  // namespace
 }  // namespace batchcol::detail

@@ -28,6 +28,8 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
+
 namespace batchcol::detail {
 
 using Mat36 = Eigen::Matrix<double, 3, 6>;
@@ -69,9 +71,61 @@ inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b
   grad_b << g.normal.transpose(), g.witness_b.cross(g.normal).transpose();
 }
 
-/// Everything above for one pair; `singular` (Jacobians left NaN) when the system (its constraint rows scaled to
-/// lengths) has an eigenvalue within 1e-9 of the problem's length scale: its inverse would magnify the witness
-/// points' own error (~1e-8 of that scale at the default GJK tolerance) beyond any meaning.
-PairJacobians implicit_jacobians(const PairGeometry& g);
+/// Entries per pair of the derivative outputs (2 x 6 + 6 x 18).
+constexpr int StoreEntries = 120;
+
+/// A sphere's or an ellipsoid's support-map Jacobian left to SmoothLanes to compute (world_support_jacobian()'s
+/// formula): the shape's rotation, its squared radii (zero for a sphere) and its round radius (sphere radius plus
+/// inflation, or the ellipsoid's inflation).
+struct CurvedSide {
+  const Eigen::Matrix3d* R = nullptr;
+  Eigen::Vector3d radii2 = Eigen::Vector3d::Zero();
+  double round = 0.0;
+};
+
+/// The separated pairs without flats (the smooth common case) of a block of up to kLanes pairs, in
+/// structure-of-arrays order (lane l of every array), so that their implicit-function Jacobians are computed
+/// across the lanes in SIMD registers. Lanes are filled in order (lane l goes to output column column[l]); a
+/// register half past `count` is computed on whatever it holds and not written.
+struct SmoothLanes {
+  static constexpr std::size_t kLanes = 8;
+  // Per side (a, b): H = H0 + B / m - (B n)(B n)^T / m^3 + round (I - n n^T) with B = R diag(radii2) R^T and
+  // m = sqrt(n^T B n) (0 / 0 taken as 0): a sphere or ellipsoid, or the given H0 (radii2 = round = 0).
+  struct Side {
+    alignas(64) double H0[9][kLanes], R[9][kLanes], radii2[3][kLanes], round[kLanes];
+  };
+  alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes];
+  Side a, b;
+  std::size_t column[kLanes];
+  std::size_t count = 0;
+  void clear() { count = 0; }
+  /// The next lane takes pair g, for output column `column`; a null side uses g.H_a / g.H_b.
+  void add(std::size_t column, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
+           const CurvedSide* curved_b = nullptr);
+  /// Writes the 120 entries of every lane l < count to out[e][column[l]] (write_jacobians()'s order; out[e] points
+  /// to column 0 of entry e: a block buffer's row or the output array itself). Whole registers are stored when
+  /// the columns are 0, 1, 2, ... (a block of smooth pairs only), single lanes otherwise.
+  void solve(double* const* out) const;
+};
+
+/// True when the pair takes SmoothLanes: no flats and separated beyond the singularity threshold.
+inline bool smooth_pair(const PairGeometry& g) {
+  return g.flats_a + g.flats_b == 0 && g.distance > 1e-9 * g.scale;
+}
+
+/// Writes J's 120 entries to `slot` (entry e at slot[e * stride], in StoreBlock's order: the distance gradients
+/// of a and b, then witness_a_a, witness_a_b, witness_b_a, witness_b_b, normal_a, normal_b, row-major).
+void write_jacobians(const PairJacobians& J, double* slot, std::size_t stride);
+
+struct IftFlags {
+  bool singular = false;   // see PairJacobians
+  bool dependent = false;
+};
+
+/// Everything above for one pair, written to `slot` as by write_jacobians(); `singular` (Jacobians left NaN) when
+/// the system (its constraint rows scaled to lengths) has an eigenvalue within 1e-9 of the problem's length scale:
+/// its inverse would magnify the witness points' own error (~1e-8 of that scale at the default GJK tolerance)
+/// beyond any meaning.
+IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride);
 
 }  // namespace batchcol::detail

@@ -32,25 +32,43 @@ template <class Body> void for_pairs(int threads, std::size_t n, const Body& bod
 bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
                       PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b);
 
-/// Collects the Jacobians of up to 8 consecutive pairs and writes them array by array: each of the 120 SoA
-/// arrays then gets one whole cache line per flush. Writing pair by pair touched 120 lines per pair, which for a
-/// power-of-two batch size (arrays a multiple of 4 KB apart) all fall in one L1 set: 4.5x a witness query in
-/// wall time for 1.6x in instructions (4096 ellipsoid pairs, 1 thread). Flushes when a pair is not the next one
-/// and on destruction; one block per task range.
+/// Collects the derivatives of up to 8 consecutive pairs in a structure-of-arrays buffer (entry e of slot j at
+/// buf_[e][j], in the order of the output arrays: distance_gradient_a/b (6 each), then witness_a_wrt_a,
+/// witness_a_wrt_b, witness_b_wrt_a, witness_b_wrt_b, normal_wrt_a, normal_wrt_b (18 each, row-major)) and writes
+/// them array by array: each of the 120 SoA arrays then gets one whole cache line per flush. Writing pair by pair
+/// touched 120 lines per pair, which for a power-of-two batch size (arrays a multiple of 4 KB apart) all fall in
+/// one L1 set: 4.5x a witness query in wall time for 1.6x in instructions (4096 ellipsoid pairs, 1 thread). The
+/// buffer is filled in place (slot()) rather than through a PairJacobians copy and a member-pointer walk, which
+/// cost ~1100 instructions per pair. Flushes when a pair is not the next one and on destruction; one block per
+/// task range.
 class StoreBlock {
  public:
+  static constexpr int kEntries = StoreEntries;
+  static constexpr std::size_t kStride = SmoothLanes::kLanes;  // slot entries are kStride doubles apart
   explicit StoreBlock(DerivativeResults& d) : d(d) {}
   StoreBlock(const StoreBlock&) = delete;
   StoreBlock& operator=(const StoreBlock&) = delete;
   ~StoreBlock() { flush(); }
+  /// The slot of pair i (entry e at slot[e * kStride]); every entry must be written before the next call.
+  double* slot(std::size_t i) {
+    if (count_ == kStride || (count_ > 0 && i != first_ + count_)) flush();
+    if (count_ == 0) first_ = i;
+    return &buf_[0][count_++];
+  }
   void add(std::size_t i, const PairJacobians& J);
+  /// Queues pair i (smooth_pair(g)) for the block's SIMD solve at the flush.
+  void add_smooth(std::size_t i, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
+                  const CurvedSide* curved_b = nullptr) {
+    slot(i);
+    smooth_.add(count_ - 1, g, curved_a, curved_b);
+  }
   void flush();
 
   DerivativeResults& d;
 
  private:
-  static constexpr std::size_t kPairs = 8;
-  PairJacobians J_[kPairs];
+  alignas(64) double buf_[kEntries][kStride] = {};
+  SmoothLanes smooth_{};  // value-initialised: an unused register half is computed (not written) on initialised numbers
   std::size_t first_ = 0, count_ = 0;
 };
 

@@ -81,7 +81,9 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   const bool features = s.type != ShapeType::sphere && s.type != ShapeType::ellipsoid;
   const double radius_b = features ? s.bounding_radius() : 0.0;
   const double tol = kExactFeature * radius_b, curved_tol = kCurvedFeature * radius_b;
-  const double rho = features ? std::hypot(u.x(), u.y()) : 0.0, rho_p = features ? std::hypot(p.x(), p.y()) : 0.0;
+  // Only the solids of revolution look at the radial coordinates (hypot is ~100 instructions per call).
+  const bool round = s.type == ShapeType::cylinder || s.type == ShapeType::cone;
+  const double rho = round ? std::hypot(u.x(), u.y()) : 0.0, rho_p = round ? std::hypot(p.x(), p.y()) : 0.0;
   const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
   switch (s.type) {
     case ShapeType::sphere: break;
@@ -139,6 +141,31 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   if (r > 0.0) J.H += r * (Eigen::Matrix3d::Identity() - u * u.transpose());
   J.zero = J.zero && r == 0.0 && J.flats == 0;
   return J;
+}
+
+bool world_support_jacobian(const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& n, Eigen::Matrix3d& H) {
+  if (s.type != ShapeType::sphere && s.type != ShapeType::ellipsoid) return false;
+  const double r = round_radius(s);
+  if (s.type == ShapeType::sphere) {
+    H = r * (Eigen::Matrix3d::Identity() - n * n.transpose());
+    return true;
+  }
+  // B = R diag(radii^2) R^T, the world-frame shape matrix: S(n) = B n / m with m = sqrt(n^T B n), so
+  // dS/dn = B / m - (B n)(B n)^T / m^3 (the local formula of support_jacobian() rotated, without the two 3x3
+  // products of R H R^T). Even in n, so the same at -n.
+  const Eigen::Vector3d r2 = s.size.cwiseProduct(s.size);
+  const Eigen::Matrix3d RD = R * r2.asDiagonal();
+  Eigen::Matrix3d B;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) B(i, j) = B(j, i) = RD(i, 0) * R(j, 0) + RD(i, 1) * R(j, 1) + RD(i, 2) * R(j, 2);
+  const Eigen::Vector3d Bn = B * n;
+  const double m = std::sqrt(n.dot(Bn)), inv_m = 1.0 / m, inv_m3 = inv_m * inv_m * inv_m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) H(i, j) = H(j, i) = B(i, j) * inv_m - Bn(i) * Bn(j) * inv_m3;
+  if (r > 0.0)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) H(i, j) += r * ((i == j ? 1.0 : 0.0) - n(i) * n(j));
+  return true;
 }
 
 Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {

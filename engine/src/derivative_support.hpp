@@ -34,6 +34,12 @@ struct SupportJacobian {
 /// inflation included).
 SupportJacobian support_jacobian(const Shape& shape, const Eigen::Vector3d& u, const Eigen::Vector3d& witness);
 
+/// support_jacobian() of a sphere or an ellipsoid (returns false for the other types, leaving H alone) at the unit
+/// WORLD direction n (or -n: the same), in the world frame, R being the shape's rotation: straight from the world
+/// shape matrix, without the local direction and the rotation of the local Jacobian.
+bool world_support_jacobian(const Shape& shape, const Eigen::Matrix3d& R, const Eigen::Vector3d& n,
+                            Eigen::Matrix3d& H);
+
 /// The full support point (core plus inflation radius) of `shape` at local direction u (not necessarily unit).
 Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
 

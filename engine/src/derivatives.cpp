@@ -6,7 +6,9 @@
 #include "derivative_support.hpp"
 #include "shape_table_access.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -32,37 +34,36 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
   return true;
 }
 
-void StoreBlock::add(std::size_t i, const PairJacobians& J) {
-  if (count_ > 0 && i != first_ + count_) flush();
-  if (count_ == 0) first_ = i;
-  J_[count_++] = J;
-  if (count_ == kPairs) flush();
-}
+void StoreBlock::add(std::size_t i, const PairJacobians& J) { write_jacobians(J, slot(i), kStride); }
 
 void StoreBlock::flush() {
   if (count_ == 0) return;
-  const std::size_t n = d.status.size(), c = count_;
-  const auto put6 = [&](Vec6Array& a, Row6 PairJacobians::*row) {
-    for (int k = 0; k < 6; ++k) {
-      double* p = a.data.data() + k * n + first_;
-      for (std::size_t j = 0; j < c; ++j) p[j] = (J_[j].*row)(k);
+  const std::size_t n = d.status.size();
+  double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
+                             d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
+                             d.witness_b_wrt_a.data.data(),     d.witness_b_wrt_b.data.data(),
+                             d.normal_wrt_a.data.data(),        d.normal_wrt_b.data.data()};
+  // Entries 0-11 are the two 6-vectors, then 18 per matrix: entry e is row e % 6 (vectors) or e - start of the
+  // matrix's (6 r + c), which is exactly the SoA index k of data[k * n + i].
+  double* rows[kEntries];
+  int e = 0;
+  for (int a = 0; a < 8; ++a)
+    for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
+  if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
+    smooth_.solve(rows);
+  } else {
+    if (smooth_.count > 0) {
+      double* buffer_rows[kEntries];
+      for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
+      smooth_.solve(buffer_rows);
     }
-  };
-  const auto put36 = [&](Mat36Array& a, Mat36 PairJacobians::*m) {
-    for (int r = 0; r < 3; ++r)
-      for (int col = 0; col < 6; ++col) {
-        double* p = a.data.data() + (6 * r + col) * n + first_;
-        for (std::size_t j = 0; j < c; ++j) p[j] = (J_[j].*m)(r, col);
-      }
-  };
-  put6(d.distance_gradient_a, &PairJacobians::distance_a);
-  put6(d.distance_gradient_b, &PairJacobians::distance_b);
-  put36(d.witness_a_wrt_a, &PairJacobians::witness_a_a);
-  put36(d.witness_a_wrt_b, &PairJacobians::witness_a_b);
-  put36(d.witness_b_wrt_a, &PairJacobians::witness_b_a);
-  put36(d.witness_b_wrt_b, &PairJacobians::witness_b_b);
-  put36(d.normal_wrt_a, &PairJacobians::normal_a);
-  put36(d.normal_wrt_b, &PairJacobians::normal_b);
+    if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
+      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
+    } else {
+      for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
+    }
+  }
+  smooth_.clear();
   count_ = 0;
 }
 
@@ -109,32 +110,63 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   }
   const Shape& a = shapes[batch.shape_a[i]];
   const Shape& b = shapes[batch.shape_b[i]];
-  const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
   DerivativeStatus status = DerivativeStatus::smooth;
   if (o.method == DerivativeMethod::analytic) {
-    const Eigen::Vector3d p_a = R_a.transpose() * (g.witness_a - batch.translation_a[i]);
-    const Eigen::Vector3d p_b = R_b.transpose() * (g.witness_b - batch.translation_b[i]);
-    const SupportJacobian J_a = support_jacobian(a, u_a, p_a), J_b = support_jacobian(b, u_b, p_b);
-    g.H_a = R_a * J_a.H * R_a.transpose();
-    g.H_b = R_b * J_b.H * R_b.transpose();
-    g.flats_a = J_a.flats;
-    g.flats_b = J_b.flats;
-    g.flat_a = R_a * J_a.flat;
-    g.flat_b = R_b * J_b.flat;
-    if (J_a.approximate || J_b.approximate) {
+    // Spheres and ellipsoids (no features, no flats): their support-map Jacobian is left to the lanes of
+    // SmoothLanes (or computed below when the other side has flats); the others go through their local frame,
+    // where the features are tested.
+    const auto side = [&](const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& witness,
+                          const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H, int& flats,
+                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, bool& approximate, CurvedSide& curved) {
+      if (s.type == ShapeType::sphere || s.type == ShapeType::ellipsoid) {
+        curved.R = &R;
+        if (s.type == ShapeType::ellipsoid) curved.radii2 = s.size.cwiseProduct(s.size);
+        curved.round = s.inflation + (s.type == ShapeType::sphere ? s.size.x() : 0.0);
+        return;
+      }
+      const Eigen::Vector3d u = sign * (R.transpose() * g.normal), p = R.transpose() * (witness - t);
+      const SupportJacobian J = support_jacobian(s, u, p);
+      // Polytopes without inflation have no curvature: skip the two 3x3 products.
+      if (J.H.isZero(0.0)) H.setZero();
+      else H = R * J.H * R.transpose();
+      flats = J.flats;
+      if (flats > 0) flat = R * J.flat;
+      zero = J.zero;
+      approximate = J.approximate;
+    };
+    bool zero_a = false, zero_b = false, approximate_a = false, approximate_b = false;
+    CurvedSide curved_a, curved_b;
+    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, approximate_a,
+         curved_a);
+    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, approximate_b,
+         curved_b);
+    if (approximate_a || approximate_b) {
       status = DerivativeStatus::nonsmooth;
-    } else if (J_a.zero || J_b.zero) {
+    } else if (zero_a || zero_b) {
       status = DerivativeStatus::zero_curvature;
     }
+    // Two polytope vertices (no curvature, no flats): polytope_jacobians' closed form, cheaper than a lane.
+    if (smooth_pair(g) && (curved_a.R || curved_b.R || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
+      out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);
+      d.status[i] = status;
+      return;
+    }
+    if (curved_a.R) world_support_jacobian(a, R_a, g.normal, g.H_a);
+    if (curved_b.R) world_support_jacobian(b, R_b, g.normal, g.H_b);
   } else {
+    const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
     const auto direction_noise = [&](const Shape& s) {
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
     g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1) * R_a.transpose();
     g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2) * R_b.transpose();
   }
-  const PairJacobians J = implicit_jacobians(g);
-  store(out, i, J);
+  if (smooth_pair(g)) {
+    out.add_smooth(i, g);
+    d.status[i] = status;
+    return;
+  }
+  const IftFlags J = implicit_jacobians(g, out.slot(i), StoreBlock::kStride);
   d.status[i] = J.dependent ? DerivativeStatus::nonsmooth : J.singular ? DerivativeStatus::singular : status;
 }
 
