@@ -137,6 +137,11 @@ class BatchLimitsCli : public testing::CliTest {
 };
 
 TEST_F(BatchLimitsCli, HostileFilesAreRefusedWithinASmallMultipleOfTheirSize) {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's shadow memory and quarantine multiply the CLI's peak (measured 157-243 MB for these 29 MB
+  // files under tools/run.sh asan-test): a bound on peak memory means nothing there. The plain build checks it.
+  GTEST_SKIP() << "peak-memory bound not meaningful under AddressSanitizer";
+#endif
   // 30 MB each: the whole-file DOM took 36x (`{},`), 26x (`[],`) and ~100x (deep `[`) of the file size.
   constexpr std::size_t kUnits = 10'000'000;
   const std::vector<std::pair<std::string, std::function<std::string()>>> files = {
