@@ -150,9 +150,8 @@ std::size_t gjk_pairs<float>(InstructionSet isa, const PairView& in, ShapeType a
                              const ResultView& out, std::uint32_t* fallback) {
   require_resolved(options.solver);
   // Large hulls climb lane by lane, so 16 float lanes gain nothing over 8 in the climb, and the 32 hulls in flight
-  // probably crowd the cache (measured with the same binary, --isa avx512 vs avx2, 2 threads, float boolean: convex250 419 vs
-  // 385 ns per pair, convex940 597 vs 505). Every instruction set gives the same bits, so such groups run on the
-  // AVX2 build's 8 lanes.
+  // probably crowd the cache: measured faster on the AVX2 build's 8 lanes (numbers in the commit that made this
+  // choice). Every instruction set gives the same bits, so such groups run there.
   if (isa == InstructionSet::avx512 && (a == ShapeType::convex || b == ShapeType::convex) &&
       mostly_large_hulls(in, a, b, pairs, n))
     isa = InstructionSet::avx2;

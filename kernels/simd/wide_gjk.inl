@@ -63,8 +63,8 @@ template <class T> struct WideGjk {
     SmallHulls* table = nullptr;  // the rows; set (by Rows) only when the side is convex
   };
   /// The rows live outside Side and Lanes: 3 KB per side, written before read (rows [0, rows) of loaded lanes),
-  /// so they are neither zeroed with the lane state at every run() (the run of one type-pair group; a mixed
-  /// batch has ~26 pairs per group) nor interleaved with the loop's hot fields.
+  /// so they are neither zeroed with the lane state at every run() (the run of one type-pair group, a few dozen
+  /// pairs in a mixed batch) nor interleaved with the loop's hot fields.
   struct SmallHulls {
     real vx[kSmallRows], vy[kSmallRows], vz[kSmallRows];
   };
@@ -308,6 +308,14 @@ template <class T> struct WideGjk {
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
+  /// Face m of tetrahedron p[0..3] that keeps vertex 3, per lane (m = 0: old vertices 1, 2; m = 1: 0, 2; m = 2: 0,
+  /// 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
+  AI static Face face_keeping_3(const V3* p, mask m0, mask m2, mask& i, mask& j) {
+    i = select(m0, splat_mask(1), splat_mask(0));
+    j = select(m2, splat_mask(1), splat_mask(2));
+    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), p[3]);
+  }
+
   /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
   /// remaining candidate (`taken[m]` says which), so the number of rounds is the largest candidate count of one
   /// lane (usually 1), not the number of distinct candidates over the lanes.
@@ -353,11 +361,11 @@ template <class T> struct WideGjk {
       choice = select(take, splat_mask(m), choice);
       have_first |= cand[m];
     }
+    mask fi, fj;
     const mask first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
-    const Face ff = face(pick(first_0, p[1], p[0]), pick(first_2, p[1], p[2]), p[3]);
+    const Face ff = face_keeping_3(p, first_0, first_2, fi, fj);
     const mask first_ok = have_first & ff.use;
-    const Proj first = face_proj(ff, select(first_0, splat_mask(1), splat_mask(0)),
-                                 select(first_2, splat_mask(1), splat_mask(2)), splat_mask(3));
+    const Proj first = face_proj(ff, fi, fj, splat_mask(3));
     if (!any(want & ~inside & ~first_ok)) return pick(inside, in, first);
     // Edge e joins old vertex e to vertex 3.
     const Edge E[3] = {edge(p[0], p[3], splat_mask(0), splat_mask(3)), edge(p[1], p[3], splat_mask(1), splat_mask(3)),
@@ -377,8 +385,8 @@ template <class T> struct WideGjk {
       const mask round = next_round(remaining, taken);
       if (!any(round)) break;
       // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
-      const mask i = select(taken[0], splat_mask(1), splat_mask(0)), j = select(taken[2], splat_mask(1), splat_mask(2));
-      const Face f = face(pick(taken[0], p[1], p[0]), pick(taken[2], p[1], p[2]), p[3]);
+      mask i, j;
+      const Face f = face_keeping_3(p, taken[0], taken[2], i, j);
       const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
       const mask to_j = takes_j(f, ni, nj);
       const real n2 = select(f.use, norm2(f.x), select(to_j, nj, ni));
@@ -406,7 +414,7 @@ template <class T> struct WideGjk {
     V3 w[4];
     // The points of A and B behind the simplex (witness levels) stay in the fixed slot where they were written;
     // slot[m] says which slot holds those of simplex vertex m. Only w is compacted after each projection (the
-    // projection reads it in order): moving a and b too was ~120 selects per iteration.
+    // projection reads it in order); a slot index per vertex is cheaper to move than six coordinates.
     V3 a[4], b[4];
     mask slot[4]{};
     real lambda[4]{};
@@ -696,7 +704,8 @@ template <class T> struct WideGjk {
             used[q] = splat_mask(0);
             for (int m = 0; m < 3; ++m) used[q] |= (L.count > splat_mask(m)) & (L.slot[m] == splat_mask(q));
           }
-          const mask free = select(~used[0], splat_mask(0), select(~used[1], splat_mask(1), select(~used[2], splat_mask(2), splat_mask(3))));
+          const mask free = select(~used[0], splat_mask(0),
+                                   select(~used[1], splat_mask(1), select(~used[2], splat_mask(2), splat_mask(3))));
           for (int q = 0; q < 4; ++q) {
             const mask here = live & (free == splat_mask(q));
             L.a[q] = pick(here, sa, L.a[q]);

@@ -51,8 +51,8 @@ template <class T> struct WideGjkPairs {
     bool normalize = !(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid);
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
-    // zeroed the chunk's 13 KB at every run() (one run() per type-pair group of a tile, ~26 pairs in a mixed
-    // batch: ~500 instructions per pair counted by callgrind in the demo).
+    // would zero the chunk's 13 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs in a
+    // mixed batch).
     Source(const PairView& in_, const QueryOptions& options_, ShapeType a, ShapeType b, const std::uint32_t* pairs_,
            std::size_t n_, const ResultView& out_, std::uint32_t* fallback_)
         : in(in_), options(options_), type_a(a), type_b(b), pairs(pairs_), n(n_), out(out_), fallback(fallback_) {}
