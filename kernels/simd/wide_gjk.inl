@@ -78,6 +78,8 @@ template <class T> struct WideGjk {
     }
   };
 
+  // Always inlined (AI above): left to itself GCC outlined one of its two inlined copies (the one in start()),
+  // a call and a type switch per support, when the batch-array refill changed.
   AI static V3 support(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
     switch (s.type) {
