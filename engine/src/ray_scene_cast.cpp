@@ -108,7 +108,9 @@ class Caster {
         return true;
       };
       using Leaf = decltype(leaf);
-      wide_(s_.wide.nodes().data(), r.wide, wide_limit(last),
+      WideRay w = r.wide;
+      w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
+      wide_(s_.wide.nodes().data(), w, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
       return;
     }

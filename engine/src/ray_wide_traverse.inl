@@ -26,6 +26,16 @@ inline void prefetch_node(const WideNode* nodes, std::uint32_t ref) {
   for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
 }
 
+// True when the ray's line passes the leaf's ball farther than its radius plus the margins (ray_wide_traverse.hpp).
+inline bool ball_misses(const float* b, const WideRay& r) {
+  const float x = b[0] - r.ball_o[0], y = b[1] - r.ball_o[1], z = b[2] - r.ball_o[2];
+  const float cx = y * r.ball_d[2] - z * r.ball_d[1], cy = z * r.ball_d[0] - x * r.ball_d[2],
+              cz = x * r.ball_d[1] - y * r.ball_d[0];
+  const float radius =
+      b[3] + r.ball_margin + kBallMargin * (__builtin_fabsf(x) + __builtin_fabsf(y) + __builtin_fabsf(z));
+  return cx * cx + cy * cy + cz * cz > radius * radius;
+}
+
 struct Entry {
   std::uint32_t ref;
   float t;
@@ -53,7 +63,12 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
   };
   for (;;) {
     if (e.ref & kLeafBit) {
-      if (!visit(context, e.ref & ~kLeafBit, limit) || !pop()) return;
+      const std::uint32_t leaf = e.ref & ~kLeafBit;
+      if (r.balls != nullptr && ball_misses(r.balls + 4 * std::size_t(leaf), r)) {
+        if (!pop()) return;
+        continue;
+      }
+      if (!visit(context, leaf, limit) || !pop()) return;
       continue;
     }
     const WideNode* n = nodes + e.ref;
