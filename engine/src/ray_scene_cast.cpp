@@ -29,12 +29,13 @@ struct Hit {
   ObjectHandle object;
 };
 
-// Batches from this size on are cast in RayOrder (below), on trees from this size on; records of rays this far ahead
-// in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies: +12% on 10k hulls, whose
-// 0.4 MB of wide nodes stay in the L2 anyway, and measured 15% slower there); it pays when the nodes do not fit a
-// core's L2 (1-2 MB on current x86 servers): 100k mixed objects, ~4 MB of nodes, +20% rays/s.
+// Batches from this size on are cast in RayOrder (below), on trees of at least kLargeTreeBytes of wide nodes; records
+// of rays this far ahead in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies:
+// +12% on 10k hulls, whose 0.4 MB of wide nodes stay in the L2 anyway, and measured 15% slower there); it pays when
+// the nodes do not fit a core's L2 (1-2 MB on current x86 servers): 100k mixed objects, +20% rays/s. The traversal
+// prefetches pushed nodes on such trees only, for the same reason.
 constexpr std::size_t kSortedCastMin = 4096;
-constexpr std::size_t kSortedCastMinTreeBytes = std::size_t(1) << 20;
+constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 constexpr std::size_t kPrefetchAhead = 8;
 
 bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
@@ -110,6 +111,7 @@ class Caster {
       using Leaf = decltype(leaf);
       WideRay w = r.wide;
       w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
+      w.prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
       wide_(s_.wide.nodes().data(), w, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
       return;
@@ -353,7 +355,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   // Closest and any hits of large batches are cast in RayOrder (all-hit rows are gathered per chunk in input order,
   // so that query keeps the input order; small batches gain nothing from the sort).
   if (!all && n >= kSortedCastMin && n < (std::size_t(1) << 32) &&
-      state_->wide.nodes().size() * sizeof(WideNode) >= kSortedCastMinTreeBytes) {
+      state_->wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes) {
     detail::run_with_threads(options.threads, [&] {
       RayOrder order(rays, state_->wide.nodes()[0]);
       std::vector<CastResult> results(n);

@@ -45,6 +45,7 @@ struct WideRay {
   float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
   float ball_margin;           // kBallMargin * |o|_1, rounded up
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
+  bool prefetch = false;         // request a pushed node's lines early (worth it when the nodes do not fit the L2)
 };
 
 /// The float ball of a leaf whose exact filter is the ball (c, bound): centre rounded to float, radius covering bound

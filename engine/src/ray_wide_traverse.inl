@@ -18,8 +18,9 @@ inline V load_at(const WideNode* node, std::uint32_t byte_offset) {
 inline V max_into(V x, V acc) { return x > acc ? x : acc; }
 inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 
-// A node that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): its four
-// cache lines are requested now, so that on scenes larger than the L2 the loads overlap the work in between.
+// A node that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
+// larger than the L2 (WideRay::prefetch) its four cache lines are requested now, so the loads overlap the work in
+// between; on smaller trees the lines are there anyway and the requests only cost issue slots.
 inline void prefetch_node(const WideNode* nodes, std::uint32_t ref) {
   if (ref & kLeafBit) return;
   const char* p = reinterpret_cast<const char*>(nodes + ref);
@@ -104,7 +105,7 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       const bool swap = entry[k1] < entry[k0];
       const int near = swap ? k1 : k0, far = swap ? k0 : k1;
       stack[top++] = Entry{n->child[far], entry[far]};
-      prefetch_node(nodes, n->child[far]);
+      if (r.prefetch) prefetch_node(nodes, n->child[far]);
       e = Entry{n->child[near], entry[near]};
       continue;
     }
@@ -118,7 +119,10 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
       hit[j] = x;
     }
-    for (int j = count - 1; j >= 1; --j) stack[top++] = hit[j], prefetch_node(nodes, hit[j].ref);
+    for (int j = count - 1; j >= 1; --j) {
+      stack[top++] = hit[j];
+      if (r.prefetch) prefetch_node(nodes, hit[j].ref);
+    }
     e = hit[0];  // the nearest child next, without a trip through the stack
   }
 }
