@@ -37,6 +37,7 @@ struct RaySceneIndex::State {
   RayBvh bvh;       // binary LBVH: built, refitted, and traversed (in double) by rays the float test cannot take
   WideBvh wide;     // its 8-wide collapse, traversed by every other ray
   std::vector<RayObject> leaves;      // leaf k = object bvh.leaf_object()[k]
+  std::vector<float> leaf_balls;      // per leaf: the wide traversal's float ball filter (make_leaf_ball)
   std::vector<RayObject> halfspaces;  // tested against every ray
   RaySceneTimings timings;
   bool rebuilt = false;

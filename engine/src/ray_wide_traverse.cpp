@@ -3,6 +3,7 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -81,7 +82,22 @@ WideRay make_wide_ray(const double o[3], const double d[3]) {
     r.o_near[k] = negative ? round_down(o[k]) : round_up(o[k]);
     r.o_far[k] = negative ? round_up(o[k]) : round_down(o[k]);
   }
+  const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  double o_length = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    r.ball_o[k] = static_cast<float>(o[k]);
+    r.ball_d[k] = static_cast<float>(d[k] / len);
+    o_length += std::fabs(o[k]);
+  }
+  r.ball_margin = round_up(double(kBallMargin) * o_length);
   return r;
+}
+
+void make_leaf_ball(const double c[3], double bound, float out[4]) {
+  double length = 0.0;
+  for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(c[k]), length += std::fabs(c[k]);
+  const double radius = bound * (1.0 + double(kBallMargin)) + double(kBallMargin) * length;
+  out[3] = bound > 0.0 && std::isfinite(radius) && radius < 0x1p100 ? std::max(round_up(radius), 0x1p-60f) : INFINITY;
 }
 
 float wide_limit(double t) { return round_up(t * double(kFarScale)); }

@@ -28,10 +28,29 @@ namespace batchcol {
 constexpr float kFarScale = 1.0f + 0x1p-20f;
 constexpr float kFarSlack = 0x1p-120f;
 
+// Leaf ball filter (optional, `balls`): most leaves a ray reaches miss their object, and the caller's exact double
+// filter (the object's bounding ball) rejects them after a call per leaf. With `balls` set (4 floats per leaf: centre
+// and radius, from make_leaf_ball()) the traversal rejects such leaves itself, in float, without the call; it only
+// rejects a leaf when the ray's line passes the centre farther than the radius plus kBallMargin of the lengths
+// involved (|o|_1, |c|_1, |c - o|_1). The float distance is within ~8 * 2^-24 of those lengths (origin, centre and
+// unit direction rounded to float, a cross product, squares), so a leaf the double filter keeps (radius widened by
+// 1e-12 of the same lengths) is never rejected, on any instruction set; leaves are visited in the same order either
+// way, so results are bitwise the same with or without it. Overflow gives inf / NaN, which never rejects; the radius
+// is at least 2^-60, so its square stays a normal float.
+constexpr float kBallMargin = 0x1p-16f;  // 32 times the error bound above
+
 struct WideRay {
   float o_near[3], o_far[3], inv[3];
   std::uint32_t near_offset[3], far_offset[3];  // byte offsets of the near / far plane arrays inside WideNode
+  float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
+  float ball_margin;           // kBallMargin * |o|_1, rounded up
+  const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
+  bool prefetch = false;         // request a pushed node's lines early (worth it when the nodes do not fit the L2)
 };
+
+/// The float ball of a leaf whose exact filter is the ball (c, bound): centre rounded to float, radius covering bound
+/// and the margin of the centre's length (see above); +inf (never rejects) when bound is not a positive finite number.
+void make_leaf_ball(const double c[3], double bound, float out[4]);
 
 /// True when the float test is safe for this ray (see above); o and d are the ray's origin and direction.
 bool wide_ray_supported(const double o[3], const double d[3]);

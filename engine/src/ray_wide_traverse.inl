@@ -18,6 +18,25 @@ inline V load_at(const WideNode* node, std::uint32_t byte_offset) {
 inline V max_into(V x, V acc) { return x > acc ? x : acc; }
 inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 
+// A node that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
+// larger than the L2 (WideRay::prefetch) its four cache lines are requested now, so the loads overlap the work in
+// between; on smaller trees the lines are there anyway and the requests only cost issue slots.
+inline void prefetch_node(const WideNode* nodes, std::uint32_t ref) {
+  if (ref & kLeafBit) return;
+  const char* p = reinterpret_cast<const char*>(nodes + ref);
+  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
+}
+
+// True when the ray's line passes the leaf's ball farther than its radius plus the margins (ray_wide_traverse.hpp).
+inline bool ball_misses(const float* b, const WideRay& r) {
+  const float x = b[0] - r.ball_o[0], y = b[1] - r.ball_o[1], z = b[2] - r.ball_o[2];
+  const float cx = y * r.ball_d[2] - z * r.ball_d[1], cy = z * r.ball_d[0] - x * r.ball_d[2],
+              cz = x * r.ball_d[1] - y * r.ball_d[0];
+  const float radius =
+      b[3] + r.ball_margin + kBallMargin * (__builtin_fabsf(x) + __builtin_fabsf(y) + __builtin_fabsf(z));
+  return cx * cx + cy * cy + cz * cz > radius * radius;
+}
+
 struct Entry {
   std::uint32_t ref;
   float t;
@@ -45,7 +64,12 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
   };
   for (;;) {
     if (e.ref & kLeafBit) {
-      if (!visit(context, e.ref & ~kLeafBit, limit) || !pop()) return;
+      const std::uint32_t leaf = e.ref & ~kLeafBit;
+      if (r.balls != nullptr && ball_misses(r.balls + 4 * std::size_t(leaf), r)) {
+        if (!pop()) return;
+        continue;
+      }
+      if (!visit(context, leaf, limit) || !pop()) return;
       continue;
     }
     const WideNode* n = nodes + e.ref;
@@ -73,6 +97,18 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     }
     // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
     // keep the slot order (the sort is stable), so the order is a function of the node and the ray only.
+    // Two children (half of the nodes with several hits) need one comparison, not the general loop below; the
+    // order is the same (the lower slot first unless the other one is strictly nearer).
+    const std::uint32_t rest = bits & (bits - 1);
+    if ((rest & (rest - 1)) == 0) {
+      const int k0 = __builtin_ctz(bits), k1 = __builtin_ctz(rest);
+      const bool swap = entry[k1] < entry[k0];
+      const int near = swap ? k1 : k0, far = swap ? k0 : k1;
+      stack[top++] = Entry{n->child[far], entry[far]};
+      if (r.prefetch) prefetch_node(nodes, n->child[far]);
+      e = Entry{n->child[near], entry[near]};
+      continue;
+    }
     Entry hit[kWideArity];
     int count = 0;
     while (bits != 0) {
@@ -83,7 +119,10 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
       hit[j] = x;
     }
-    for (int j = count - 1; j >= 1; --j) stack[top++] = hit[j];
+    for (int j = count - 1; j >= 1; --j) {
+      stack[top++] = hit[j];
+      if (r.prefetch) prefetch_node(nodes, hit[j].ref);
+    }
     e = hit[0];  // the nearest child next, without a trip through the stack
   }
 }

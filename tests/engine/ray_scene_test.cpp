@@ -281,5 +281,94 @@ TEST(RayScene, EmptySceneAndHalfspacesOnly) {
   EXPECT_EQ(r.hit_begin, (std::vector<std::uint64_t>{0, 1}));
 }
 
+// Large batches on large trees are cast in a coherent order with the rays and results copied (ray_scene_cast.cpp,
+// RayOrder: batches of >= 4096 rays when the wide nodes exceed 1 MiB; 60k objects here give 19928 nodes, 5.1 MB).
+// Their results must be those of input order bit for bit: batches of 1000 rays are below the threshold and are cast
+// in input order. Invalid rays are mixed in (they sort last and must keep their status).
+TEST(RayScene, CastOrderOfLargeBatchesGivesTheSameBits) {
+  Rng rng(16);
+  World w = make_world(rng, 60000, true);
+  RayBatch rays = random_rays(rng, 9000);
+  for (std::size_t i = 0; i < rays.size(); i += 97) rays.direction.set(i, Eigen::Vector3d::Zero());
+  for (std::size_t i = 5; i < rays.size(); i += 89) rays.origin.x[i] = std::nan("");
+  for (RayQuery q : {RayQuery::closest, RayQuery::any}) {
+    for (int threads : {1, 2}) {
+      RaySceneIndex index;
+      index.update(w.scene, threads);
+      RayOptions o;
+      o.query = q;
+      o.threads = threads;
+      RayResults whole;
+      index.cast(rays, o, whole);
+      int hits = 0;
+      for (std::size_t begin = 0; begin < rays.size(); begin += 1000) {
+        RayBatch part;
+        const std::size_t end = std::min(rays.size(), begin + 1000);
+        for (std::size_t i = begin; i < end; ++i) part.add(rays.origin[i], rays.direction[i], rays.t_max[i]);
+        RayResults r;
+        index.cast(part, o, r);
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::size_t k = i - begin;
+          SCOPED_TRACE(::testing::Message() << to_string(q) << ", " << threads << " threads, ray " << i);
+          ASSERT_EQ(whole.status[i], r.status[k]);
+          ASSERT_EQ(whole.hit[i], r.hit[k]);
+          ASSERT_EQ(whole.object[i], r.object[k]);
+          ASSERT_TRUE(
+              same_bits(std::vector<double>{whole.t[i], whole.normal.x[i], whole.normal.y[i], whole.normal.z[i]},
+                        std::vector<double>{r.t[k], r.normal.x[k], r.normal.y[k], r.normal.z[k]}));
+          hits += r.hit[k];
+        }
+      }
+      EXPECT_GT(hits, 1000);
+      EXPECT_EQ(whole.status[0], RayStatus::invalid_input);
+      EXPECT_EQ(whole.status[5], RayStatus::invalid_input);
+    }
+  }
+}
+
+// The wide traversal rejects leaves with a float ball test before the exact double one (ray_wide_traverse.hpp); its
+// margins cover the rounding of origins and centres to float, which at 10^6 m is 1/16 m, far more than the gap left
+// here (the test fails when the margins are left out). Spheres of radius 0.5 m around centres up to 10^6 m from the
+// origin, rays from 10 m away aimed to pass each centre at 0.5 (1 - 1e-9) m (hits) or 0.5 (1 + 1e-9) m (misses):
+// every answer must be brute force's.
+TEST(RayScene, LeafBallFilterKeepsGrazingRaysFarFromTheOrigin) {
+  Rng rng(17);
+  for (double scale : {1.0, 1e3, 1e6}) {
+    auto table = std::make_shared<ShapeTable>();
+    const std::uint32_t sphere = table->add(Shape::sphere(0.5));
+    World w(table);
+    std::vector<Eigen::Vector3d> centres;
+    for (int i = 0; i < 300; ++i) {
+      centres.emplace_back(uniform(rng, -1, 1) * scale, uniform(rng, -1, 1) * scale, uniform(rng, -1, 1) * scale);
+      w.handles.push_back(w.scene.add(sphere, Pose::from_translation(centres.back())));
+    }
+    RayBatch rays;
+    for (int i = 0; i < 600; ++i) {
+      const Eigen::Vector3d c = centres[std::size_t(i) % centres.size()];
+      const Eigen::Vector3d d =
+          Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)).normalized();
+      const Eigen::Vector3d side = d.unitOrthogonal();
+      const double pass = 0.5 * (i % 2 == 0 ? 1.0 - 1e-9 : 1.0 + 1e-9);
+      rays.add(c + pass * side - 10.0 * d, d, INFINITY);
+    }
+    RaySceneIndex index;
+    index.update(w.scene);
+    const auto brute = brute_force(w, rays);
+    RayResults r;
+    index.cast(rays, {}, r);
+    int hits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      SCOPED_TRACE(::testing::Message() << "scale " << scale << ", ray " << i);
+      ASSERT_EQ(r.hit[i], brute[i].empty() ? 0 : 1);
+      if (!r.hit[i]) continue;
+      ++hits;
+      if (brute[i].size() < 2 || brute[i][1].t - brute[i][0].t > kTransformSlack) {
+        EXPECT_EQ(r.object[i], brute[i][0].object);
+      }
+    }
+    EXPECT_GE(hits, 300);  // every grazing ray hits its sphere
+  }
+}
+
 }  // namespace
 }  // namespace batchcol
