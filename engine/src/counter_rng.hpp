@@ -33,8 +33,10 @@ inline double log_unit(double u) {
     ++k;
   }
   const double s = (m - 1.0) / (m + 1.0), z = s * s;
-  double p = 1.0 / 23.0;
-  for (int n = 21; n >= 1; n -= 2) p = p * z + 1.0 / n;
+  // 1/23, 1/21, ..., 1/1 spelled out: a loop over 1.0 / n divided at run time unless fully unrolled.
+  const double p = (((((((((((1.0 / 23.0) * z + 1.0 / 21.0) * z + 1.0 / 19.0) * z + 1.0 / 17.0) * z + 1.0 / 15.0) * z +
+                          1.0 / 13.0) * z + 1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z +
+                    1.0 / 3.0) * z + 1.0;
   return k * 0.6931471805599453 + 2.0 * s * p;
 }
 

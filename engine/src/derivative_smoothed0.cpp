@@ -162,11 +162,15 @@ struct Span {
 /// in A's frame; sample 2k+1 is its antithetic copy -z, whose rotation is the transpose of sample 2k's. Plain
 /// arrays (no Eigen temporaries): this is per-sample work.
 void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
-  double* const R = b.at(Block::kR);
-  double* const t = b.at(Block::kT);
-  double* const dir = b.at(Block::kDir);
-  double* const zs = b.at(Block::kZ);
-  const std::size_t cap = b.capacity;
+  double* R[9];
+  double* t[3];
+  double* dir[3];
+  double* zs[6];
+  for (int e = 0; e < 9; ++e) R[e] = b.at(Block::kR + e) + slot;
+  for (int e = 0; e < 3; ++e) t[e] = b.at(Block::kT + e) + slot, dir[e] = b.at(Block::kDir + e) + slot;
+  for (int e = 0; e < 6; ++e) zs[e] = b.at(Block::kZ + e) + slot;
+  std::uint32_t* const shape_a = b.shape_a.data() + slot;
+  std::uint32_t* const shape_b = b.shape_b.data() + slot;
   const std::uint32_t ia = c.batch.shape_a[p.i], ib = c.batch.shape_b[p.i];
   double R0[9], t0[3], n0[3], warm[3], P[18];
   for (int r = 0; r < 3; ++r) {
@@ -177,41 +181,38 @@ void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t coun
     for (int e = 0; e < 6; ++e) P[6 * r + e] = p.P(r, e);
   }
   const double st = p.s.translation, sw = p.s.rotation;
-  const std::size_t end = j0 + count;
-  for (std::size_t j = j0; j < end; j += 2) {
+  const bool predict = p.predict;
+  for (std::size_t j = j0, k = 0; j < j0 + count; j += 2, k += 2) {
     double z[6];
     gaussian_vector<6>(c.o.seed, p.i, j / 2, 0, z);
     const double w[3] = {sw * z[3], sw * z[4], sw * z[5]};
     double E[9];
     rotation_exp(w, E);
     double dz[3] = {0.0, 0.0, 0.0};
-    if (p.predict)
+    if (predict)
       for (int r = 0; r < 3; ++r)
         dz[r] = ((((P[6 * r] * z[0] + P[6 * r + 1] * z[1]) + P[6 * r + 2] * z[2]) + P[6 * r + 3] * z[3]) +
                  P[6 * r + 4] * z[4]) + P[6 * r + 5] * z[5];
-    const std::size_t k = slot + (j - j0);
-    const bool pair = j + 1 < end;
     for (int r = 0; r < 3; ++r) {
-      for (int q = 0; q < 3; ++q) {
-        // E R0 for sample 2k, E^T R0 for 2k+1.
-        R[(3 * r + q) * cap + k] = (E[3 * r] * R0[q] + E[3 * r + 1] * R0[3 + q]) + E[3 * r + 2] * R0[6 + q];
-        if (pair) R[(3 * r + q) * cap + k + 1] = (E[r] * R0[q] + E[3 + r] * R0[3 + q]) + E[6 + r] * R0[6 + q];
-      }
-      const double v = st * z[r];
-      t[r * cap + k] = t0[r] + v;
-      dir[r * cap + k] = p.predict ? -(n0[r] + dz[r]) : warm[r];
-      if (pair) {
-        t[r * cap + k + 1] = t0[r] - v;
-        dir[r * cap + k + 1] = p.predict ? -(n0[r] - dz[r]) : warm[r];
-      }
+      for (int q = 0; q < 3; ++q)  // E R0 for sample 2k
+        R[3 * r + q][k] = (E[3 * r] * R0[q] + E[3 * r + 1] * R0[3 + q]) + E[3 * r + 2] * R0[6 + q];
+      t[r][k] = t0[r] + st * z[r];
+      dir[r][k] = predict ? -(n0[r] + dz[r]) : warm[r];
     }
-    for (int e = 0; e < 6; ++e) {
-      zs[e * cap + k] = z[e];
-      if (pair) zs[e * cap + k + 1] = -z[e];
+    for (int e = 0; e < 6; ++e) zs[e][k] = z[e];
+    shape_a[k] = ia;
+    shape_b[k] = ib;
+    if (j + 1 == j0 + count) break;  // an odd M's last sample has no antithetic copy
+    const std::size_t m = k + 1;
+    for (int r = 0; r < 3; ++r) {
+      for (int q = 0; q < 3; ++q)  // E^T R0 for sample 2k+1
+        R[3 * r + q][m] = (E[r] * R0[q] + E[3 + r] * R0[3 + q]) + E[6 + r] * R0[6 + q];
+      t[r][m] = t0[r] - st * z[r];
+      dir[r][m] = predict ? -(n0[r] - dz[r]) : warm[r];
     }
-    b.shape_a[k] = ia;
-    b.shape_b[k] = ib;
-    if (pair) b.shape_a[k + 1] = ia, b.shape_b[k + 1] = ib;
+    for (int e = 0; e < 6; ++e) zs[e][m] = -z[e];
+    shape_a[m] = ia;
+    shape_b[m] = ib;
   }
 }
 
@@ -280,20 +281,43 @@ struct Sums {
 /// Adds samples [first, first + count) of the block: each sample's values (distance, witness points, normal in A's
 /// frame) minus the unperturbed ones, times its noise z; a sample without a converged, finite answer adds nothing.
 void accumulate(const PairPlan& p, Block& b, std::size_t first, std::size_t count, Sums& sums) {
-  const std::size_t cap = b.capacity;
-  const double* zs = b.at(Block::kZ);
-  const double* v0 = b.at(Block::kDist);  // kDist, kWa, kWb, kN: 10 consecutive arrays
-  for (std::size_t k = first; k < first + count; ++k) {
-    if (b.status[k] != Status::converged) continue;
-    Values v;
-    for (int e = 0; e < 10; ++e) v[e] = v0[e * cap + k];
-    if (!v.allFinite()) continue;
-    Eigen::Matrix<double, 1, 6> z;
-    for (int e = 0; e < 6; ++e) z[e] = zs[e * cap + k];
-    sums.mean += v;
-    sums.G += (v - p.g0) * z;
-    ++sums.valid;
+  const double* v0[10];
+  const double* z0[6];
+  for (int e = 0; e < 10; ++e) v0[e] = b.at(Block::kDist + e) + first;  // kDist, kWa, kWb, kN: consecutive
+  for (int f = 0; f < 6; ++f) z0[f] = b.at(Block::kZ + f) + first;
+  // Local sums (column-major, as Eigen's): the compiler keeps them out of the reference's aliasing and vectorises
+  // each column's 10 entries; every entry still adds its samples in sample order.
+  double mean[10], G[6][10], g0[10];
+  for (int e = 0; e < 10; ++e) {
+    mean[e] = sums.mean[e];
+    g0[e] = p.g0[e];
+    for (int f = 0; f < 6; ++f) G[f][e] = sums.G(e, f);
   }
+  int valid = sums.valid;
+  const Status* status = b.status.data() + first;
+  for (std::size_t k = 0; k < count; ++k) {
+    if (status[k] != Status::converged) continue;
+    double v[10], d[10], z[6];
+    bool finite = true;
+    for (int e = 0; e < 10; ++e) {
+      v[e] = v0[e][k];
+      finite = finite && std::isfinite(v[e]);
+    }
+    if (!finite) continue;
+    for (int f = 0; f < 6; ++f) z[f] = z0[f][k];
+    for (int e = 0; e < 10; ++e) {
+      mean[e] += v[e];
+      d[e] = v[e] - g0[e];
+    }
+    for (int f = 0; f < 6; ++f)
+      for (int e = 0; e < 10; ++e) G[f][e] += d[e] * z[f];
+    ++valid;
+  }
+  for (int e = 0; e < 10; ++e) {
+    sums.mean[e] = mean[e];
+    for (int f = 0; f < 6; ++f) sums.G(e, f) = G[f][e];
+  }
+  sums.valid = valid;
 }
 
 /// The estimator from the sums, mapped from A's frame and A-frame noise to the world.

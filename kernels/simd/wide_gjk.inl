@@ -461,8 +461,12 @@ template <class T> struct WideGjk {
       for (int v = 0; v < 3; ++v)
         for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = (*c.triangle)[v][i];
     if (s.type == ShapeType::convex) {
+      // The same small hull as the lane's previous pair (consecutive samples of one pair, a batch's repeated
+      // shapes): its rows are still the lane's (rows only grow, and growing pads every lane with its last vertex).
+      const bool same = s.hull[l] == c.hull && s.lane_vertices[l] == c.hull->vertex_count && (s.small >> l & 1u);
       s.hull[l] = c.hull;
       s.hint[l] = SupportHint{};
+      if (same) return;
       const std::uint32_t bit = 1u << l;
       const bool small = c.hull->vertex_count < kHillClimbMinVertices;
       s.small = small ? s.small | bit : s.small & ~bit;
