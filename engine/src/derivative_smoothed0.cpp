@@ -58,6 +58,7 @@ struct PairPlan {
   Eigen::Matrix<double, 3, 6> P;
   ShapeType type_a = ShapeType::sphere, type_b = ShapeType::sphere;
   bool wide = false;  // the type pair runs through gjk_samples
+  kernels::simd::SamplePlan samples;  // the above as build_samples() reads it
 };
 
 struct Context {
@@ -112,26 +113,18 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
     p.P.rightCols<3>() = p.s.rotation * (R_a.transpose() * (Jv * skew(t_b) + Jw) * R_a);
     p.predict = p.P.allFinite();
   }
-}
-
-/// exp([w]x), row-major, through the unit quaternion (cos(h), sin(h) w / (2h)), h = |w| / 2: sin(h) / h by its
-/// series for h <= pi/4 (exact at w = 0, no division), libm beyond (angles past pi/2, rare at useful noise levels).
-void rotation_exp(const double w[3], double E[9]) {
-  const double angle2 = (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2];
-  const double h = 0.5 * std::sqrt(angle2);
-  double sinc, c;
-  if (h <= 0.7853981633974483) {
-    sinc_cos_small(h, sinc, c);
-  } else {
-    sinc = std::sin(h) / h;
-    c = std::cos(h);
+  kernels::simd::SamplePlan& sp = p.samples;
+  sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // CounterRng's (seed, pair) half of the key
+  for (int r = 0; r < 3; ++r) {
+    for (int q = 0; q < 3; ++q) sp.R0[3 * r + q] = p.R(r, q);
+    sp.t0[r] = p.t[r];
+    sp.n0[r] = p.g0[7 + r];
+    sp.first[r] = p.warm[r];
+    for (int e = 0; e < 6; ++e) sp.P[6 * r + e] = p.predict ? p.P(r, e) : 0.0;
   }
-  const double k = 0.5 * sinc, x = k * w[0], y = k * w[1], z = k * w[2];
-  const double xx = x * x, yy = y * y, zz = z * z, xy = x * y, xz = x * z, yz = y * z, cx = c * x, cy = c * y,
-               cz = c * z;
-  E[0] = 1.0 - 2.0 * (yy + zz), E[1] = 2.0 * (xy - cz), E[2] = 2.0 * (xz + cy);
-  E[3] = 2.0 * (xy + cz), E[4] = 1.0 - 2.0 * (xx + zz), E[5] = 2.0 * (yz - cx);
-  E[6] = 2.0 * (xz - cy), E[7] = 2.0 * (yz + cx), E[8] = 1.0 - 2.0 * (xx + yy);
+  sp.translation = p.s.translation;
+  sp.rotation = p.s.rotation;
+  sp.predict = p.predict;
 }
 
 /// One block's samples and answers, structure of arrays (the kernel's layout).
@@ -158,62 +151,21 @@ struct Span {
   std::size_t plan, first, count, j0;
 };
 
-/// Writes samples j0 .. j0 + count of plan p at block slot `slot`. Sample 2k draws z from the key (seed, pair, k)
-/// in A's frame; sample 2k+1 is its antithetic copy -z, whose rotation is the transpose of sample 2k's. Plain
-/// arrays (no Eigen temporaries): this is per-sample work.
+/// Writes samples j0 .. j0 + count of plan p (j0 even) at block slot `slot`: the first samples of the antithetic
+/// pairs (2k: z drawn from the key (seed, pair, k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
+/// the transposed rotation) after them, so that build_samples() writes whole registers.
 void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
-  double* R[9];
-  double* t[3];
-  double* dir[3];
-  double* zs[6];
-  for (int e = 0; e < 9; ++e) R[e] = b.at(Block::kR + e) + slot;
-  for (int e = 0; e < 3; ++e) t[e] = b.at(Block::kT + e) + slot, dir[e] = b.at(Block::kDir + e) + slot;
-  for (int e = 0; e < 6; ++e) zs[e] = b.at(Block::kZ + e) + slot;
-  std::uint32_t* const shape_a = b.shape_a.data() + slot;
-  std::uint32_t* const shape_b = b.shape_b.data() + slot;
-  const std::uint32_t ia = c.batch.shape_a[p.i], ib = c.batch.shape_b[p.i];
-  double R0[9], t0[3], n0[3], warm[3], P[18];
-  for (int r = 0; r < 3; ++r) {
-    for (int q = 0; q < 3; ++q) R0[3 * r + q] = p.R(r, q);
-    t0[r] = p.t[r];
-    n0[r] = p.g0[7 + r];
-    warm[r] = p.warm[r];
-    for (int e = 0; e < 6; ++e) P[6 * r + e] = p.P(r, e);
+  const std::size_t evens = (count + 1) / 2, odds = count / 2;
+  kernels::simd::SampleArrays even, odd;
+  for (int e = 0; e < 9; ++e) even.R[e] = b.at(Block::kR + e) + slot, odd.R[e] = even.R[e] + evens;
+  for (int e = 0; e < 3; ++e) {
+    even.t[e] = b.at(Block::kT + e) + slot, odd.t[e] = even.t[e] + evens;
+    even.direction[e] = b.at(Block::kDir + e) + slot, odd.direction[e] = even.direction[e] + evens;
   }
-  const double st = p.s.translation, sw = p.s.rotation;
-  const bool predict = p.predict;
-  for (std::size_t j = j0, k = 0; j < j0 + count; j += 2, k += 2) {
-    double z[6];
-    gaussian_vector<6>(c.o.seed, p.i, j / 2, 0, z);
-    const double w[3] = {sw * z[3], sw * z[4], sw * z[5]};
-    double E[9];
-    rotation_exp(w, E);
-    double dz[3] = {0.0, 0.0, 0.0};
-    if (predict)
-      for (int r = 0; r < 3; ++r)
-        dz[r] = ((((P[6 * r] * z[0] + P[6 * r + 1] * z[1]) + P[6 * r + 2] * z[2]) + P[6 * r + 3] * z[3]) +
-                 P[6 * r + 4] * z[4]) + P[6 * r + 5] * z[5];
-    for (int r = 0; r < 3; ++r) {
-      for (int q = 0; q < 3; ++q)  // E R0 for sample 2k
-        R[3 * r + q][k] = (E[3 * r] * R0[q] + E[3 * r + 1] * R0[3 + q]) + E[3 * r + 2] * R0[6 + q];
-      t[r][k] = t0[r] + st * z[r];
-      dir[r][k] = predict ? -(n0[r] + dz[r]) : warm[r];
-    }
-    for (int e = 0; e < 6; ++e) zs[e][k] = z[e];
-    shape_a[k] = ia;
-    shape_b[k] = ib;
-    if (j + 1 == j0 + count) break;  // an odd M's last sample has no antithetic copy
-    const std::size_t m = k + 1;
-    for (int r = 0; r < 3; ++r) {
-      for (int q = 0; q < 3; ++q)  // E^T R0 for sample 2k+1
-        R[3 * r + q][m] = (E[r] * R0[q] + E[3 + r] * R0[3 + q]) + E[6 + r] * R0[6 + q];
-      t[r][m] = t0[r] - st * z[r];
-      dir[r][m] = predict ? -(n0[r] - dz[r]) : warm[r];
-    }
-    for (int e = 0; e < 6; ++e) zs[e][m] = -z[e];
-    shape_a[m] = ia;
-    shape_b[m] = ib;
-  }
+  for (int e = 0; e < 6; ++e) even.z[e] = b.at(Block::kZ + e) + slot, odd.z[e] = even.z[e] + evens;
+  kernels::simd::build_samples(c.isa, p.samples, j0 / 2, evens, odds, even, odd);
+  std::fill_n(b.shape_a.data() + slot, count, c.batch.shape_a[p.i]);
+  std::fill_n(b.shape_b.data() + slot, count, c.batch.shape_b[p.i]);
 }
 
 /// The scalar path for one sample: setup, GJK, completion (closed forms, EPA, float stalls redone in double).
@@ -281,6 +233,8 @@ struct Sums {
 /// Adds samples [first, first + count) of the block: each sample's values (distance, witness points, normal in A's
 /// frame) minus the unperturbed ones, times its noise z; a sample without a converged, finite answer adds nothing.
 void accumulate(const PairPlan& p, Block& b, std::size_t first, std::size_t count, Sums& sums) {
+  // Sample order: the first sample of antithetic pair e at first + e, its copy at first + evens + e (build()).
+  const std::size_t evens = (count + 1) / 2;
   const double* v0[10];
   const double* z0[6];
   for (int e = 0; e < 10; ++e) v0[e] = b.at(Block::kDist + e) + first;  // kDist, kWa, kWb, kN: consecutive
@@ -295,7 +249,8 @@ void accumulate(const PairPlan& p, Block& b, std::size_t first, std::size_t coun
   }
   int valid = sums.valid;
   const Status* status = b.status.data() + first;
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t n = 0; n < count; ++n) {
+    const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
     if (status[k] != Status::converged) continue;
     double v[10], d[10], z[6];
     bool finite = true;

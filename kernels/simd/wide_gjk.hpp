@@ -88,4 +88,26 @@ template <>
 std::size_t gjk_samples<float>(InstructionSet, const PairView&, ShapeType, ShapeType, const SampleBatch&,
                                const QueryOptions&, const SampleResults&, std::uint32_t*);
 
+/// What the samples of one pair share, for build_samples(): the counter key's per-pair half
+/// splitmix64(splitmix64(seed) ^ pair) (engine/src/counter_rng.hpp), B's pose in A's frame, the noise scales
+/// (metres, radians), and the first GJK direction: -(n0 + P z) when `predict`, else `first`.
+struct SamplePlan {
+  std::uint64_t key = 0;
+  double R0[9] = {}, t0[3] = {}, n0[3] = {}, first[3] = {}, P[18] = {};
+  double translation = 0.0, rotation = 0.0;
+  bool predict = false;
+};
+/// Per-sample arrays build_samples() writes: B's pose in A's frame (row-major R, t), the first direction and z.
+struct SampleArrays {
+  double* R[9] = {};
+  double* t[3] = {};
+  double* direction[3] = {};
+  double* z[6] = {};
+};
+/// Antithetic pairs k = a0 .. a0 + count - 1 of plan p (kernels/simd/wide_samples.inl): z from the counter key
+/// (pair, k), sample 2k (E R0, t0 + s_t z, z) at index k - a0 of `even`, its antithetic copy (E^T R0, t0 - s_t z, -z)
+/// at index k - a0 of `odd` for the first odd_count pairs. The same bits on every instruction set.
+void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
+                   std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd);
+
 }  // namespace batchcol::kernels::simd
