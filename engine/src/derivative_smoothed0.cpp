@@ -1,12 +1,12 @@
 // Randomized smoothing of order 0 (Montaut et al. 2023, sec. III; the slides "Randomized smoothing" and "- 0th
 // order"). The M perturbed copies ("samples") of a pair share its shapes, A's pose and B's pose up to the
-// perturbation, so they do not go through collide() as new pairs (validation, type grouping, world poses and
-// outputs per sample were ~1250 instructions of a ~4500-instruction sample): each sample's relative pose is built in
-// A's frame straight into the SIMD GJK's sample layout (kernels::simd::gjk_samples), its answer stays in A's frame,
-// and the estimator is reduced there and mapped to the world once per pair. Each sample's GJK starts from the
-// direction the analytic normal Jacobian predicts for its perturbation (first order: GJK then needs ~1.2 iterations
-// instead of ~4.5 from the unperturbed direction on ellipsoid pairs at eps 0.01, 8 cold); polytope pairs, whose
-// GJK needs its simplex anyway, start from the unperturbed query's direction.
+// perturbation, so they do not go through collide() as new pairs (whose validation, type grouping, world poses and
+// outputs per sample cost more than a warm-started sample's GJK): each sample's relative pose is built in A's frame
+// straight into the SIMD GJK's sample layout (kernels::simd::build_samples, gjk_samples), its answer stays in A's
+// frame, and the estimator is reduced there and mapped to the world once per pair. Each sample's GJK starts from the
+// direction the analytic normal Jacobian predicts for its perturbation (first order: on curved pairs GJK then needs
+// about one iteration, the start being off by O(eps^2) only); polytope pairs, whose GJK needs its simplex anyway,
+// start from the unperturbed query's direction.
 #include "counter_rng.hpp"
 #include "derivative_pairs.hpp"
 #include "instruction_set.hpp"
@@ -383,7 +383,7 @@ void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOpti
   for (std::size_t i = 0; i < n && !any_curved; ++i)
     any_curved = curved(shapes, batch.shape_a[i]) || curved(shapes, batch.shape_b[i]);
   // Reused by the calls of this thread up to 2^14 pairs (15 MB): a fresh 120 doubles per pair were zero-filled and
-  // page-faulted at every call (callgrind: ~960 instructions per pair of memset alone).
+  // page-faulted at every call, a fixed cost that small M feels.
   thread_local DerivativeResults reused;
   DerivativeResults fresh;
   DerivativeResults& predictor = n <= (std::size_t(1) << 14) ? reused : fresh;

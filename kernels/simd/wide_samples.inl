@@ -4,8 +4,7 @@
 // perturbed pose in A's frame, E R0 and t0 + s_t z for sample 2k, E^T R0 and t0 - s_t z for its antithetic copy
 // 2k+1. Every lane does the scalar code's operations in its order (no FMA contraction), so every instruction set
 // gives the bits of engine/src/counter_rng.hpp's gaussian_vector<6> and of the scalar build (tested in
-// tests/kernels/wide_samples_test.cpp). Drawing and building a sample in scalar code cost ~520 instructions, a
-// third of a sample's work.
+// tests/kernels/wide_samples_test.cpp). In scalar code the drawing and the building were a third of a sample's work.
 //
 // No include guard: included once per instruction set by isa_body.inl.
 
