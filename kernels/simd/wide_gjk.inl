@@ -78,7 +78,9 @@ template <class T> struct WideGjk {
     }
   };
 
-  static V3 support(Side& s, const V3& d, std::uint32_t live) {
+  // Always inlined (AI above): left to itself GCC outlined one of its two inlined copies (the one in start()),
+  // a call and a type switch per support, when the batch-array refill changed.
+  AI static V3 support(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
     switch (s.type) {
       case ShapeType::sphere: return {zero, zero, zero};
@@ -460,18 +462,20 @@ template <class T> struct WideGjk {
     if (s.type == ShapeType::triangle)
       for (int v = 0; v < 3; ++v)
         for (int i = 0; i < 3; ++i) s.tri[3 * v + i][l] = (*c.triangle)[v][i];
-    if (s.type == ShapeType::convex) {
-      // The same small hull as the lane's previous pair (consecutive samples of one pair, a batch's repeated
-      // shapes): its rows are still the lane's (rows only grow, and growing pads every lane with its last vertex).
-      const bool same = s.hull[l] == c.hull && s.lane_vertices[l] == c.hull->vertex_count && (s.small >> l & 1u);
-      s.hull[l] = c.hull;
-      s.hint[l] = SupportHint{};
-      if (same) return;
-      const std::uint32_t bit = 1u << l;
-      const bool small = c.hull->vertex_count < kHillClimbMinVertices;
-      s.small = small ? s.small | bit : s.small & ~bit;
-      if (small) load_small_hull(s, l, *c.hull);
-    }
+    if (s.type == ShapeType::convex) load_hull(s, c.hull, l);
+  }
+  /// A convex side's hull in lane l: the view, a fresh hill-climbing hint, the rows of a small hull.
+  static void load_hull(Side& s, const HullView* hull, int l) {
+    // The same small hull as the lane's previous pair (consecutive samples of one pair, a batch's repeated
+    // shapes): its rows are still the lane's (rows only grow, and growing pads every lane with its last vertex).
+    const bool same = s.hull[l] == hull && s.lane_vertices[l] == hull->vertex_count && (s.small >> l & 1u);
+    s.hull[l] = hull;
+    s.hint[l] = SupportHint{};
+    if (same) return;
+    const std::uint32_t bit = 1u << l;
+    const bool small = hull->vertex_count < kHillClimbMinVertices;
+    s.small = small ? s.small | bit : s.small & ~bit;
+    if (small) load_small_hull(s, l, *hull);
   }
 
   template <class V> static void set_lane(V3& v, int l, const V& p) {
@@ -502,6 +506,22 @@ template <class T> struct WideGjk {
     load_side(L.B, s.B, l);
     Vec3<T> init = s.initial_direction;
     if (!(kernels::norm2(init) > T(0))) init = Vec3<T>::UnitX();
+    reset_search(L, l, init);
+    L.max_iterations[l] = s.max_iterations;
+    L.momentum[l] = s.momentum ? -1 : 0;
+    L.normalize[l] = s.normalize ? -1 : 0;
+    L.boolean_only[l] = s.boolean_only ? -1 : 0;
+    L.tolerance[l] = s.tolerance;
+    L.relative[l] = s.relative;
+    L.touch[l] = s.touch;
+    L.core_margin[l] = s.core_margin;
+  }
+
+  /// The search state a lane starts every pair with, whatever the pair: the one-vertex simplex whose support
+  /// point start() computes, d_prev = the (non-zero) initial direction `init`, no lower bound, no iteration.
+  /// start_lane() and the batch-array GJK's refill (wide_gjk_pairs.inl, which sets the pair's values itself) both
+  /// call it, so a field added to the search state is reset in one place.
+  AI static void reset_search(Lanes& L, int l, const Vec3<T>& init) {
     L.fresh |= 1u << l;
     L.lambda[0][l] = T(1);
     L.count[l] = 1;
@@ -511,14 +531,6 @@ template <class T> struct WideGjk {
     L.lower[l] = -std::numeric_limits<T>::infinity();
     L.k[l] = 0;
     L.stale[l] = 0;
-    L.max_iterations[l] = s.max_iterations;
-    L.momentum[l] = s.momentum ? -1 : 0;
-    L.normalize[l] = s.normalize ? -1 : 0;
-    L.boolean_only[l] = s.boolean_only ? -1 : 0;
-    L.tolerance[l] = s.tolerance;
-    L.relative[l] = s.relative;
-    L.touch[l] = s.touch;
-    L.core_margin[l] = s.core_margin;
   }
 
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {

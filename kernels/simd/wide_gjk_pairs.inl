@@ -1,8 +1,8 @@
 // GJK pairs straight from the batch arrays: the executor's per-pair work (pose validation, B's pose in A's frame,
 // the setup, completion, the world-frame output) done without a PairSetup per pair. Poses are validated and the
-// relative poses computed W pairs per register in double (PairLanes), a chunk at a time; each lane then takes its
-// pair's shapes and parameters from those arrays when it is refilled, runs WideGjk's loop, and writes its answer
-// into the result arrays. Every operation is the executor's scalar path's (prepare_pair's arithmetic, make_core,
+// relative poses computed W pairs per register in double (PairLanes), a chunk at a time, then the shapes' parameters,
+// GJK's limits and first direction for the whole chunk; a lane refilled with the next pair copies them from the
+// chunk's arrays, runs WideGjk's loop, and writes its answer into the result arrays. Every operation is the executor's scalar path's (prepare_pair's arithmetic, make_core,
 // set_gjk_parameters, complete_from_gjk, write_pair_output), in the same order, so the results are the same bits
 // (tested in tests/engine/executor_gjk_pairs_test.cpp); pairs that need more (invalid input, a float stall redone
 // in double) go back to that path.
@@ -12,27 +12,86 @@
 template <class T> struct WideGjkPairs {
   using G = WideGjk<T>;
   using Lanes = typename G::Lanes;
+  using Int = typename G::Int;
   using P = PairLanes;
   static constexpr int W = G::W;
   static constexpr int Wd = P::W;
   /// Pairs whose relative poses are computed ahead of the lanes: a few KB, in L1.
   static constexpr std::size_t kChunk = 64;
 
-  /// Valid pairs of the current chunk, in double: B's pose in A's frame and A's world pose (row-major).
-  /// Written before read: fill_chunk() sets count and the first count entries.
+  /// The current chunk's pairs, slot s = pair `read - count + s` of the run, as separate arrays (one per value):
+  /// everything a lane's refill copies and its completion needs, computed W pairs per register from the batch and
+  /// ShapeTable arrays (poses, the cores' parameters, gjk_limits(), the first direction), so that a refill is a
+  /// row of copies instead of per-pair scalar arithmetic (the setup was a third of a boolean ellipsoid pair's
+  /// instructions). Slots of invalid pairs are computed too (their lanes read shape 0) but never loaded: `left`
+  /// holds the valid slots not yet loaded. Written before read: fill_chunk() writes slots [0, count).
   struct Chunk {
-    double R[9][kChunk], t[3][kChunk], Ra[9][kChunk], ta[3][kChunk];
-    std::uint32_t pair[kChunk], shape_a[kChunk], shape_b[kChunk];
-    std::size_t count = 0;
+    static_assert(kChunk % std::size_t(Wd) == 0 && kChunk <= 64, "whole registers per chunk, one bit per slot");
+    // B's pose in A's frame (R row-major, rounded to T as start_lane() took them), A's world pose for the output.
+    T R[9][kChunk], t[3][kChunk];
+    double Ra[9][kChunk], ta[3][kChunk];
+    std::uint32_t pair[kChunk];
+    std::int64_t shape_a[kChunk], shape_b[kChunk];  // for the hull views
+    // make_core()'s parameters, gjk_limits(), the first direction.
+    T size_a[3][kChunk], size_b[3][kChunk], radius_a[kChunk], radius_b[kChunk];
+    T radii[kChunk], scale[kChunk], floor[kChunk], tolerance[kChunk], core_margin[kChunk];
+    T init[3][kChunk];
+    std::uint64_t left = 0;
   };
 
-  /// What a lane keeps of its pair until it finishes: where the answer goes and how it is completed.
+  /// What a lane keeps of its pair until it finishes: where the answer goes and what completing it needs beyond
+  /// the lane's own tolerance, touch (= the floor) and core margin.
   struct LanePair {
     std::uint32_t pair = 0;
     Eigen::Matrix3d Ra;
-    Eigen::Vector3d ta;
-    GjkCompletion<T> completion;
+    Eigen::Vector3d ta;  // only at QueryLevel::witness (the only level that writes world points)
+    T radius_a, radius_b, radii, scale;
   };
+
+  /// W pairs' values of precision T in double-width registers (Wd lanes): the side stage's arithmetic is T's,
+  /// lane by lane, so it gives the scalar setup's bits in either precision.
+  typedef T tvec __attribute__((vector_size(sizeof(T) * Wd)));
+  typedef T unaligned_tvec __attribute__((vector_size(sizeof(T) * Wd), aligned(alignof(T))));
+  typedef typename P::mask unaligned_mask __attribute__((aligned(alignof(std::int64_t))));
+  static tvec to_t(typename P::real v) { return __builtin_convertvector(v, tvec); }
+  static tvec splat_t(T v) { return tvec{} + v; }
+  static void put(T* to, tvec v) { *reinterpret_cast<unaligned_tvec*>(to) = v; }
+  static void put_double(double* to, typename P::real v) { *reinterpret_cast<typename P::unaligned_real*>(to) = v; }
+
+  /// One side's core for W pairs, as make_core() builds it from the ShapeTable's per-shape arrays (no ShapeCore,
+  /// no PairSetup): the sizes the support reads, the swept radius with make_core's roundings (T(inflation), plus
+  /// T(radius) for spheres and capsules) and the core's centre (the hull's centroid, else the origin).
+  struct SideLanes {
+    tvec size[3], radius, centre[3];
+  };
+  static SideLanes side_lanes(const PairView& in, ShapeType type, const typename P::Pose& p) {
+    SideLanes r;
+    const tvec zero = splat_t(T(0));
+    for (int c = 0; c < 3; ++c) r.size[c] = zero, r.centre[c] = zero;
+    r.radius = to_t(P::field(in.shape_inflation, p));
+    switch (type) {
+      case ShapeType::sphere: r.radius += to_t(P::field(in.shape_size[0], p)); break;  // a point: no size read
+      case ShapeType::capsule:
+        r.radius += to_t(P::field(in.shape_size[0], p));
+        r.size[1] = to_t(P::field(in.shape_size[1], p));  // the half length
+        break;
+      case ShapeType::convex: {
+        // HullView::centroid of each lane's view: the views are an array indexed by shape like the others, of
+        // sizeof(HullView)-byte entries (p.shape is the index times sizeof(double)).
+        static_assert(sizeof(HullView) % sizeof(double) == 0, "whole doubles per view");
+        const typename P::mask offset = p.shape * typename P::Int(sizeof(HullView) / sizeof(double));
+        const char* views = reinterpret_cast<const char*>(in.shape_hull);
+        for (int c = 0; c < 3; ++c)
+          r.centre[c] = to_t(gather_bytes<double>(
+              reinterpret_cast<const double*>(views + offsetof(HullView, centroid) + sizeof(double) * c), offset));
+        break;
+      }
+      default:
+        for (int c = 0; c < 3; ++c) r.size[c] = to_t(P::field(in.shape_size[c], p));
+        break;
+    }
+    return r;
+  }
 
   struct Source {
     const PairView& in;
@@ -43,58 +102,92 @@ template <class T> struct WideGjkPairs {
     const ResultView& out;
     std::uint32_t* fallback;
     std::size_t fallbacks = 0;
-    std::size_t read = 0;  // pairs[0 .. read) went through the pose stage
-    std::size_t next = 0;  // chunk slot the next load takes
+    std::size_t read = 0;  // pairs[0 .. read) went into a chunk
+    bool witness = options.level >= QueryLevel::witness;
+    /// The same for every pair of the run (gjk_limits() and the solver): set once per run in every lane by
+    /// start_run(); a refill sets only what differs per pair (momentum too: the loop clears it per lane).
+    Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
     Chunk chunk;
     LanePair lane[W];  // written by load() before done() reads it
-    /// Normalised momentum directions unless both cores are strictly convex (ShapeCore::strictly_convex()).
-    bool normalize = !(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid);
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
-    // would zero the chunk's 13 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs in a
-    // mixed batch).
+    // would zero the chunk's ~25 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs
+    // in a mixed batch).
     Source(const PairView& in_, const QueryOptions& options_, ShapeType a, ShapeType b, const std::uint32_t* pairs_,
            std::size_t n_, const ResultView& out_, std::uint32_t* fallback_)
         : in(in_), options(options_), type_a(a), type_b(b), pairs(pairs_), n(n_), out(out_), fallback(fallback_) {}
 
-    /// Validates the next kChunk pairs and computes their poses, W per register (prepare_pair's rule and
-    /// arithmetic); invalid ones go to the fallback.
+    /// The lanes' fields that are the same for every pair of the run (set_gjk_parameters()'s values):
+    /// max_iterations, the relative tolerance, boolean_only, and the momentum normalisation (normalised
+    /// directions unless both cores are strictly convex, ShapeCore::strictly_convex()).
+    void start_run(Lanes& L) const {
+      const bool normalize = !(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid);
+      L.max_iterations = G::splat_mask(Int(options.max_iterations));
+      L.relative = G::splat(T(options.relative_tolerance));
+      L.normalize = G::truth(normalize);
+      L.boolean_only = G::truth(options.level == QueryLevel::boolean);
+    }
+
+    /// The next kChunk pairs, W per register: poses validated and B's pose in A's frame (prepare_pair's rule and
+    /// arithmetic; invalid pairs go to the fallback), then set_gjk_parameters()'s values with the same
+    /// operations.
     void fill_chunk() {
-      chunk.count = 0;
-      next = 0;
+      chunk.left = 0;
       const std::size_t end = std::min(n, read + kChunk);
+      const T tolerance = T(options.tolerance), margin = T(options.margin);
       for (std::size_t k = read; k < end; k += Wd) {
-        const auto b = P::block(pairs + read, end - read, k - read);
+        const std::size_t s = k - read;  // a multiple of Wd: whole registers stay inside the chunk
+        const auto b = P::block(pairs + read, end - read, s);
         P::Pose pa = load(b, true), pb = load(b, false);
         P::normalize(pa);
         P::normalize(pb);
         const P::V3 ca[3] = {P::column(pa, 0), P::column(pa, 1), P::column(pa, 2)};
         const P::V3 cb[3] = {P::column(pb, 0), P::column(pb, 1), P::column(pb, 2)};
         const P::V3 d = P::sub(pb.t, pa.t);
-        typename P::real R[9], t[3];
+        tvec R[9], t[3];
+        typename P::real td[3];
         for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) R[3 * i + j] = P::dot(ca[i], cb[j]);
-          t[i] = P::dot(ca[i], d);
+          for (int j = 0; j < 3; ++j) put(chunk.R[3 * i + j] + s, R[3 * i + j] = to_t(P::dot(ca[i], cb[j])));
+          td[i] = P::dot(ca[i], d);
+          put(chunk.t[i] + s, t[i] = to_t(td[i]));
+          // Column i of Ra: entries (0, i), (1, i), (2, i).
+          put_double(chunk.Ra[i] + s, ca[i].x), put_double(chunk.Ra[3 + i] + s, ca[i].y),
+              put_double(chunk.Ra[6 + i] + s, ca[i].z);
         }
-        const std::uint32_t valid = lane_bits(pa.valid & pb.valid);
-        for (int l = 0; l < b.lanes; ++l) {
-          const std::uint32_t i = b.idx[l];
-          if (!(valid >> l & 1u)) {
-            fallback[fallbacks++] = i;
-            continue;
-          }
-          const std::size_t s = chunk.count++;
-          chunk.pair[s] = i;
-          chunk.shape_a[s] = in.shape_a[i];
-          chunk.shape_b[s] = in.shape_b[i];
-          for (int e = 0; e < 9; ++e) chunk.R[e][s] = R[e][l];
-          chunk.ta[0][s] = pa.t.x[l], chunk.ta[1][s] = pa.t.y[l], chunk.ta[2][s] = pa.t.z[l];
-          for (int c = 0; c < 3; ++c) {
-            chunk.t[c][s] = t[c][l];
-            const P::V3& col = ca[c];  // column c of Ra: entries (0, c), (1, c), (2, c)
-            chunk.Ra[c][s] = col.x[l], chunk.Ra[3 + c][s] = col.y[l], chunk.Ra[6 + c][s] = col.z[l];
-          }
-        }
+        put_double(chunk.ta[0] + s, pa.t.x), put_double(chunk.ta[1] + s, pa.t.y), put_double(chunk.ta[2] + s, pa.t.z);
+        __builtin_memcpy(chunk.pair + s, b.idx, sizeof b.idx);
+        *reinterpret_cast<unaligned_mask*>(chunk.shape_a + s) = pa.shape >> 3;
+        *reinterpret_cast<unaligned_mask*>(chunk.shape_b + s) = pb.shape >> 3;
+
+        const SideLanes A = side_lanes(in, type_a, pa), B = side_lanes(in, type_b, pb);
+        for (int c = 0; c < 3; ++c) put(chunk.size_a[c] + s, A.size[c]), put(chunk.size_b[c] + s, B.size[c]);
+        put(chunk.radius_a + s, A.radius);
+        put(chunk.radius_b + s, B.radius);
+        // gjk_limits(): |t| as norm3() in setup_pair_into(), in double; the rest in T.
+        const typename P::real t_norm = wsqrt<double>((td[0] * td[0] + td[1] * td[1]) + td[2] * td[2]);
+        const typename P::real bounding = P::field(in.bounding_radii, pa) + P::field(in.bounding_radii, pb);
+        const tvec radii = A.radius + B.radius, scale = to_t(bounding + t_norm);
+        const tvec floor = splat_t(T(16) * machine_epsilon<T>()) * scale;  // tolerance_floor(scale)
+        put(chunk.radii + s, radii);
+        put(chunk.scale + s, scale);
+        put(chunk.floor + s, floor);
+        put(chunk.tolerance + s, wmax(splat_t(tolerance), floor));
+        put(chunk.core_margin + s, splat_t(margin) + radii);
+        // MinkowskiDifference::center(): A's centre minus B's centre mapped into A's frame (mul()'s association),
+        // the x axis when that is zero (start_lane()'s rule).
+        tvec init[3];
+        for (int r = 0; r < 3; ++r)
+          init[r] = A.centre[r] - (((R[3 * r] * B.centre[0] + R[3 * r + 1] * B.centre[1]) + R[3 * r + 2] * B.centre[2]) +
+                                   t[r]);
+        const auto nonzero = (init[0] * init[0] + init[1] * init[1]) + init[2] * init[2] > splat_t(T(0));
+        put(chunk.init[0] + s, nonzero ? init[0] : splat_t(T(1)));
+        put(chunk.init[1] + s, nonzero ? init[1] : splat_t(T(0)));
+        put(chunk.init[2] + s, nonzero ? init[2] : splat_t(T(0)));
+
+        const std::uint32_t valid = lane_bits(pa.valid & pb.valid) & b.live;
+        chunk.left |= std::uint64_t(valid) << s;
+        for (std::uint32_t bad = b.live & ~valid; bad != 0; bad &= bad - 1)
+          fallback[fallbacks++] = b.idx[__builtin_ctz(bad)];
       }
       read = end;
     }
@@ -103,74 +196,53 @@ template <class T> struct WideGjkPairs {
                           side_a ? in.rotation_a : in.rotation_b, b.idx, b.consecutive);
     }
 
-    /// One side's core as make_core() builds it, read straight from the ShapeTable's per-shape arrays (no
-    /// ShapeCore, no PairSetup: building those per pair was a fifth of an ellipsoid pair's work). `radius` gets the
-    /// swept radius with make_core's roundings: T(inflation), plus T(radius) for spheres and capsules.
-    static typename G::SideStart side(const PairView& in, std::uint32_t shape, T& radius) {
-      typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
-      radius = T(in.shape_inflation[shape]);
-      switch (in.shape_type[shape]) {
-        case ShapeType::sphere: radius += T(in.shape_size[0][shape]); break;
-        case ShapeType::capsule:
-          radius += T(in.shape_size[0][shape]);
-          c.size[1] = T(in.shape_size[1][shape]);
-          break;
-        case ShapeType::convex: c.hull = &in.shape_hull[shape]; break;
-        default:
-          for (int i = 0; i < 3; ++i) c.size[i] = T(in.shape_size[i][shape]);
-          break;
-      }
-      return c;
-    }
-    /// ShapeCore::center() of a core (the hull's centroid, the origin for the other types in this path).
-    static Vec3<T> center(const typename G::SideStart& c) {
-      return c.hull ? hull_centroid<T>(*c.hull) : Vec3<T>::Zero();
-    }
-
-    /// setup_pair_into() and set_gjk_parameters() for a pair without closed form or warm start (the same
-    /// gjk_limits(), make_core's radii and centre arithmetic), then WideGjk's start_lane().
+    /// Starts the next pair in lane l: copies of the chunk's values (start_lane()'s writes, the run's constants
+    /// aside), the hull's rows for small hulls (load_side()), the search reset.
     bool load(Lanes& L, int l) {
-      while (next == chunk.count) {
+      while (chunk.left == 0) {
         if (read == n) return false;
         fill_chunk();
       }
-      const std::size_t s = next++;
-      const std::uint32_t ia = chunk.shape_a[s], ib = chunk.shape_b[s];
-      typename G::LaneStart q;
-      T radius_a, radius_b;
-      q.A = side(in, ia, radius_a);
-      q.B = side(in, ib, radius_b);
-      for (int e = 0; e < 9; ++e) q.R[e] = T(chunk.R[e][s]);
-      const double tx = chunk.t[0][s], ty = chunk.t[1][s], tz = chunk.t[2][s];
-      q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
-      // |t| as norm3() computes it in setup_pair_into().
-      const GjkLimits<T> g = gjk_limits<T>(radius_a, radius_b, in.bounding_radii[ia], in.bounding_radii[ib],
-                                           std::sqrt((tx * tx + ty * ty) + tz * tz), options);
-      q.tolerance = g.tolerance;
-      q.relative = g.relative;
-      q.max_iterations = g.max_iterations;
-      q.momentum = options.solver != Solver::gjk;
-      q.normalize = normalize;
-      q.boolean_only = g.boolean_only;
-      q.core_margin = g.core_margin;
-      q.touch = g.touch;
-      // MinkowskiDifference::center(): A's centre minus B's centre mapped into A's frame (mul()'s association).
-      const Vec3<T> cb = center(q.B);
-      const T* R = q.R;
-      const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + q.t[0],
-                             (R[3] * cb.x() + R[4] * cb.y()) + R[5] * cb.z() + q.t[1],
-                             (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + q.t[2]);
-      q.initial_direction = center(q.A) - b_center;
-      G::start_lane(L, l, q, std::int64_t(s));
+      const std::size_t s = std::size_t(__builtin_ctzll(chunk.left));
+      chunk.left &= chunk.left - 1;
+      const Chunk& c = chunk;
+      L.pair[l] = std::int64_t(s);
+      for (int e = 0; e < 9; ++e) L.R[e][l] = c.R[e][s];
+      for (int i = 0; i < 3; ++i) L.t[i][l] = c.t[i][s];
+      side(L.A, c.size_a, c.shape_a, s, l);
+      side(L.B, c.size_b, c.shape_b, s, l);
+      G::reset_search(L, l, Vec3<T>(c.init[0][s], c.init[1][s], c.init[2][s]));
+      L.momentum[l] = momentum;
+      L.tolerance[l] = c.tolerance[s];
+      L.touch[l] = c.floor[s];  // gjk_limits(): touch = floor
+      L.core_margin[l] = c.core_margin[s];
 
       LanePair& lp = lane[l];
-      lp.pair = chunk.pair[s];
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) lp.Ra(i, j) = chunk.Ra[3 * i + j][s];
-        lp.ta[i] = chunk.ta[i][s];
-      }
-      lp.completion = {radius_a, radius_b, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
+      lp.pair = c.pair[s];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) lp.Ra(i, j) = c.Ra[3 * i + j][s];
+      if (witness)
+        for (int i = 0; i < 3; ++i) lp.ta[i] = c.ta[i][s];
+      lp.radius_a = c.radius_a[s];
+      lp.radius_b = c.radius_b[s];
+      lp.radii = c.radii[s];
+      lp.scale = c.scale[s];
       return true;
+    }
+    /// Slot s of one side into lane l, as load_side() takes it: the sizes of the types that have them (the
+    /// support of the others reads none), the hull of a convex core. (No triangle: its pairs are not run here.)
+    void side(typename G::Side& side, const T (&size)[3][kChunk], const std::int64_t* shape, std::size_t s,
+              int l) const {
+      switch (side.type) {
+        case ShapeType::sphere: return;
+        case ShapeType::capsule: side.s1[l] = size[1][s]; return;
+        case ShapeType::convex: G::load_hull(side, &in.shape_hull[shape[s]], l); return;
+        default:
+          side.s0[l] = size[0][s];
+          side.s1[l] = size[1][s];
+          side.s2[l] = size[2][s];
+          return;
+      }
     }
 
     /// complete_pair() and write_pair_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
@@ -190,10 +262,13 @@ template <class T> struct WideGjkPairs {
         return;
       }
       GjkResult<T> g;
-      G::finish(L, l, status, g, options.level >= QueryLevel::witness);
+      G::finish(L, l, status, g, witness);
       const LanePair& lp = lane[l];
+      // The setup's completion values: the floor is the lane's touch tolerance (gjk_limits()).
+      const GjkCompletion<T> completion{lp.radius_a, lp.radius_b, lp.radii,          lp.scale,
+                                        L.touch[l],  L.tolerance[l], L.core_margin[l]};
       PairOutput<T> r;
-      if (!complete_from_gjk(lp.completion, g, options, r)) {
+      if (!complete_from_gjk(completion, g, options, r)) {
         fallback[fallbacks++] = lp.pair;
         return;
       }
@@ -210,6 +285,7 @@ template <class T> struct WideGjkPairs {
     typename G::Rows rows;
     rows.attach(L.A, L.B);
     Source source{in, options, type_a, type_b, pairs, n, out, fallback};
+    source.start_run(L);
     G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
     return source.fallbacks;
   }

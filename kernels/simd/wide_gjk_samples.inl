@@ -7,13 +7,11 @@
 // tests/kernels/wide_gjk_samples_test.cpp); a sample that needs more than GJK (overlap at the penetration level,
 // a float stall redone in double, a double stall above the certified floor) goes back to the caller.
 //
-// No include guard: included once per instruction set by isa_body.inl, after wide_gjk_pairs.inl (whose side() and
-// center() build a lane's cores from the ShapeTable's arrays, as make_core() does).
+// No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl.
 
 template <class T> struct WideGjkSamples {
   using G = WideGjk<T>;
   using Lanes = typename G::Lanes;
-  using Pairs = typename WideGjkPairs<T>::Source;
   static constexpr int W = G::W;
 
   /// What every sample of one pair shares: the cores, their swept radii and centres, the bounding radii.
@@ -23,6 +21,30 @@ template <class T> struct WideGjkSamples {
     double bounding_a, bounding_b;
     Vec3<T> center_a, center_b;
   };
+
+  /// One side's core as make_core() builds it, read from the ShapeTable's per-shape arrays, once per run of a
+  /// pair's samples: the sizes the support reads and the swept radius with make_core's roundings (T(inflation),
+  /// plus T(radius) for spheres and capsules).
+  static typename G::SideStart side(const PairView& in, std::uint32_t shape, T& radius) {
+    typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
+    radius = T(in.shape_inflation[shape]);
+    switch (in.shape_type[shape]) {
+      case ShapeType::sphere: radius += T(in.shape_size[0][shape]); break;
+      case ShapeType::capsule:
+        radius += T(in.shape_size[0][shape]);
+        c.size[1] = T(in.shape_size[1][shape]);
+        break;
+      case ShapeType::convex: c.hull = &in.shape_hull[shape]; break;
+      default:
+        for (int i = 0; i < 3; ++i) c.size[i] = T(in.shape_size[i][shape]);
+        break;
+    }
+    return c;
+  }
+  /// ShapeCore::center() of such a core: the hull's centroid, the origin for the other types of this path.
+  static Vec3<T> center(const typename G::SideStart& c) {
+    return c.hull ? hull_centroid<T>(*c.hull) : Vec3<T>::Zero();
+  }
 
   struct Source {
     const PairView& shapes;
@@ -46,12 +68,12 @@ template <class T> struct WideGjkSamples {
     void share(std::uint32_t ia, std::uint32_t ib) {
       shape_a = ia;
       shape_b = ib;
-      shared.A = Pairs::side(shapes, ia, shared.radius_a);
-      shared.B = Pairs::side(shapes, ib, shared.radius_b);
+      shared.A = side(shapes, ia, shared.radius_a);
+      shared.B = side(shapes, ib, shared.radius_b);
       shared.bounding_a = shapes.bounding_radii[ia];
       shared.bounding_b = shapes.bounding_radii[ib];
-      shared.center_a = Pairs::center(shared.A);
-      shared.center_b = Pairs::center(shared.B);
+      shared.center_a = center(shared.A);
+      shared.center_b = center(shared.B);
     }
 
     /// setup_pair_into() and set_gjk_parameters() for the next sample (gjk_limits() from its own |t|, the warm
@@ -79,7 +101,7 @@ template <class T> struct WideGjkSamples {
       const Vec3<T> warm(T(in.direction[0][s]), T(in.direction[1][s]), T(in.direction[2][s]));
       if (warm.allFinite() && warm.squaredNorm() > T(0)) {
         q.initial_direction = warm;
-      } else {  // MinkowskiDifference::center(), as in WideGjkPairs::Source::load()
+      } else {  // MinkowskiDifference::center(): A's centre minus B's mapped into A's frame
         const Vec3<T>& cb = shared.center_b;
         const T* R = q.R;
         const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + q.t[0],
