@@ -1,10 +1,20 @@
 // Randomized smoothing of order 0 (Montaut et al. 2023, sec. III; the slides "Randomized smoothing" and "- 0th
-// order"): the M perturbed copies of every pair go through collide() as one batch (per chunk of 2^20 samples), so
-// the SIMD lanes, the type grouping and the thread pool serve the samples exactly as they serve user pairs, and each
-// copy starts GJK from the unperturbed query's final direction.
+// order"). The M perturbed copies ("samples") of a pair share its shapes, A's pose and B's pose up to the
+// perturbation, so they do not go through collide() as new pairs (whose validation, type grouping, world poses and
+// outputs per sample cost more than a warm-started sample's GJK): each sample's relative pose is built in A's frame
+// straight into the SIMD GJK's sample layout (kernels::simd::build_samples, gjk_samples), its answer stays in A's
+// frame, and the estimator is reduced there and mapped to the world once per pair. Each sample's GJK starts from the
+// direction the analytic normal Jacobian predicts for its perturbation (first order: on curved pairs GJK then needs
+// about one iteration, the start being off by O(eps^2) only); polytope pairs, whose GJK needs its simplex anyway,
+// start from the unperturbed query's direction.
 #include "counter_rng.hpp"
 #include "derivative_pairs.hpp"
+#include "instruction_set.hpp"
+#include "kernel_views.hpp"
+#include "kernels/narrowphase.hpp"
+#include "kernels/simd/wide_gjk.hpp"
 #include "shape_table_access.hpp"
+#include "validate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +23,9 @@
 namespace batchcol::detail {
 namespace {
 
-// Samples per collide() call: bounds the temporary batch and results (~250 bytes per sample) to ~250 MB.
-constexpr std::size_t kSamplesPerCall = static_cast<std::size_t>(kMaxDerivativeSamples);
+/// Samples per block of a task: the block's poses, directions, noise and answers (~40 doubles per sample, ~330 KB)
+/// stay in L2 between the sample generation, the GJK and the reduction. Even: blocks end on antithetic pairs.
+constexpr std::size_t kBlockSamples = 1024;
 
 struct Noise {
   double translation = 0.0, rotation = 0.0;  // standard deviations: metres, radians
@@ -26,92 +37,262 @@ Noise noise_of(const ShapeTable& shapes, std::uint32_t b, const DerivativeOption
   return o.noise_scale == NoiseScale::relative ? Noise{o.noise * r, o.noise} : Noise{o.noise, o.noise / r};
 }
 
-// Shape b's pose perturbed about its own origin: t + s_t z_v, q R with q = exp(s_w z_w).
-void perturb(const PairBatch& batch, std::size_t i, const Noise& s, const double z[6], const Eigen::Quaterniond& q,
-             PairBatch& out, std::size_t k) {
-  out.shape_a[k] = batch.shape_a[i];
-  out.shape_b[k] = batch.shape_b[i];
-  out.translation_a.set(k, batch.translation_a[i]);
-  out.rotation_a.set(k, batch.rotation_a[i]);
-  out.translation_b.set(k, batch.translation_b[i] + s.translation * Eigen::Vector3d(z[0], z[1], z[2]));
-  out.rotation_b.set(k, (q * batch.rotation_b[i]).normalized());
+/// A shape with curvature somewhere (a round part or an inflation): the samples' GJK gains from a predicted start.
+bool curved(const ShapeTable& shapes, std::uint32_t s) {
+  if (s >= shapes.size()) return false;
+  const Shape& shape = shapes[s];
+  return shape.inflation > 0.0 || (shape.type != ShapeType::box && shape.type != ShapeType::convex &&
+                                   shape.type != ShapeType::triangle && shape.type != ShapeType::halfspace);
 }
 
-// Fills the samples of pairs [first, first + count) and their standard normal noise (6 per sample, in `noise`).
-// Sample 2k draws z from the key (seed, pair, k); sample 2k+1 is its antithetic copy -z, whose rotation is the
-// inverse (conjugate) of sample 2k's: one draw and one exponential serve both.
-void build_samples(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                   const DerivativeOptions& o, int threads, std::size_t first, std::size_t count, PairBatch& out,
-                   std::vector<double>& noise) {
-  const std::size_t M = static_cast<std::size_t>(o.samples), total = count * M;
-  out.shape_a.resize(total);
-  out.shape_b.resize(total);
-  for (Vec3Array* v : {&out.translation_a, &out.translation_b, &out.warm_start}) v->resize(total);
-  out.rotation_a.resize(total);
-  out.rotation_b.resize(total);
-  noise.resize(6 * total);
-  const bool warm = results.direction.size() == batch.size();
-  if (!warm) out.warm_start = Vec3Array();
-  for_pairs(threads, count, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p) {
-      const std::size_t i = first + p;
-      const Noise s = noise_of(shapes, batch.shape_b[i], o);
-      for (std::size_t j = 0; j < M; j += 2) {
-        double* z = &noise[6 * (p * M + j)];
-        gaussian_vector<6>(o.seed, i, j / 2, 0, z);
-        const Eigen::Vector3d w = s.rotation * Eigen::Vector3d(z[3], z[4], z[5]);
-        const double angle = w.norm();
-        const Eigen::Quaterniond q = angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle))
-                                                 : Eigen::Quaterniond::Identity();
-        perturb(batch, i, s, z, q, out, p * M + j);
-        if (j + 1 < M) {
-          double* minus = z + 6;
-          for (int k = 0; k < 6; ++k) minus[k] = -z[k];
-          perturb(batch, i, s, minus, q.conjugate(), out, p * M + j + 1);
-        }
-      }
-      if (warm)
-        for (std::size_t j = 0; j < M; ++j) out.warm_start.set(p * M + j, results.direction[i]);
-    }
-  });
+/// What the samples of pair i share, in A's frame: B's pose (R, t), the unperturbed answer g0 (distance, witness
+/// points, normal), the noise scales, the first GJK direction without perturbation and its first-order change P z.
+struct PairPlan {
+  std::size_t i = 0;
+  bool ok = false;  // false: no nominal witness, or b has no finite size (store_nothing)
+  Eigen::Matrix3d Ra, R;
+  Eigen::Vector3d ta, t, warm;
+  Eigen::Matrix<double, 10, 1> g0;
+  Noise s;
+  bool predict = false;
+  Eigen::Matrix<double, 3, 6> P;
+  ShapeType type_a = ShapeType::sphere, type_b = ShapeType::sphere;
+  bool wide = false;  // the type pair runs through gjk_samples
+  kernels::simd::SamplePlan samples;  // the above as build_samples() reads it
+};
+
+struct Context {
+  const ShapeTable& shapes;
+  const PairBatch& batch;
+  const PairResults& results;
+  const DerivativeOptions& o;
+  QueryOptions query;  // solver resolved
+  InstructionSet isa;
+  const DerivativeResults* predictor;  // analytic derivatives of the pairs with a curved side, or null
+  kernels::simd::PairView view;
+};
+
+bool wide_type_pair(ShapeType a, ShapeType b, const QueryOptions& q) {
+  const auto plain = [](ShapeType t) { return t != ShapeType::triangle && t != ShapeType::halfspace; };
+  return plain(a) && plain(b) && !kernels::may_have_closed_form(a, b, q);
+}
+
+void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
+  p.i = i;
+  PairGeometry g;
+  Eigen::Matrix3d R_a, R_b;
+  p.ok = nominal_geometry(c.shapes, c.batch, c.results, i, g, R_a, R_b);
+  if (!p.ok) return;
+  p.s = noise_of(c.shapes, c.batch.shape_b[i], c.o);
+  if (!(p.s.translation > 0.0)) {
+    p.ok = false;
+    return;
+  }
+  p.Ra = R_a;
+  p.ta = c.batch.translation_a[i];
+  p.R = R_a.transpose() * R_b;
+  const Eigen::Vector3d t_b = c.batch.translation_b[i];
+  p.t = R_a.transpose() * (t_b - p.ta);
+  p.g0 << g.distance, R_a.transpose() * (g.witness_a - p.ta), R_a.transpose() * (g.witness_b - p.ta),
+      R_a.transpose() * g.normal;
+  const Eigen::Vector3d d = c.results.direction.size() == c.batch.size() ? Eigen::Vector3d(c.results.direction[i])
+                                                                         : Eigen::Vector3d(-g.normal);
+  p.warm = R_a.transpose() * d;
+  const auto& types = ShapeTableAccess::types(c.shapes);
+  p.type_a = types[c.batch.shape_a[i]];
+  p.type_b = types[c.batch.shape_b[i]];
+  p.wide = wide_type_pair(p.type_a, p.type_b, c.query);
+  p.predict = false;
+  if (c.predictor && (c.predictor->status[i] == DerivativeStatus::smooth ||
+                      c.predictor->status[i] == DerivativeStatus::zero_curvature)) {
+    // A sample moves b about its own origin by v_n = s_t Ra z_v and w = s_w Ra z_w (z in A's frame): the world
+    // twist (v_n + t_b x w, w); the normal moves by J_n of that, taken back to A's frame.
+    const Mat36 J = c.predictor->normal_wrt_b[i];
+    const Eigen::Matrix3d Jv = J.leftCols<3>(), Jw = J.rightCols<3>();
+    p.P.leftCols<3>() = p.s.translation * (R_a.transpose() * Jv * R_a);
+    p.P.rightCols<3>() = p.s.rotation * (R_a.transpose() * (Jv * skew(t_b) + Jw) * R_a);
+    p.predict = p.P.allFinite();
+  }
+  kernels::simd::SamplePlan& sp = p.samples;
+  sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // CounterRng's (seed, pair) half of the key
+  for (int r = 0; r < 3; ++r) {
+    for (int q = 0; q < 3; ++q) sp.R0[3 * r + q] = p.R(r, q);
+    sp.t0[r] = p.t[r];
+    sp.n0[r] = p.g0[7 + r];
+    sp.first[r] = p.warm[r];
+    for (int e = 0; e < 6; ++e) sp.P[6 * r + e] = p.predict ? p.P(r, e) : 0.0;
+  }
+  sp.translation = p.s.translation;
+  sp.rotation = p.s.rotation;
+  sp.predict = p.predict;
+}
+
+/// One block's samples and answers, structure of arrays (the kernel's layout).
+struct Block {
+  enum Array { kR = 0, kT = 9, kDir = 12, kZ = 15, kDist = 21, kWa = 22, kWb = 25, kN = 28, kArrays = 31 };
+  std::size_t capacity = 0, count = 0;
+  std::vector<double> data;
+  std::vector<std::uint32_t> shape_a, shape_b, fallback;
+  std::vector<Status> status;
+  double* at(int array) { return data.data() + static_cast<std::size_t>(array) * capacity; }
+  void reserve(std::size_t n) {
+    capacity = n;
+    data.resize(kArrays * n);
+    shape_a.resize(n);
+    shape_b.resize(n);
+    fallback.resize(n);
+    status.resize(n);
+  }
+};
+
+/// One pair's samples in the block: plan, its samples [first, first + count) of the block, the first being its
+/// sample j0.
+struct Span {
+  std::size_t plan, first, count, j0;
+};
+
+/// Writes samples j0 .. j0 + count of plan p (j0 even) at block slot `slot`: the first samples of the antithetic
+/// pairs (2k: z drawn from the key (seed, pair, k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
+/// the transposed rotation) after them, so that build_samples() writes whole registers.
+void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
+  const std::size_t evens = (count + 1) / 2, odds = count / 2;
+  kernels::simd::SampleArrays even, odd;
+  for (int e = 0; e < 9; ++e) even.R[e] = b.at(Block::kR + e) + slot, odd.R[e] = even.R[e] + evens;
+  for (int e = 0; e < 3; ++e) {
+    even.t[e] = b.at(Block::kT + e) + slot, odd.t[e] = even.t[e] + evens;
+    even.direction[e] = b.at(Block::kDir + e) + slot, odd.direction[e] = even.direction[e] + evens;
+  }
+  for (int e = 0; e < 6; ++e) even.z[e] = b.at(Block::kZ + e) + slot, odd.z[e] = even.z[e] + evens;
+  kernels::simd::build_samples(c.isa, p.samples, j0 / 2, evens, odds, even, odd);
+  std::fill_n(b.shape_a.data() + slot, count, c.batch.shape_a[p.i]);
+  std::fill_n(b.shape_b.data() + slot, count, c.batch.shape_b[p.i]);
+}
+
+/// The scalar path for one sample: setup, GJK, completion (closed forms, EPA, float stalls redone in double).
+template <class T> void solve_sample(const Context& c, Block& b, std::size_t k) {
+  const std::size_t cap = b.capacity;
+  const double* R = b.at(Block::kR);
+  const double* t = b.at(Block::kT);
+  const double* dir = b.at(Block::kDir);
+  kernels::RelativePose X;
+  for (int r = 0; r < 3; ++r) {
+    for (int q = 0; q < 3; ++q) X.R(r, q) = R[(3 * r + q) * cap + k];
+    X.t[r] = t[r * cap + k];
+  }
+  const Eigen::Vector3d warm(dir[k], dir[cap + k], dir[2 * cap + k]);
+  const kernels::PairOutput<T> r =
+      kernels::solve_pair<T>(ShapeTableAccess::view(c.shapes, b.shape_a[k]), ShapeTableAccess::view(c.shapes, b.shape_b[k]),
+                             X, warm, c.query);
+  b.status[k] = r.status;
+  b.at(Block::kDist)[k] = double(r.distance);
+  for (int e = 0; e < 3; ++e) {
+    b.at(Block::kWa + e)[k] = double(r.witness_a[e]);
+    b.at(Block::kWb + e)[k] = double(r.witness_b[e]);
+    b.at(Block::kN + e)[k] = double(r.normal[e]);
+  }
+}
+
+template <class T> void solve_samples(const Context& c, Block& b, std::size_t first, std::size_t count, bool wide,
+                                      ShapeType ta, ShapeType tb) {
+  if (!wide) {
+    for (std::size_t k = first; k < first + count; ++k) solve_sample<T>(c, b, k);
+    return;
+  }
+  const std::size_t cap = b.capacity;
+  kernels::simd::SampleBatch in;
+  in.shape_a = b.shape_a.data() + first;
+  in.shape_b = b.shape_b.data() + first;
+  in.samples = count;
+  for (int e = 0; e < 9; ++e) in.R[e] = b.at(Block::kR) + e * cap + first;
+  for (int e = 0; e < 3; ++e) {
+    in.t[e] = b.at(Block::kT) + e * cap + first;
+    in.direction[e] = b.at(Block::kDir) + e * cap + first;
+  }
+  kernels::simd::SampleResults out;
+  out.status = b.status.data() + first;
+  out.distance = b.at(Block::kDist) + first;
+  for (int e = 0; e < 3; ++e) {
+    out.witness_a[e] = b.at(Block::kWa + e) + first;
+    out.witness_b[e] = b.at(Block::kWb + e) + first;
+    out.normal[e] = b.at(Block::kN + e) + first;
+  }
+  const std::size_t left = kernels::simd::gjk_samples<T>(c.isa, c.view, ta, tb, in, c.query, out, b.fallback.data());
+  for (std::size_t f = 0; f < left; ++f) solve_sample<T>(c, b, first + b.fallback[f]);
 }
 
 using Values = Eigen::Matrix<double, 10, 1>;  // signed distance, witness a, witness b, normal
 
-bool sample_values(const PairResults& r, std::size_t k, Values& v) {
-  if (r.status[k] != Status::converged) return false;
-  v << r.distance[k], r.witness_a[k], r.witness_b[k], r.normal[k];
-  return v.allFinite();
-}
-
-void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                 const DerivativeOptions& o, std::size_t i, const PairResults& samples, std::size_t first_sample,
-                 const double* noise, StoreBlock& out) {
-  DerivativeResults& d = out.d;
-  PairGeometry g;
-  Eigen::Matrix3d R_a, R_b;
-  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) return store_nothing(out, i);
-  const Noise s = noise_of(shapes, batch.shape_b[i], o);
-  if (!(s.translation > 0.0)) return store_nothing(out, i);
-  Values g0, v, mean = Values::Zero();
-  g0 << g.distance, g.witness_a, g.witness_b, g.normal;
+/// The running sums of one pair's estimator, sample by sample in sample order (so a pair split over blocks gives the
+/// same bits).
+struct Sums {
+  Values mean = Values::Zero();
   Eigen::Matrix<double, 10, 6> G = Eigen::Matrix<double, 10, 6>::Zero();
   int valid = 0;
-  for (int j = 0; j < o.samples; ++j) {
-    if (!sample_values(samples, first_sample + j, v)) continue;
-    const double* z = noise + 6 * j;
-    Eigen::Matrix<double, 1, 6> score;  // S^-1 z: the score of the Gaussian over the noise scale
-    score << z[0] / s.translation, z[1] / s.translation, z[2] / s.translation, z[3] / s.rotation,
-        z[4] / s.rotation, z[5] / s.rotation;
-    mean += v;
-    G += (v - g0) * score;
+};
+
+/// Adds samples [first, first + count) of the block: each sample's values (distance, witness points, normal in A's
+/// frame) minus the unperturbed ones, times its noise z; a sample without a converged, finite answer adds nothing.
+void accumulate(const PairPlan& p, Block& b, std::size_t first, std::size_t count, Sums& sums) {
+  // Sample order: the first sample of antithetic pair e at first + e, its copy at first + evens + e (build()).
+  const std::size_t evens = (count + 1) / 2;
+  const double* v0[10];
+  const double* z0[6];
+  for (int e = 0; e < 10; ++e) v0[e] = b.at(Block::kDist + e) + first;  // kDist, kWa, kWb, kN: consecutive
+  for (int f = 0; f < 6; ++f) z0[f] = b.at(Block::kZ + f) + first;
+  // Local sums (column-major, as Eigen's): the compiler keeps them out of the reference's aliasing and vectorises
+  // each column's 10 entries; every entry still adds its samples in sample order.
+  double mean[10], G[6][10], g0[10];
+  for (int e = 0; e < 10; ++e) {
+    mean[e] = sums.mean[e];
+    g0[e] = p.g0[e];
+    for (int f = 0; f < 6; ++f) G[f][e] = sums.G(e, f);
+  }
+  int valid = sums.valid;
+  const Status* status = b.status.data() + first;
+  for (std::size_t n = 0; n < count; ++n) {
+    const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
+    if (status[k] != Status::converged) continue;
+    double v[10], d[10], z[6];
+    bool finite = true;
+    for (int e = 0; e < 10; ++e) {
+      v[e] = v0[e][k];
+      finite = finite && std::isfinite(v[e]);
+    }
+    if (!finite) continue;
+    for (int f = 0; f < 6; ++f) z[f] = z0[f][k];
+    for (int e = 0; e < 10; ++e) {
+      mean[e] += v[e];
+      d[e] = v[e] - g0[e];
+    }
+    for (int f = 0; f < 6; ++f)
+      for (int e = 0; e < 10; ++e) G[f][e] += d[e] * z[f];
     ++valid;
   }
-  if (valid == 0) return store_nothing(out, i);
-  mean /= valid;
-  G /= valid;
+  for (int e = 0; e < 10; ++e) {
+    sums.mean[e] = mean[e];
+    for (int f = 0; f < 6; ++f) sums.G(e, f) = G[f][e];
+  }
+  sums.valid = valid;
+}
+
+/// The estimator from the sums, mapped from A's frame and A-frame noise to the world.
+void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlock& out) {
+  const std::size_t i = p.i;
+  if (sums.valid == 0) return store_nothing(out, i);
+  DerivativeResults& d = out.d;
+  const Values mean_a = sums.mean / sums.valid;
+  Eigen::Matrix<double, 10, 6> G = sums.G / sums.valid;
+  // The score of the Gaussian over the noise scale: S^-1 z.
+  G.leftCols<3>() /= p.s.translation;
+  G.rightCols<3>() /= p.s.rotation;
+  // Values and noise to the world: v_world - g0_world = Ra (v_A - g0_A) for the points and the normal, and the
+  // world noise is Ra z.
+  const Eigen::Matrix3d& Ra = p.Ra;
+  for (int r = 1; r < 10; r += 3) G.middleRows<3>(r) = (Ra * G.middleRows<3>(r)).eval();
+  G.leftCols<3>() = (G.leftCols<3>() * Ra.transpose()).eval();
+  G.rightCols<3>() = (G.rightCols<3>() * Ra.transpose()).eval();
   // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
-  const Eigen::Vector3d t_b = batch.translation_b[i];
+  const Eigen::Vector3d t_b = c.batch.translation_b[i];
   G.rightCols<3>() -= G.leftCols<3>() * skew(t_b);
   PairJacobians J;
   J.distance_b = G.row(0);
@@ -119,38 +300,106 @@ void reduce_pair(const ShapeTable& shapes, const PairBatch& batch, const PairRes
   J.witness_a_b = G.middleRows<3>(1);
   J.witness_b_b = G.middleRows<3>(4);
   J.normal_b = G.middleRows<3>(7);
-  const Eigen::Vector3d xa = mean.segment<3>(1), xb = mean.segment<3>(4), n = mean.segment<3>(7);
+  const Eigen::Vector3d xa = Ra * mean_a.segment<3>(1) + p.ta, xb = Ra * mean_a.segment<3>(4) + p.ta;
+  const Eigen::Vector3d n = Ra * mean_a.segment<3>(7);
   J.witness_a_a = rigid_motion(xa) - J.witness_a_b;
   J.witness_b_a = rigid_motion(xb) - J.witness_b_b;
   J.normal_a = (Mat36() << Eigen::Matrix3d::Zero(), -skew(n)).finished() - J.normal_b;
   store(out, i, J);
-  d.smoothed_distance[i] = mean(0);
+  d.smoothed_distance[i] = mean_a(0);
   d.smoothed_witness_a.set(i, xa);
   d.smoothed_witness_b.set(i, xb);
   d.smoothed_normal.set(i, n);
-  d.status[i] = valid == o.samples ? DerivativeStatus::smooth : DerivativeStatus::partial_samples;
+  d.status[i] = sums.valid == c.o.samples ? DerivativeStatus::smooth : DerivativeStatus::partial_samples;
+}
+
+template <class T> void run_pairs(const Context& c, std::size_t begin, std::size_t end, DerivativeResults& d) {
+  const std::size_t M = static_cast<std::size_t>(c.o.samples);
+  thread_local Block block;  // reused by every task of this thread (a task never waits on TBB)
+  if (block.capacity != kBlockSamples) block.reserve(kBlockSamples);
+  std::vector<PairPlan> plans;
+  std::vector<Span> spans;
+  StoreBlock out(d);
+  Sums sums;
+  std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
+  PairPlan current;
+  bool planned = false;
+  while (i < end) {
+    // Fill the block with whole antithetic pairs of samples, pair after pair.
+    plans.clear();
+    spans.clear();
+    std::size_t used = 0;
+    while (i < end && used + 2 <= kBlockSamples) {
+      if (!planned) {
+        plan_pair(c, i, current);
+        planned = true;
+        j = 0;
+        if (!current.ok) {
+          store_nothing(out, i);
+          ++i;
+          planned = false;
+          continue;
+        }
+      }
+      const std::size_t take = std::min(M - j, (kBlockSamples - used) & ~std::size_t(1));
+      plans.push_back(current);
+      spans.push_back({plans.size() - 1, used, take, j});
+      build(c, current, j, take, block, used);
+      used += take;
+      j += take;
+      if (j == M) {
+        ++i;
+        planned = false;
+      }
+    }
+    // Runs of one type pair through the kernel (or the scalar path).
+    for (std::size_t s = 0; s < spans.size();) {
+      const PairPlan& p = plans[spans[s].plan];
+      std::size_t e = s + 1;
+      while (e < spans.size() && plans[spans[e].plan].type_a == p.type_a && plans[spans[e].plan].type_b == p.type_b)
+        ++e;
+      const std::size_t first = spans[s].first, count = spans[e - 1].first + spans[e - 1].count - first;
+      solve_samples<T>(c, block, first, count, p.wide, p.type_a, p.type_b);
+      s = e;
+    }
+    // Reduce: a span that ends its pair finishes it; the last span may continue in the next block.
+    for (const Span& sp : spans) {
+      const PairPlan& p = plans[sp.plan];
+      if (sp.j0 == 0) sums = Sums();
+      accumulate(p, block, sp.first, sp.count, sums);
+      if (sp.j0 + sp.count == M) finish_pair(c, p, sums, out);
+    }
+  }
 }
 
 }  // namespace
 
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                const DerivativeOptions& o, const PairResults& results, DerivativeResults& d) {
-  const std::size_t n = batch.size(), M = static_cast<std::size_t>(o.samples);
+  const std::size_t n = batch.size();
   size_for(d, n, true);  // every pair writes all its entries
-  const std::size_t chunk = std::max<std::size_t>(1, kSamplesPerCall / M);
-  PairBatch samples;
-  PairResults sample_results;
-  std::vector<double> noise;
-  for (std::size_t first = 0; first < n; first += chunk) {
-    const std::size_t count = std::min(chunk, n - first);
-    build_samples(shapes, batch, results, o, query.threads, first, count, samples, noise);
-    collide(shapes, samples, query, sample_results);
-    for_pairs(query.threads, count, [&](std::size_t begin, std::size_t end) {
-      StoreBlock out(d);
-      for (std::size_t p = begin; p < end; ++p)
-        reduce_pair(shapes, batch, results, o, first + p, sample_results, p * M, &noise[6 * p * M], out);
-    });
+  // The first-order start needs the normal's Jacobian: the analytic derivatives, when some pair has curvature.
+  bool any_curved = false;
+  for (std::size_t i = 0; i < n && !any_curved; ++i)
+    any_curved = curved(shapes, batch.shape_a[i]) || curved(shapes, batch.shape_b[i]);
+  // Reused by the calls of this thread up to 2^14 pairs (15 MB): a fresh 120 doubles per pair were zero-filled and
+  // page-faulted at every call, a fixed cost that small M feels.
+  thread_local DerivativeResults reused;
+  DerivativeResults fresh;
+  DerivativeResults& predictor = n <= (std::size_t(1) << 14) ? reused : fresh;
+  if (any_curved) {
+    DerivativeOptions analytic = o;
+    analytic.method = DerivativeMethod::analytic;
+    differentiate_results(shapes, batch, results, analytic, query.threads, predictor);
   }
+  QueryOptions q = query;
+  q.solver = resolve_solver(query.solver, query.level);
+  const Context c{shapes, batch, results, o, q, resolve_instruction_set(query.isa),
+                  any_curved ? &predictor : nullptr, pair_view(shapes, batch)};
+  for_pairs(query.threads, n, [&](std::size_t begin, std::size_t end) {
+    if (query.precision == Precision::float32) run_pairs<float>(c, begin, end, d);
+    else run_pairs<double>(c, begin, end, d);
+  });
 }
 
 }  // namespace batchcol::detail

@@ -26,6 +26,12 @@ namespace batchcol::kernels::simd {
                                const QueryOptions&, const ResultView&, std::uint32_t*);                            \
   std::size_t gjk_pairs_float(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,            \
                               const QueryOptions&, const ResultView&, std::uint32_t*);                             \
+  std::size_t gjk_samples_double(const PairView&, ShapeType, ShapeType, const SampleBatch&, const QueryOptions&,    \
+                                 const SampleResults&, std::uint32_t*);                                            \
+  std::size_t gjk_samples_float(const PairView&, ShapeType, ShapeType, const SampleBatch&, const QueryOptions&,     \
+                                const SampleResults&, std::uint32_t*);                                             \
+  void build_samples(const SamplePlan&, std::uint64_t, std::size_t, std::size_t, const SampleArrays&,               \
+                     const SampleArrays&);                                                                         \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -67,10 +73,14 @@ struct IsaKernels {
   decltype(&scalar::point_solid_pairs) point_solid_pairs;
   decltype(&scalar::gjk_pairs_double) gjk_pairs_double;
   decltype(&scalar::gjk_pairs_float) gjk_pairs_float;
+  decltype(&scalar::gjk_samples_double) gjk_samples_double;
+  decltype(&scalar::gjk_samples_float) gjk_samples_float;
+  decltype(&scalar::build_samples) build_samples;
 };
 #define BATCHCOL_ISA_TABLE(ns)                                                                               \
   IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
-               &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float }
+               &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float, &ns::gjk_samples_double,   \
+               &ns::gjk_samples_float, &ns::build_samples }
 // Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
 // same bits), scalar, avx2, avx512.
 constexpr IsaKernels kIsaKernels[] = {BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(avx2),
@@ -124,6 +134,27 @@ std::size_t gjk_pairs<double>(InstructionSet isa, const PairView& in, ShapeType 
                               const ResultView& out, std::uint32_t* fallback) {
   require_resolved(options.solver);
   return kernels_of(isa).gjk_pairs_double(in, a, b, pairs, n, options, out, fallback);
+}
+
+template <>
+std::size_t gjk_samples<double>(InstructionSet isa, const PairView& shapes, ShapeType a, ShapeType b,
+                                const SampleBatch& in, const QueryOptions& options, const SampleResults& out,
+                                std::uint32_t* fallback) {
+  require_resolved(options.solver);
+  return kernels_of(isa).gjk_samples_double(shapes, a, b, in, options, out, fallback);
+}
+
+template <>
+std::size_t gjk_samples<float>(InstructionSet isa, const PairView& shapes, ShapeType a, ShapeType b,
+                               const SampleBatch& in, const QueryOptions& options, const SampleResults& out,
+                               std::uint32_t* fallback) {
+  require_resolved(options.solver);
+  return kernels_of(isa).gjk_samples_float(shapes, a, b, in, options, out, fallback);
+}
+
+void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
+                   std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd) {
+  kernels_of(isa).build_samples(p, a0, count, odd_count, even, odd);
 }
 
 namespace {

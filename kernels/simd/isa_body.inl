@@ -11,6 +11,8 @@ namespace batchcol::kernels::simd::BATCHCOL_SIMD_NS {
 #include "kernels/simd/wide_boxes.inl"
 #include "kernels/simd/wide_point_solids.inl"
 #include "kernels/simd/wide_gjk_pairs.inl"
+#include "kernels/simd/wide_gjk_samples.inl"
+#include "kernels/simd/wide_samples.inl"
 
 void gjk_lanes_double(const PairSetup<double>* setups, std::size_t n, GjkResult<double>* out, Solver solver,
                       bool points) {
@@ -28,6 +30,20 @@ std::size_t gjk_pairs_double(const PairView& in, ShapeType a, ShapeType b, const
 std::size_t gjk_pairs_float(const PairView& in, ShapeType a, ShapeType b, const std::uint32_t* pairs, std::size_t n,
                             const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
   return WideGjkPairs<float>::run(in, a, b, pairs, n, options, out, fallback);
+}
+
+std::size_t gjk_samples_double(const PairView& shapes, ShapeType a, ShapeType b, const SampleBatch& in,
+                               const QueryOptions& options, const SampleResults& out, std::uint32_t* fallback) {
+  return WideGjkSamples<double>::run(shapes, a, b, in, options, out, fallback);
+}
+std::size_t gjk_samples_float(const PairView& shapes, ShapeType a, ShapeType b, const SampleBatch& in,
+                              const QueryOptions& options, const SampleResults& out, std::uint32_t* fallback) {
+  return WideGjkSamples<float>::run(shapes, a, b, in, options, out, fallback);
+}
+
+void build_samples(const SamplePlan& p, std::uint64_t a0, std::size_t count, std::size_t odd_count,
+                   const SampleArrays& even, const SampleArrays& odd) {
+  WideSamples::run(p, a0, count, odd_count, even, odd);
 }
 
 std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, const std::uint32_t* pairs,

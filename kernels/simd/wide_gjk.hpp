@@ -49,4 +49,65 @@ template <>
 std::size_t gjk_pairs<float>(InstructionSet, const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,
                              const QueryOptions&, const ResultView&, std::uint32_t*);
 
+/// Perturbed copies ("samples") of pairs of one shape-pair type (the smoothed0 derivatives' M copies of a pair,
+/// engine/src/derivative_smoothed0.cpp): sample s has the shapes shape_a[s], shape_b[s] (a pair's samples are
+/// consecutive: the cores are read once per run of equal shapes), B's pose in A's frame (R row-major, t) and the
+/// first GJK direction in A's frame (not finite or zero: the cores' centres' difference, as without warm start).
+struct SampleBatch {
+  const std::uint32_t* shape_a = nullptr;
+  const std::uint32_t* shape_b = nullptr;
+  std::size_t samples = 0;
+  const double* R[9] = {};
+  const double* t[3] = {};
+  const double* direction[3] = {};
+};
+/// Each sample's answer in A's frame (written for every sample not handed back).
+struct SampleResults {
+  Status* status = nullptr;
+  double* distance = nullptr;
+  double* witness_a[3] = {};
+  double* witness_b[3] = {};
+  double* normal[3] = {};
+};
+
+/// GJK on every sample of `in` (kernels/simd/wide_gjk_samples.inl): the answer setup_pair_into(), the SIMD GJK and
+/// complete_pair() give on the sample's relative pose and first direction, with the same bits, without a PairSetup
+/// per sample. Preconditions as for gjk_pairs (shapes of types type_a, type_b, neither triangle nor halfspace, no
+/// closed form for the pair under `options`, options.solver resolved), but options.level is witness or
+/// penetration. Returns how many samples it left to the caller (overlap at the penetration level, a float stall
+/// redone in double, a double stall above the certified floor), listed in fallback[0 .. count) (room for
+/// in.samples); their results are not written. Only `shapes`' per-shape arrays are read.
+template <class T>
+std::size_t gjk_samples(InstructionSet isa, const PairView& shapes, ShapeType type_a, ShapeType type_b,
+                        const SampleBatch& in, const QueryOptions& options, const SampleResults& out,
+                        std::uint32_t* fallback);
+template <>
+std::size_t gjk_samples<double>(InstructionSet, const PairView&, ShapeType, ShapeType, const SampleBatch&,
+                                const QueryOptions&, const SampleResults&, std::uint32_t*);
+template <>
+std::size_t gjk_samples<float>(InstructionSet, const PairView&, ShapeType, ShapeType, const SampleBatch&,
+                               const QueryOptions&, const SampleResults&, std::uint32_t*);
+
+/// What the samples of one pair share, for build_samples(): the counter key's per-pair half
+/// splitmix64(splitmix64(seed) ^ pair) (engine/src/counter_rng.hpp), B's pose in A's frame, the noise scales
+/// (metres, radians), and the first GJK direction: -(n0 + P z) when `predict`, else `first`.
+struct SamplePlan {
+  std::uint64_t key = 0;
+  double R0[9] = {}, t0[3] = {}, n0[3] = {}, first[3] = {}, P[18] = {};
+  double translation = 0.0, rotation = 0.0;
+  bool predict = false;
+};
+/// Per-sample arrays build_samples() writes: B's pose in A's frame (row-major R, t), the first direction and z.
+struct SampleArrays {
+  double* R[9] = {};
+  double* t[3] = {};
+  double* direction[3] = {};
+  double* z[6] = {};
+};
+/// Antithetic pairs k = a0 .. a0 + count - 1 of plan p (kernels/simd/wide_samples.inl): z from the counter key
+/// (pair, k), sample 2k (E R0, t0 + s_t z, z) at index k - a0 of `even`, its antithetic copy (E^T R0, t0 - s_t z, -z)
+/// at index k - a0 of `odd` for the first odd_count pairs. The same bits on every instruction set.
+void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
+                   std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd);
+
 }  // namespace batchcol::kernels::simd

@@ -466,8 +466,12 @@ template <class T> struct WideGjk {
   }
   /// A convex side's hull in lane l: the view, a fresh hill-climbing hint, the rows of a small hull.
   static void load_hull(Side& s, const HullView* hull, int l) {
+    // The same small hull as the lane's previous pair (consecutive samples of one pair, a batch's repeated
+    // shapes): its rows are still the lane's (rows only grow, and growing pads every lane with its last vertex).
+    const bool same = s.hull[l] == hull && s.lane_vertices[l] == hull->vertex_count && (s.small >> l & 1u);
     s.hull[l] = hull;
     s.hint[l] = SupportHint{};
+    if (same) return;
     const std::uint32_t bit = 1u << l;
     const bool small = hull->vertex_count < kHillClimbMinVertices;
     s.small = small ? s.small | bit : s.small & ~bit;

@@ -42,7 +42,7 @@ TEST(DerivativesOptions, BadOptionsAreInputErrorsNamingTheOption) {
   expect_input_error(f.shapes, f.batch, q, o, "samples");
   o.samples = -3;
   expect_input_error(f.shapes, f.batch, q, o, "samples");
-  o.samples = kMaxDerivativeSamples + 1;  // would need a ~250 MB batch per pair
+  o.samples = kMaxDerivativeSamples + 1;  // above the documented limit
   expect_input_error(f.shapes, f.batch, q, o, "samples");
   o.samples = 8;
   for (double bad : {0.0, -1e-3, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {

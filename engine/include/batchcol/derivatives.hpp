@@ -16,7 +16,9 @@
 //             infinite curvature along it, whose limit is taken exactly). DerivativeStatus says where the
 //             derivative is undefined or uninformative.
 //  smoothed0  Randomized smoothing of order 0: M perturbed copies of every pair (shape b's pose perturbed by Gaussian
-//             noise on se(3) about its own origin) run as one batch through collide(); the smoothed values are the
+//             noise on se(3) about its own origin, the noise drawn in shape a's frame) run through the batched
+//             SIMD GJK with the query's options (each sample answered as collide() would answer that pose, to
+//             the query's tolerance); the smoothed values are the
 //             sample means and their gradients the Gaussian score-function estimator, with antithetic samples
 //             (sample 2k+1 uses -z of sample 2k) and the unperturbed query as baseline: grad = 1/M sum_j
 //             (g(T + S z_j) - g(T)) (S^-1 z_j)^T. For even M the baseline cancels within each antithetic pair; an
@@ -53,7 +55,7 @@ enum class NoiseScale : std::uint8_t { relative, absolute };
 BATCHCOL_API const char* to_string(DerivativeMethod method);
 BATCHCOL_API const char* to_string(NoiseScale scale);
 
-/// The most samples per pair (smoothed0 runs at most this many samples per collide() call: ~250 MB of temporaries).
+/// The most samples per pair.
 constexpr int kMaxDerivativeSamples = 1 << 20;
 
 struct DerivativeOptions {
@@ -126,8 +128,9 @@ struct BATCHCOL_API DerivativeResults {
 
 /// Runs collide(shapes, batch, query, results) and the derivatives of every pair. query.level must be witness or
 /// penetration (InputError naming "level" otherwise); derivative options are validated as by validate(). smoothed0
-/// runs the M perturbed copies of all pairs as batches of M * (at most 2^20 / M) pairs through collide() with the
-/// same query options, warm-started from the unperturbed query. Results are bitwise identical for any thread count.
+/// runs the M perturbed copies of every pair through the SIMD GJK in blocks of 1024 samples with the same query
+/// options, each started from the direction the analytic normal Jacobian predicts for its perturbation (pairs with
+/// a curved side) or from the unperturbed query's. Results are bitwise identical for any thread count.
 BATCHCOL_API void differentiate(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
                    const DerivativeOptions& options, PairResults& results, DerivativeResults& derivatives);
 

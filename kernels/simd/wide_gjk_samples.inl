@@ -1,0 +1,150 @@
+// Perturbed copies of pairs ("samples": the smoothed0 derivatives' M copies of a pair with B's pose perturbed,
+// engine/src/derivative_smoothed0.cpp) straight from per-sample arrays into per-sample answers in A's frame. The M
+// samples of a pair share its shapes, so a lane refill reads the pair's cores once per pair (not per sample) and
+// only the sample's relative pose and first direction per sample; no batch validation, type grouping, world pose
+// or world output is done per sample. Each lane runs WideGjk's loop, so a sample's answer is bitwise the answer of
+// the scalar setup + GJK + complete_pair() on the same relative pose, tolerance and first direction (tested in
+// tests/kernels/wide_gjk_samples_test.cpp); a sample that needs more than GJK (overlap at the penetration level,
+// a float stall redone in double, a double stall above the certified floor) goes back to the caller.
+//
+// No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl.
+
+template <class T> struct WideGjkSamples {
+  using G = WideGjk<T>;
+  using Lanes = typename G::Lanes;
+  static constexpr int W = G::W;
+
+  /// What every sample of one pair shares: the cores, their swept radii and centres, the bounding radii.
+  struct Shared {
+    typename G::SideStart A, B;
+    T radius_a, radius_b;
+    double bounding_a, bounding_b;
+    Vec3<T> center_a, center_b;
+  };
+
+  /// One side's core as make_core() builds it, read from the ShapeTable's per-shape arrays, once per run of a
+  /// pair's samples: the sizes the support reads and the swept radius with make_core's roundings (T(inflation),
+  /// plus T(radius) for spheres and capsules).
+  static typename G::SideStart side(const PairView& in, std::uint32_t shape, T& radius) {
+    typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
+    radius = T(in.shape_inflation[shape]);
+    switch (in.shape_type[shape]) {
+      case ShapeType::sphere: radius += T(in.shape_size[0][shape]); break;
+      case ShapeType::capsule:
+        radius += T(in.shape_size[0][shape]);
+        c.size[1] = T(in.shape_size[1][shape]);
+        break;
+      case ShapeType::convex: c.hull = &in.shape_hull[shape]; break;
+      default:
+        for (int i = 0; i < 3; ++i) c.size[i] = T(in.shape_size[i][shape]);
+        break;
+    }
+    return c;
+  }
+  /// ShapeCore::center() of such a core: the hull's centroid, the origin for the other types of this path.
+  static Vec3<T> center(const typename G::SideStart& c) {
+    return c.hull ? hull_centroid<T>(*c.hull) : Vec3<T>::Zero();
+  }
+
+  struct Source {
+    const PairView& shapes;
+    const SampleBatch& in;
+    const QueryOptions& options;
+    const SampleResults& out;
+    std::uint32_t* fallback;
+    std::size_t fallbacks = 0;
+    std::size_t next = 0;  // the next sample to load
+    std::uint32_t shape_a = ~0u, shape_b = ~0u;  // the shapes `shared` was made of
+    Shared shared;
+    bool normalize;
+    std::uint32_t sample[W] = {};
+    GjkCompletion<T> completion[W];
+
+    Source(const PairView& shapes_, const SampleBatch& in_, const QueryOptions& options_, const SampleResults& out_,
+           std::uint32_t* fallback_, ShapeType a, ShapeType b)
+        : shapes(shapes_), in(in_), options(options_), out(out_), fallback(fallback_),
+          normalize(!(a == ShapeType::ellipsoid && b == ShapeType::ellipsoid)) {}
+
+    void share(std::uint32_t ia, std::uint32_t ib) {
+      shape_a = ia;
+      shape_b = ib;
+      shared.A = side(shapes, ia, shared.radius_a);
+      shared.B = side(shapes, ib, shared.radius_b);
+      shared.bounding_a = shapes.bounding_radii[ia];
+      shared.bounding_b = shapes.bounding_radii[ib];
+      shared.center_a = center(shared.A);
+      shared.center_b = center(shared.B);
+    }
+
+    /// setup_pair_into() and set_gjk_parameters() for the next sample (gjk_limits() from its own |t|, the warm
+    /// direction when finite and non-zero, else the centres' difference), then WideGjk's start_lane().
+    bool load(Lanes& L, int l) {
+      if (next == in.samples) return false;
+      const std::size_t s = next++;
+      if (in.shape_a[s] != shape_a || in.shape_b[s] != shape_b) share(in.shape_a[s], in.shape_b[s]);
+      typename G::LaneStart q;
+      q.A = shared.A;
+      q.B = shared.B;
+      for (int e = 0; e < 9; ++e) q.R[e] = T(in.R[e][s]);
+      const double tx = in.t[0][s], ty = in.t[1][s], tz = in.t[2][s];
+      q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
+      const GjkLimits<T> g = gjk_limits<T>(shared.radius_a, shared.radius_b, shared.bounding_a, shared.bounding_b,
+                                           std::sqrt((tx * tx + ty * ty) + tz * tz), options);
+      q.tolerance = g.tolerance;
+      q.relative = g.relative;
+      q.max_iterations = g.max_iterations;
+      q.momentum = options.solver != Solver::gjk;
+      q.normalize = normalize;
+      q.boolean_only = g.boolean_only;
+      q.core_margin = g.core_margin;
+      q.touch = g.touch;
+      const Vec3<T> warm(T(in.direction[0][s]), T(in.direction[1][s]), T(in.direction[2][s]));
+      if (warm.allFinite() && warm.squaredNorm() > T(0)) {
+        q.initial_direction = warm;
+      } else {  // MinkowskiDifference::center(): A's centre minus B's mapped into A's frame
+        const Vec3<T>& cb = shared.center_b;
+        const T* R = q.R;
+        const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + q.t[0],
+                               (R[3] * cb.x() + R[4] * cb.y()) + R[5] * cb.z() + q.t[1],
+                               (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + q.t[2]);
+        q.initial_direction = shared.center_a - b_center;
+      }
+      G::start_lane(L, l, q, std::int64_t(s));
+      sample[l] = std::uint32_t(s);
+      completion[l] = {shared.radius_a, shared.radius_b, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
+      return true;
+    }
+
+    /// complete_from_gjk() for lane l's sample, written in A's frame; what it cannot finish goes to the fallback.
+    void done(const Lanes& L, int l, GjkStatus status) {
+      GjkResult<T> g;
+      G::finish(L, l, status, g, true);
+      PairOutput<T> r;
+      const std::uint32_t s = sample[l];
+      if (!complete_from_gjk(completion[l], g, options, r)) {
+        fallback[fallbacks++] = s;
+        return;
+      }
+      out.status[s] = r.status;
+      out.distance[s] = double(r.distance);
+      for (int c = 0; c < 3; ++c) {
+        out.witness_a[c][s] = double(r.witness_a[c]);
+        out.witness_b[c][s] = double(r.witness_b[c]);
+        out.normal[c][s] = double(r.normal[c]);
+      }
+    }
+  };
+
+  static std::size_t run(const PairView& shapes, ShapeType type_a, ShapeType type_b, const SampleBatch& in,
+                         const QueryOptions& options, const SampleResults& out, std::uint32_t* fallback) {
+    if (in.samples == 0) return 0;
+    Lanes L;
+    L.A.type = type_a;
+    L.B.type = type_b;
+    typename G::Rows rows;
+    rows.attach(L.A, L.B);
+    Source source(shapes, in, options, out, fallback, type_a, type_b);
+    G::drive(L, source, options.solver, true);
+    return source.fallbacks;
+  }
+};

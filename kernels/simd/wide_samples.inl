@@ -1,0 +1,138 @@
+// The smoothed0 derivatives' perturbed samples, W antithetic pairs of samples per register (engine/src/
+// derivative_smoothed0.cpp): the counter-based Gaussian draws (engine/src/counter_rng.hpp's generator, lane by
+// lane: SplitMix64 keyed by (seed, pair, k), Box-Muller through its log_unit and sincos_turn series) and B's
+// perturbed pose in A's frame, E R0 and t0 + s_t z for sample 2k, E^T R0 and t0 - s_t z for its antithetic copy
+// 2k+1. Every lane does the scalar code's operations in its order (no FMA contraction), so every instruction set
+// gives the bits of engine/src/counter_rng.hpp's gaussian_vector<6> and of the scalar build (tested in
+// tests/kernels/wide_samples_test.cpp). In scalar code the drawing and the building were a third of a sample's work.
+//
+// No include guard: included once per instruction set by isa_body.inl.
+
+struct WideSamples {
+  static constexpr int W = Wide<double>::W;
+  using real = wreal<double>;
+  using mask = wmask<double>;  // 64-bit lane integers
+  typedef std::uint64_t u64 __attribute__((vector_size(sizeof(real))));
+
+  static u64 splitmix(u64 x) {
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+  }
+  static real splat(double v) { return real{} + v; }
+
+  /// CounterRng::uniform(): (next >> 11) + 1 times 2^-53, exact.
+  static real uniform(u64& state) {
+    state += 0x9E3779B97F4A7C15ull;
+    const u64 x = (splitmix(state) >> 11) + 1;
+    return __builtin_convertvector(x, real) * 0x1.0p-53;
+  }
+  /// counter_rng.hpp's log_unit, lane by lane.
+  static real log_unit(real u) {
+    const u64 bits = (u64)u;  // same-size vector casts keep the bits
+    mask k = mask((bits >> 52)) - 1023;
+    const u64 mbits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+    real m = (real)mbits;
+    const mask big = m > 1.4142135623730951;
+    m = select(big, m * 0.5, m);
+    k = select(big, k + 1, k);
+    const real s = (m - 1.0) / (m + 1.0), z = s * s;
+    const real p = (((((((((((1.0 / 23.0) * z + 1.0 / 21.0) * z + 1.0 / 19.0) * z + 1.0 / 17.0) * z + 1.0 / 15.0) *
+                            z + 1.0 / 13.0) * z + 1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) *
+                      z + 1.0 / 3.0) * z + 1.0;
+    return __builtin_convertvector(k, real) * 0.6931471805599453 + 2.0 * s * p;
+  }
+  /// counter_rng.hpp's sinc_cos_small.
+  static void sinc_cos_small(real x, real& sinc, real& cos) {
+    const real z = x * x;
+    sinc = ((((((((-1.0 / 355687428096000.0) * z + 1.0 / 1307674368000.0) * z - 1.0 / 6227020800.0) * z +
+                 1.0 / 39916800.0) * z - 1.0 / 362880.0) * z + 1.0 / 5040.0) * z - 1.0 / 120.0) * z + 1.0 / 6.0);
+    sinc = 1.0 - z * sinc;
+    cos = (((((((1.0 / 20922789888000.0 * z - 1.0 / 87178291200.0) * z + 1.0 / 479001600.0) * z -
+                 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z + 1.0 / 24.0) * z - 0.5) * z + 1.0;
+  }
+  /// counter_rng.hpp's sincos_turn: the quarter turn q = int(4u + 0.5) removed exactly, then the series.
+  static void sincos_turn(real u, real& sin, real& cos) {
+    const mask q = __builtin_convertvector(4.0 * u + 0.5, mask);
+    const real x = 6.283185307179586 * (u - 0.25 * __builtin_convertvector(q, real));
+    real sx, cx;
+    sinc_cos_small(x, sx, cx);
+    sx *= x;
+    const mask quarter = q & 3;
+    const mask q1 = quarter == 1, q2 = quarter == 2, q3 = quarter == 3;
+    sin = select(q1, cx, select(q2, -sx, select(q3, -cx, sx)));
+    cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
+  }
+
+  /// Samples of antithetic pairs a0 .. a0 + count - 1 of plan p: pair e's first sample goes to index e of `even`,
+  /// its antithetic copy to index e of `odd` (odd's arrays may be null when count == 1 and the copy is not wanted:
+  /// `odd_count` copies are written, count or count - 1).
+  static void run(const SamplePlan& p, std::uint64_t a0, std::size_t count, std::size_t odd_count,
+                  const SampleArrays& even, const SampleArrays& odd) {
+    for (std::size_t e0 = 0; e0 < count; e0 += W) {
+      const int lanes = int(std::min<std::size_t>(W, count - e0));
+      u64 index{};
+      for (int l = 0; l < W; ++l) index[l] = a0 + e0 + std::uint64_t(l);
+      // CounterRng(seed, pair, k, 0): p.key holds splitmix(splitmix(seed) ^ pair).
+      u64 state = splitmix(splitmix((u64{} + p.key) ^ index) ^ std::uint64_t(0));
+      real z[6];
+      for (int g = 0; g < 6; g += 2) {
+        const real radius = wsqrt<double>(-2.0 * log_unit(uniform(state)));
+        real s, c;
+        sincos_turn(uniform(state), s, c);
+        z[g] = radius * c;
+        z[g + 1] = radius * s;
+      }
+      // exp([w]x) through the unit quaternion (cos h, sin(h) w / (2h)), h = |w| / 2 (the engine's rotation_exp).
+      const real w0 = p.rotation * z[3], w1 = p.rotation * z[4], w2 = p.rotation * z[5];
+      const real angle2 = (w0 * w0 + w1 * w1) + w2 * w2;
+      const real h = 0.5 * wsqrt<double>(angle2);
+      real sinc, c;
+      sinc_cos_small(h, sinc, c);
+      const mask wide = h > 0.7853981633974483;
+      if (any(wide)) {
+        for (int l = 0; l < W; ++l) {
+          if (!wide[l]) continue;
+          sinc[l] = std::sin(h[l]) / h[l];
+          c[l] = std::cos(h[l]);
+        }
+      }
+      const real k = 0.5 * sinc, x = k * w0, y = k * w1, zq = k * w2;
+      const real xx = x * x, yy = y * y, zz = zq * zq, xy = x * y, xz = x * zq, yz = y * zq, cx = c * x, cy = c * y,
+                 cz = c * zq;
+      const real E[9] = {1.0 - 2.0 * (yy + zz), 2.0 * (xy - cz),       2.0 * (xz + cy),
+                         2.0 * (xy + cz),       1.0 - 2.0 * (xx + zz), 2.0 * (yz - cx),
+                         2.0 * (xz - cy),       2.0 * (yz + cx),       1.0 - 2.0 * (xx + yy)};
+      real dz[3] = {splat(0.0), splat(0.0), splat(0.0)};
+      if (p.predict)
+        for (int r = 0; r < 3; ++r)
+          dz[r] = ((((p.P[6 * r] * z[0] + p.P[6 * r + 1] * z[1]) + p.P[6 * r + 2] * z[2]) + p.P[6 * r + 3] * z[3]) +
+                   p.P[6 * r + 4] * z[4]) + p.P[6 * r + 5] * z[5];
+      real R[9], Rt[9], t[3], tm[3], d[3], dm[3];
+      for (int r = 0; r < 3; ++r) {
+        for (int q = 0; q < 3; ++q) {
+          R[3 * r + q] = (E[3 * r] * p.R0[q] + E[3 * r + 1] * p.R0[3 + q]) + E[3 * r + 2] * p.R0[6 + q];
+          Rt[3 * r + q] = (E[r] * p.R0[q] + E[3 + r] * p.R0[3 + q]) + E[6 + r] * p.R0[6 + q];
+        }
+        const real v = p.translation * z[r];
+        t[r] = p.t0[r] + v;
+        tm[r] = p.t0[r] - v;
+        d[r] = p.predict ? -(p.n0[r] + dz[r]) : splat(p.first[r]);
+        dm[r] = p.predict ? -(p.n0[r] - dz[r]) : splat(p.first[r]);
+      }
+      const auto put = [&](double* dst, const real& v, int n) {
+        if (n == W) std::memcpy(dst + e0, &v, sizeof v);
+        else for (int l = 0; l < n; ++l) dst[e0 + l] = v[l];
+      };
+      const int odd_lanes = int(std::min<std::size_t>(lanes, odd_count > e0 ? odd_count - e0 : 0));
+      for (int e = 0; e < 9; ++e) put(even.R[e], R[e], lanes);
+      for (int e = 0; e < 3; ++e) put(even.t[e], t[e], lanes), put(even.direction[e], d[e], lanes);
+      for (int e = 0; e < 6; ++e) put(even.z[e], z[e], lanes);
+      if (odd_lanes == 0) continue;
+      for (int e = 0; e < 9; ++e) put(odd.R[e], Rt[e], odd_lanes);
+      for (int e = 0; e < 3; ++e) put(odd.t[e], tm[e], odd_lanes), put(odd.direction[e], dm[e], odd_lanes);
+      for (int e = 0; e < 6; ++e) put(odd.z[e], -z[e], odd_lanes);
+    }
+  }
+};
