@@ -7,6 +7,9 @@
 //   Montaut, Le Lidec, Petrik, Sivic, Carpentier, "Collision detection accelerated: an optimization
 //   perspective", RSS 2022 (Nesterov momentum delta_k = (k+1)/(k+3), normalised directions for shapes that are not
 //   strictly convex, fallback to plain GJK when momentum stops helping).
+// Distance / witness queries on curved cores (ellipsoid, cylinder, cone) switch to Newton search directions near the
+// optimum: Newton on the optimality condition of the direction, with the support functions' Hessians
+// (wide_gjk.inl's newton_direction()); the simplex, bounds and termination stay GJK's.
 // Minimising f(x) = |x|^2 / 2 over D: the gradient at x is x, a Frank-Wolfe step asks the support of D in
 // direction -d, and the support point s gives the certified lower bound <s, d>/|d| on dist(0, D). We stop when
 // |x| minus the best lower bound (an upper bound on the distance error) is below the tolerance; with d = x this is

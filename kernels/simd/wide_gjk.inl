@@ -644,16 +644,16 @@ template <class T> struct WideGjk {
     return pick(keep, x, scale(xn / nn, signed_n));
   }
 
-  /// Newton's direction after the support point w of D in direction -d (lb = <w, d> / |d| > 0, n = d / |d|, and
-  /// r = w - lb n its tangential residual).
-  /// the support point w(n) = s_A(-n) - s_B(n) minimises <w, n> over D; n is optimal when w(n) is parallel to n,
+  /// Newton's direction after the support point w of D in direction -d (n = d / |d|, lb = <w, n> > 0, and
+  /// r = w - lb n its tangential residual), and step2 = |delta|^2.
+  /// The support point w(n) = s_A(-n) - s_B(n) minimises <w, n> over D; n is optimal when w(n) is parallel to n,
   /// i.e. when the tangential residual P w = w - lb n (P = I - n n^T) vanishes. w(n) moves with n by -H delta,
   /// H = H_A(-n) + R H_B(R^T n) R^T the support functions' Hessian (null on n), and the residual along the turned
   /// direction n + delta is, to first order, P w - H delta - lb delta: Newton's step on the sphere of directions
   /// solves (P H P + lb I) delta = P w. P H P = H since H n = 0, so the 3x3 system is H + lb I, positive definite
   /// for lb > 0 (H is PSD) and mapping the tangent plane to itself (delta stays orthogonal to n up to rounding).
   /// With H = 0 the step is n + P w / lb = w / lb: GJK's own fixed point n <- w / |w|. |delta| <= |P w| / lb.
-  /// step2 = |delta|^2 (NaN or infinite where a Hessian overflowed: the caller's comparisons then refuse the step).
+  /// step2 is NaN or infinite where a Hessian overflowed (rho^3 underflow): the caller's comparisons refuse the step.
   /// Why: GJK is Frank-Wolfe on the minimum-norm-point problem (the seed talk "Collision Detection for Rigid-Body
   /// Physics Simulation"; Montaut et al. 2022), a first-order method, linear on curved sets; this is a
   /// second-order step on the dual variable n, with the support functions' Hessians as curvature.
