@@ -118,8 +118,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   bool momentum = params.solver != Solver::gjk;
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound
-  // Newton directions (witness / distance queries on a curved pair) until one fails to progress.
-  bool newton = !params.boolean_only && (curved_core(D.A->type) || curved_core(D.B->type));
+  // Newton directions (witness / distance queries of newton_pair_type()s) until one fails to progress.
+  bool newton = !params.boolean_only && newton_pair_type(D.A->type, D.B->type);
   bool newton_next = false;
   Vec3<T> newton_dir = Vec3<T>::Zero();
   T newton_step2 = T(0);  // |delta|^2 of the step that chose newton_dir
