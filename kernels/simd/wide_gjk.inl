@@ -486,7 +486,7 @@ template <class T> struct WideGjk {
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
-  static void start(Lanes& L) {
+  AI static void start(Lanes& L) {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
@@ -719,6 +719,7 @@ template <class T> struct WideGjk {
     for (int l = 0; l < W; ++l)
       if (!source.load(L, l)) L.pair[l] = -1;
     const real zero = splat(T(0)), one = splat(T(1));
+    const bool newton_run = newton_pair_type(L.A.type, L.B.type);  // else no lane ever has L.newton
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -769,13 +770,16 @@ template <class T> struct WideGjk {
       d = pick(norm(d) > zero, d, x);
       // Newton's direction, where the last iteration set one up, replaces plain GJK's and momentum's (and ends
       // momentum for the lane: Newton converges quadratically where momentum's gain is linear).
-      const mask newton_step = live & L.newton_next;
-      if (any(newton_step)) {
-        d = pick(newton_step, L.newton_dir, d);
-        L.momentum &= ~newton_step;
-        L.newton_steps = select(newton_step, L.newton_steps + 1, L.newton_steps);
+      mask newton_step = splat_mask(0);
+      if (newton_run) {  // the other pair types skip Newton's bookkeeping (~1% of their instructions)
+        newton_step = live & L.newton_next;
+        if (any(newton_step)) {
+          d = pick(newton_step, L.newton_dir, d);
+          L.momentum &= ~newton_step;
+          L.newton_steps = select(newton_step, L.newton_steps + 1, L.newton_steps);
+        }
+        L.newton_next = splat_mask(0);  // set again below, only for lanes that take a step
       }
-      L.newton_next = splat_mask(0);  // set again below, only for lanes that take a step
       const mask plain = equal(d, x);
       const mask face = live & plain & (L.count == splat_mask(3));
       if (any(face)) d = pick(face, face_direction(L, x), d);
@@ -839,7 +843,7 @@ template <class T> struct WideGjk {
         ends_contains = live & proj.contains;
         const mask no_decrease = live & ~ends_contains & ~(next_xx < xx);
         L.momentum &= ~(no_decrease & ~plain);
-        L.newton &= ~(no_decrease & ~plain);
+        if (newton_run) L.newton &= ~(no_decrease & ~plain);
         const mask stall = no_decrease & plain;
         ends_stall_overlap = stall & (xn <= T(2) * L.touch);
         ends_stall = stall & ~ends_stall_overlap;
@@ -872,9 +876,8 @@ template <class T> struct WideGjk {
         //    a flat face or a rim, where the Hessian says nothing, or the end of the arithmetic's resolution);
         //  - the certified gap after this step is still above kNewtonPlainGap x tol: below it, a plain step at x
         //    certifies the witness (the duality gap along x itself, which the termination test needs).
-        const bool curved_pair = newton_pair_type(L.A.type, L.B.type);  // else no lane has L.newton
         const mask newton_lanes = steps & L.newton;
-        if (curved_pair && any(newton_lanes)) {
+        if (newton_run && any(newton_lanes)) {
           const V3 n = divide(d, dnorm);
           const V3 r = sub(sw, scale(lb, n));
           real step2;
