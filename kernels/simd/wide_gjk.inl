@@ -79,7 +79,8 @@ template <class T> struct WideGjk {
   };
 
   // Always inlined (AI above): left to itself GCC outlined one of its two inlined copies (the one in start()),
-  // a call and a type switch per support, when the batch-array refill changed.
+  // a call and a type switch per support, when the batch-array refill changed (and when the Newton code grew
+  // drive()).
   AI static V3 support(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
     switch (s.type) {
@@ -149,6 +150,58 @@ template <class T> struct WideGjk {
       r = pick(better, V3{x, y, z}, r);
     }
     return r;
+  }
+
+  // ---- Newton search direction (see the drive() loop; tests/support/reference_gjk.hpp, same operations) ----
+  /// Symmetric 3x3 matrix: the Hessian of a support function.
+  struct Sym {
+    real xx, yy, zz, xy, xz, yz;
+  };
+  /// Core types whose support function has a non-zero Hessian somewhere (a curved boundary): the others (points,
+  /// segments, boxes, triangles, hulls) have support maps that are piecewise constant in the direction.
+  static constexpr bool curved(ShapeType t) {
+    return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
+  }
+  /// Hessian of the support function h(u) = max <p, u> of a curved core at the unit direction u (its own frame):
+  /// the Jacobian of the support map, which moves the support point along the boundary as u turns. It has u in
+  /// its null space (h is 1-homogeneous).
+  ///   ellipsoid, radii r, q = diag(r) u, g = diag(r) q / |q| (the support point): (diag(r^2) - g g^T) / |q|;
+  ///   cylinder / cone rim, radius r, rho = |u_xy|: (r / rho^3) [uy^2, -ux uy; -ux uy, ux^2] in the xy block
+  ///   (r times the projector orthogonal to the axis and to the radial direction, over rho); zero on a cone's apex
+  ///   and where rho = 0 (the support map jumps there).
+  static Sym support_hessian(const Side& s, const V3& u) {
+    const real zero = splat(T(0));
+    Sym h{zero, zero, zero, zero, zero, zero};
+    if (s.type == ShapeType::ellipsoid) {
+      const V3 q = {s.s0 * u.x, s.s1 * u.y, s.s2 * u.z};
+      const real m = norm(q);
+      const V3 g = {(s.s0 * q.x) / m, (s.s1 * q.y) / m, (s.s2 * q.z) / m};
+      const mask ok = m > zero;
+      h.xx = select(ok, (s.s0 * s.s0 - g.x * g.x) / m, zero);
+      h.yy = select(ok, (s.s1 * s.s1 - g.y * g.y) / m, zero);
+      h.zz = select(ok, (s.s2 * s.s2 - g.z * g.z) / m, zero);
+      h.xy = select(ok, -(g.x * g.y) / m, zero);
+      h.xz = select(ok, -(g.x * g.z) / m, zero);
+      h.yz = select(ok, -(g.y * g.z) / m, zero);
+    } else if (s.type == ShapeType::cylinder || s.type == ShapeType::cone) {
+      const real rho2 = u.x * u.x + u.y * u.y;
+      const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
+      mask ok = rho2 > zero;
+      if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
+      h.xx = select(ok, (k * u.y) * u.y, zero);
+      h.yy = select(ok, (k * u.x) * u.x, zero);
+      h.xy = select(ok, -((k * u.x) * u.y), zero);
+    }
+    return h;
+  }
+  /// R h R^T (R row-major): B's Hessian in A's frame.
+  static Sym rotate(const real* R, const Sym& h) {
+    const real H[9] = {h.xx, h.xy, h.xz, h.xy, h.yy, h.yz, h.xz, h.yz, h.zz};
+    real M[9];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) M[3 * i + j] = (R[3 * i] * H[j] + R[3 * i + 1] * H[3 + j]) + R[3 * i + 2] * H[6 + j];
+    const auto e = [&](int i, int j) { return (M[3 * i] * R[3 * j] + M[3 * i + 1] * R[3 * j + 1]) + M[3 * i + 2] * R[3 * j + 2]; };
+    return {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
   }
 
   /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
@@ -424,6 +477,11 @@ template <class T> struct WideGjk {
     V3 x, d_prev, last_s, direction;
     real lower{};
     mask momentum{}, normalize{}, boolean_only{};
+    // Newton directions: `newton` = lanes that may take them (witness / distance lanes of a curved pair type,
+    // until a Newton step fails to progress), `newton_next` = the next iteration steps along newton_dir.
+    mask newton{}, newton_next{}, newton_steps{};
+    V3 newton_dir;
+    real newton_step2{};  // |delta|^2 of the Newton step that chose newton_dir
     real tolerance{}, relative{}, touch{}, core_margin{};
     std::int64_t pair[W];      // pair index of each lane, -1 when empty
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
@@ -431,7 +489,7 @@ template <class T> struct WideGjk {
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
-  static void start(Lanes& L) {
+  AI static void start(Lanes& L) {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
@@ -531,6 +589,11 @@ template <class T> struct WideGjk {
     L.lower[l] = -std::numeric_limits<T>::infinity();
     L.k[l] = 0;
     L.stale[l] = 0;
+    // Newton directions: every lane of a newton_pair_type() run may take them (boolean lanes are left out where
+    // the steps are chosen, by L.boolean_only, which the batch-array refill sets per run).
+    L.newton[l] = newton_pair_type(L.A.type, L.B.type) ? -1 : 0;
+    L.newton_next[l] = 0;
+    L.newton_steps[l] = 0;
   }
 
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
@@ -557,6 +620,7 @@ template <class T> struct WideGjk {
   static void finish(const Lanes& L, int l, GjkStatus status, GjkResult<T>& r, bool points) {
     r.status = status;
     r.iterations = int(L.k[l]);
+    r.newton_steps = int(L.newton_steps[l]);
     r.simplex.count = int(L.count[l]);
     for (int m = 0; m < 4; ++m) {
       r.simplex.v[m].w = get_lane(L.w[m], l);
@@ -599,6 +663,44 @@ template <class T> struct WideGjk {
     return pick(keep, x, scale(xn / nn, signed_n));
   }
 
+  /// Newton's direction after the support point w of D in direction -d (n = d / |d|, lb = <w, n> > 0, and
+  /// r = w - lb n its tangential residual), and step2 = |delta|^2.
+  /// The support point w(n) = s_A(-n) - s_B(n) minimises <w, n> over D; n is optimal when w(n) is parallel to n,
+  /// i.e. when the tangential residual P w = w - lb n (P = I - n n^T) vanishes. w(n) moves with n by -H delta,
+  /// H = H_A(-n) + R H_B(R^T n) R^T the support functions' Hessian (null on n), and the residual along the turned
+  /// direction n + delta is, to first order, P w - H delta - lb delta: Newton's step on the sphere of directions
+  /// solves (P H P + lb I) delta = P w. P H P = H since H n = 0, so the 3x3 system is H + lb I, positive definite
+  /// for lb > 0 (H is PSD) and mapping the tangent plane to itself (delta stays orthogonal to n up to rounding).
+  /// With H = 0 the step is n + P w / lb = w / lb: GJK's own fixed point n <- w / |w|. |delta| <= |P w| / lb.
+  /// step2 is NaN or infinite where a Hessian overflowed (rho^3 underflow): the caller's comparisons refuse the step.
+  /// Why: GJK is Frank-Wolfe on the minimum-norm-point problem (the seed talk "Collision Detection for Rigid-Body
+  /// Physics Simulation"; Montaut et al. 2022), a first-order method, linear on curved sets; this is a
+  /// second-order step on the dual variable n, with the support functions' Hessians as curvature.
+  /// Out of line: taken in a few iterations of some pairs; inlined, it grew drive() enough for GCC to outline
+  /// support() (measured: +3% instructions on boolean ellipsoid pairs, which never take Newton steps).
+  __attribute__((noinline)) static V3 newton_direction(const Lanes& L, const V3& n, const V3& r, real lb, real& step2) {
+    Sym h{};
+    const bool ca = curved(L.A.type), cb = curved(L.B.type);
+    if (ca) h = support_hessian(L.A, neg(n));
+    if (cb) {
+      const real* R = L.R;
+      const V3 n_in_b = {(R[0] * n.x + R[3] * n.y) + R[6] * n.z, (R[1] * n.x + R[4] * n.y) + R[7] * n.z,
+                         (R[2] * n.x + R[5] * n.y) + R[8] * n.z};
+      const Sym hb = rotate(R, support_hessian(L.B, n_in_b));
+      if (ca) h = {h.xx + hb.xx, h.yy + hb.yy, h.zz + hb.zz, h.xy + hb.xy, h.xz + hb.xz, h.yz + hb.yz};
+      else h = hb;
+    }
+    // Cofactors of the symmetric M = H + lb I, then delta = adj(M) r / det(M).
+    const real a = h.xx + lb, b = h.yy + lb, c = h.zz + lb, p = h.xy, q = h.xz, t = h.yz;
+    const real c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
+    const real c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
+    const real det = (a * c00 + p * c01) + q * c02;
+    const V3 delta = {((c00 * r.x + c01 * r.y) + c02 * r.z) / det, ((c01 * r.x + c11 * r.y) + c12 * r.z) / det,
+                      ((c02 * r.x + c12 * r.y) + c22 * r.z) / det};
+    step2 = norm2(delta);
+    return add(n, delta);
+  }
+
   /// Runs GJK on setups[0 .. n): every pair must have the same (A type, B type) and need GJK (setup.done false).
   /// `points`: keep the points of A and B behind each simplex vertex (witness points, EPA); without it the
   /// simplex carries only w = a - b and its a, b come back NaN.
@@ -636,6 +738,7 @@ template <class T> struct WideGjk {
     for (int l = 0; l < W; ++l)
       if (!source.load(L, l)) L.pair[l] = -1;
     const real zero = splat(T(0)), one = splat(T(1));
+    const bool newton_run = newton_pair_type(L.A.type, L.B.type);  // else no lane ever has L.newton
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -684,6 +787,18 @@ template <class T> struct WideGjk {
         d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
       }
       d = pick(norm(d) > zero, d, x);
+      // Newton's direction, where the last iteration set one up, replaces plain GJK's and momentum's (and ends
+      // momentum for the lane: Newton converges quadratically where momentum's gain is linear).
+      mask newton_step = splat_mask(0);
+      if (newton_run) {  // the other pair types skip Newton's bookkeeping (~1% of their instructions)
+        newton_step = live & L.newton_next;
+        if (any(newton_step)) {
+          d = pick(newton_step, L.newton_dir, d);
+          L.momentum &= ~newton_step;
+          L.newton_steps = select(newton_step, L.newton_steps + 1, L.newton_steps);
+        }
+        L.newton_next = splat_mask(0);  // set again below, only for lanes that take a step
+      }
       const mask plain = equal(d, x);
       const mask face = live & plain & (L.count == splat_mask(3));
       if (any(face)) d = pick(face, face_direction(L, x), d);
@@ -691,7 +806,8 @@ template <class T> struct WideGjk {
       const std::uint32_t live_bits = lane_bits(live);
       V3 sw, sa, sb;
       minkowski(L, neg(d), live_bits, sw, sa, sb);
-      const real lb = dot(sw, d) / norm(d);
+      const real dnorm = norm(d);
+      const real lb = dot(sw, d) / dnorm;
       const mask progress = lb > L.lower + T(0.1) * (xn - L.lower);
       L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
       L.lower = select(live, wmax(L.lower, lb), L.lower);
@@ -702,8 +818,13 @@ template <class T> struct WideGjk {
       const real tol = wmax(L.tolerance, L.relative * xn);
       const mask ends_converged = live & plain & (xn - lb <= tol);
       live &= ~ends_converged;
-      const mask gap_closed = live & ~plain & (xn - L.lower <= tol);
-      const mask no_move = live & ~plain & ~gap_closed & (xx - dot(x, sw) <= tol * xn);
+      // Momentum's point is skipped when the gap is closed or when it would not move x (plain GJK certifies
+      // next). Newton's point is kept: it is the best point of D the lane has (Newton's error is quadratic), and
+      // the plain step that certifies needs x itself accurate, not only |x|; Newton's sequence ends on its own
+      // (below, and on no decrease).
+      const mask momentum_step = live & ~plain & ~newton_step;
+      const mask gap_closed = momentum_step & (xn - L.lower <= tol);
+      const mask no_move = momentum_step & ~gap_closed & (xx - dot(x, sw) <= tol * xn);
       L.momentum &= ~(gap_closed | no_move);
       live &= ~(gap_closed | no_move);
 
@@ -741,11 +862,13 @@ template <class T> struct WideGjk {
         ends_contains = live & proj.contains;
         const mask no_decrease = live & ~ends_contains & ~(next_xx < xx);
         L.momentum &= ~(no_decrease & ~plain);
+        if (newton_run) L.newton &= ~(no_decrease & ~plain);
         const mask stall = no_decrease & plain;
         ends_stall_overlap = stall & (xn <= T(2) * L.touch);
         ends_stall = stall & ~ends_stall_overlap;
         const mask moves = live & ~no_decrease;  // includes ends_contains: S = next, x = proj.x
-        const mask lagging = (xn - wsqrt<T>(next_xx) <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
+        const real next_xn = wsqrt<T>(next_xx);
+        const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
         L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
         for (int m = 0; m < 4; ++m) {
           mask from_q[4];
@@ -763,6 +886,29 @@ template <class T> struct WideGjk {
         const mask steps = moves & ~ends_contains;
         L.d_prev = pick(steps, d, L.d_prev);
         L.last_s = pick(steps, sw, L.last_s);
+        // Newton's direction for the next iteration (newton_direction()), where this support point gives one:
+        //  - lb > 0 (separated cores: H + lb I is positive definite);
+        //  - the step turns the direction by at most kNewtonSwitch (|delta| estimates the angle to the optimal
+        //    direction; beyond it the linearisation is not trusted and GJK's own steps bring the lane closer);
+        //  - a lane that just took a Newton step keeps them only if this step is at most half the last one
+        //    (Newton's steps shrink quadratically; one that does not left Newton's region: a support jumping over
+        //    a flat face or a rim, where the Hessian says nothing, or the end of the arithmetic's resolution);
+        //  - the certified gap after this step is still above kNewtonPlainGap x tol: below it, a plain step at x
+        //    certifies the witness (the duality gap along x itself, which the termination test needs).
+        const mask newton_lanes = steps & L.newton & ~L.boolean_only;
+        if (newton_run && any(newton_lanes)) {
+          const V3 n = divide(d, dnorm);
+          const V3 r = sub(sw, scale(lb, n));
+          real step2;
+          const V3 nd = newton_direction(L, n, r, lb, step2);
+          const mask valid = lb > zero;
+          L.newton &= ~(newton_lanes & newton_step & ~(valid & (step2 <= T(0.25) * L.newton_step2)));
+          const mask want = newton_lanes & L.newton & valid & (step2 <= T(kNewtonSwitch * kNewtonSwitch)) &
+                             (next_xn - L.lower > T(kNewtonPlainGap) * tol);
+          L.newton_dir = pick(want, nd, L.newton_dir);
+          L.newton_step2 = select(want, step2, L.newton_step2);
+          L.newton_next = want;
+        }
       }
 
       const std::uint32_t b_overlap = lane_bits(ends_overlap | ends_contains | ends_stall_overlap);

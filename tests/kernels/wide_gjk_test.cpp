@@ -35,6 +35,7 @@ std::string compare(const kernels::GjkResult<T>& want, const kernels::GjkResult<
   if (want.status != got.status) return "status";
   if (want.iterations != got.iterations) return "iterations " + std::to_string(want.iterations) + " vs " +
                                                  std::to_string(got.iterations);
+  if (want.newton_steps != got.newton_steps) return "newton steps";
   if (want.simplex.count != got.simplex.count) return "simplex count";
   for (int m = 0; m < want.simplex.count; ++m) {
     if (!same_bits(want.simplex.lambda[m], got.simplex.lambda[m])) return "lambda";
@@ -82,6 +83,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   options.margin = level == QueryLevel::boolean ? 0.01 : 0.0;
   const auto sets = runnable_sets();
   int compared = 0, spread = 0;
+  long newton_steps = 0, newton_pairs = 0;  // Newton directions taken (reference): the lanes must have run them
   for (const ShapeType ta : testing::bounded_shape_types()) {
     for (const ShapeType tb : testing::bounded_shape_types()) {
       std::deque<OwnedShapeView> keep;  // the setups' cores point into it: a deque never moves its elements
@@ -91,6 +93,8 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
       int lo = 1 << 30, hi = 0;
       for (const auto& s : setups) {
         want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
+        newton_steps += want.back().newton_steps;
+        newton_pairs += want.back().newton_steps > 0 ? 1 : 0;
         lo = std::min(lo, want.back().iterations);
         hi = std::max(hi, want.back().iterations);
       }
@@ -113,6 +117,9 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   }
   EXPECT_GT(compared, 1000);
   EXPECT_GE(spread, 4) << "lanes should finish at different iterations";
+  // Newton directions are for distance / witness lanes of curved pairs only; boolean lanes never take them.
+  if (level == QueryLevel::boolean) EXPECT_EQ(newton_steps, 0);
+  else EXPECT_GT(newton_pairs, 50) << "too few pairs took Newton steps to check them lane by lane";
 }
 
 TEST(WideGjk, EqualsReferenceBitwiseDouble) {

@@ -7,6 +7,9 @@
 //   Montaut, Le Lidec, Petrik, Sivic, Carpentier, "Collision detection accelerated: an optimization
 //   perspective", RSS 2022 (Nesterov momentum delta_k = (k+1)/(k+3), normalised directions for shapes that are not
 //   strictly convex, fallback to plain GJK when momentum stops helping).
+// Distance / witness queries on curved cores (ellipsoid, cylinder, cone) switch to Newton search directions near the
+// optimum: Newton on the optimality condition of the direction, with the support functions' Hessians
+// (wide_gjk.inl's newton_direction()); the simplex, bounds and termination stay GJK's.
 // Minimising f(x) = |x|^2 / 2 over D: the gradient at x is x, a Frank-Wolfe step asks the support of D in
 // direction -d, and the support point s gives the certified lower bound <s, d>/|d| on dist(0, D). We stop when
 // |x| minus the best lower bound (an upper bound on the distance error) is below the tolerance; with d = x this is
@@ -37,6 +40,69 @@ template <class T> Vec3<T> face_direction(const Simplex<T>& S, const Vec3<T>& x)
   return (dot3(n, x) < T(0) ? -n : n) * (xn / nn);
 }
 
+/// Whether a core's support function has a curved part (wide_gjk.inl's curved()).
+inline bool curved_core(ShapeType t) {
+  return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
+}
+
+/// Hessian xx, yy, zz, xy, xz, yz of a curved core's support function at the unit direction u (its frame): the
+/// formulas and operations of wide_gjk.inl's support_hessian().
+template <class T> std::array<T, 6> support_hessian(const ShapeCore<T>& core, const Vec3<T>& u) {
+  std::array<T, 6> h{};
+  const T s0 = core.size.x(), s1 = core.size.y(), s2 = core.size.z();
+  if (core.type == ShapeType::ellipsoid) {
+    const Vec3<T> q(s0 * u.x(), s1 * u.y(), s2 * u.z());
+    const T m = norm3(q);
+    if (!(m > T(0))) return h;
+    const Vec3<T> g((s0 * q.x()) / m, (s1 * q.y()) / m, (s2 * q.z()) / m);
+    h = {(s0 * s0 - g.x() * g.x()) / m, (s1 * s1 - g.y() * g.y()) / m, (s2 * s2 - g.z() * g.z()) / m,
+         -(g.x() * g.y()) / m, -(g.x() * g.z()) / m, -(g.y() * g.z()) / m};
+  } else if (core.type == ShapeType::cylinder || core.type == ShapeType::cone) {
+    const T rho2 = u.x() * u.x() + u.y() * u.y();
+    if (!(rho2 > T(0))) return h;
+    if (core.type == ShapeType::cone && s1 * u.z() >= (-s1) * u.z() + s0 * std::sqrt(rho2)) return h;  // apex
+    const T k = s0 / (rho2 * std::sqrt(rho2));
+    h[0] = (k * u.y()) * u.y();
+    h[1] = (k * u.x()) * u.x();
+    h[3] = -((k * u.x()) * u.y());
+  }
+  return h;
+}
+
+/// Newton's direction after the support point w of D in direction -n (unit n, lb = <w, n>, r = w - lb n):
+/// wide_gjk.inl's newton_direction(), where the derivation is: n + delta with (H + lb I) delta = r; step2 =
+/// |delta|^2.
+template <class T>
+Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, const Vec3<T>& r, T lb, T& step2) {
+  std::array<T, 6> h{};
+  const bool ca = curved_core(D.A->type), cb = curved_core(D.B->type);
+  if (ca) h = support_hessian(*D.A, Vec3<T>(-n));
+  if (cb) {
+    const auto& R = D.b_in_a.R;
+    const Vec3<T> n_in_b((R(0, 0) * n.x() + R(1, 0) * n.y()) + R(2, 0) * n.z(),
+                         (R(0, 1) * n.x() + R(1, 1) * n.y()) + R(2, 1) * n.z(),
+                         (R(0, 2) * n.x() + R(1, 2) * n.y()) + R(2, 2) * n.z());
+    const std::array<T, 6> b = support_hessian(*D.B, n_in_b);
+    const T H[3][3] = {{b[0], b[3], b[4]}, {b[3], b[1], b[5]}, {b[4], b[5], b[2]}};
+    T M[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) M[i][j] = (R(i, 0) * H[0][j] + R(i, 1) * H[1][j]) + R(i, 2) * H[2][j];
+    const auto e = [&](int i, int j) { return (M[i][0] * R(j, 0) + M[i][1] * R(j, 1)) + M[i][2] * R(j, 2); };
+    const std::array<T, 6> hb = {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
+    if (ca) for (int i = 0; i < 6; ++i) h[i] = h[i] + hb[i];
+    else h = hb;
+  }
+  const T a = h[0] + lb, b = h[1] + lb, c = h[2] + lb, p = h[3], q = h[4], t = h[5];
+  const T c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
+  const T c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
+  const T det = (a * c00 + p * c01) + q * c02;
+  const Vec3<T> delta(((c00 * r.x() + c01 * r.y()) + c02 * r.z()) / det,
+                      ((c01 * r.x() + c11 * r.y()) + c12 * r.z()) / det,
+                      ((c02 * r.x() + c12 * r.y()) + c22 * r.z()) / det);
+  step2 = norm2(delta);
+  return Vec3<T>(n.x() + delta.x(), n.y() + delta.y(), n.z() + delta.z());
+}
+
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -52,6 +118,11 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   bool momentum = params.solver != Solver::gjk;
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound
+  // Newton directions (witness / distance queries of newton_pair_type()s) until one fails to progress.
+  bool newton = !params.boolean_only && newton_pair_type(D.A->type, D.B->type);
+  bool newton_next = false;
+  Vec3<T> newton_dir = Vec3<T>::Zero();
+  T newton_step2 = T(0);  // |delta|^2 of the step that chose newton_dir
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
@@ -73,11 +144,19 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     }
     const T dn = norm3(d);
     if (!(dn > T(0))) d = x;  // momentum cancelled out: use the gradient
+    const bool newton_step = newton_next;
+    if (newton_step) {  // Newton's direction replaces plain GJK's and momentum's, and ends momentum
+      d = newton_dir;
+      momentum = false;
+      r.newton_steps += 1;
+    }
+    newton_next = false;
     const bool plain_step = (d == x);
     if (plain_step && S.count == 3) d = face_direction(S, x);
 
     const SupportPoint<T> s = D.support(-d);
-    const T lb = dot3(s.w, d) / norm3(d);  // every y in D has <y, d/|d|> >= lb
+    const T d_norm = norm3(d);
+    const T lb = dot3(s.w, d) / d_norm;  // every y in D has <y, d/|d|> >= lb
     // Progress = closing at least a tenth of the certified gap |x| - lower_bound.
     stale = lb > lower_bound + T(0.1) * (xn - lower_bound) ? 0 : stale + 1;
     lower_bound = std::max(lower_bound, lb);
@@ -89,11 +168,12 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     // the normal -x/|x| (its support gap is <= tol). A bound from an earlier or a momentum direction certifies
     // |x| only and leaves the direction of x off by up to sqrt(2 |x| tol) / |x|, so it just switches to plain steps.
     if (plain_step && xn - lb <= tol) { r.status = GjkStatus::converged; break; }
-    if (!plain_step && xn - lower_bound <= tol) {
+    // Newton's point is always added (wide_gjk.inl says why); momentum's is skipped in these two cases.
+    if (!plain_step && !newton_step && xn - lower_bound <= tol) {
       momentum = false;
       continue;
     }
-    if (!plain_step && xx - dot3(x, s.w) <= tol * xn) {
+    if (!plain_step && !newton_step && xx - dot3(x, s.w) <= tol * xn) {
       // The momentum support point would not move x: switch to plain GJK, whose gap certifies convergence.
       momentum = false;
       continue;
@@ -111,7 +191,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (!(next_xx < xx)) {
       // No decrease although conv(W + s) contains x: we are at the resolution of the arithmetic.
       S.count -= 1;
-      if (!plain_step) { momentum = false; continue; }
+      if (!plain_step) { momentum = false; newton = false; continue; }
       r.status = xn <= T(2) * params.touch_tolerance ? GjkStatus::overlap : GjkStatus::stalled;
       break;
     }
@@ -119,11 +199,26 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     // makes the direction sluggish near a flat contact): finish with plain GJK steps, as Montaut et al. do.
     // Likewise when its support points stopped improving the lower bound (a simple adaptive restart, after
     // O'Donoghue and Candes, "Adaptive restart for accelerated gradient schemes", 2015).
-    if (!plain_step && (xn - std::sqrt(next_xx) <= tol || stale >= kMaxStaleMomentumSteps)) momentum = false;
+    const T next_xn = std::sqrt(next_xx);
+    if (!plain_step && (xn - next_xn <= tol || stale >= kMaxStaleMomentumSteps)) momentum = false;
     S = next;
     x = proj.x;
     d_prev = d;
     last_s = s.w;
+    // Newton's direction for the next iteration (wide_gjk.inl: when, and why).
+    if (newton) {
+      const Vec3<T> n(d.x() / d_norm, d.y() / d_norm, d.z() / d_norm);
+      const Vec3<T> res(s.w.x() - lb * n.x(), s.w.y() - lb * n.y(), s.w.z() - lb * n.z());
+      T step2 = T(0);
+      const Vec3<T> nd = newton_direction(D, n, res, lb, step2);
+      const bool valid = lb > T(0);
+      if (newton_step && !(valid && step2 <= T(0.25) * newton_step2)) newton = false;
+      if (newton && valid && step2 <= T(kNewtonSwitch * kNewtonSwitch) && next_xn - lower_bound > T(kNewtonPlainGap) * tol) {
+        newton_dir = nd;
+        newton_step2 = step2;
+        newton_next = true;
+      }
+    }
   }
   // The budget can run out right after x reached the origin.
   if (r.status == GjkStatus::max_iterations && norm3(x) <= params.touch_tolerance) r.status = GjkStatus::overlap;
