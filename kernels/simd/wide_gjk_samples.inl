@@ -14,36 +14,22 @@ template <class T> struct WideGjkSamples {
   using Lanes = typename G::Lanes;
   static constexpr int W = G::W;
 
-  /// What every sample of one pair shares: the cores, their swept radii and centres, the bounding radii.
+  /// What every sample of one pair shares: the cores (their swept radii and centres), the bounding radii.
   struct Shared {
-    typename G::SideStart A, B;
-    T radius_a, radius_b;
+    ShapeCore<T> core_a, core_b;
     double bounding_a, bounding_b;
     Vec3<T> center_a, center_b;
   };
 
-  /// One side's core as make_core() builds it, read from the ShapeTable's per-shape arrays, once per run of a
-  /// pair's samples: the sizes the support reads and the swept radius with make_core's roundings (T(inflation),
-  /// plus T(radius) for spheres and capsules).
-  static typename G::SideStart side(const PairView& in, std::uint32_t shape, T& radius) {
-    typename G::SideStart c{{T(0), T(0), T(0)}, nullptr, nullptr};
-    radius = T(in.shape_inflation[shape]);
-    switch (in.shape_type[shape]) {
-      case ShapeType::sphere: radius += T(in.shape_size[0][shape]); break;
-      case ShapeType::capsule:
-        radius += T(in.shape_size[0][shape]);
-        c.size[1] = T(in.shape_size[1][shape]);
-        break;
-      case ShapeType::convex: c.hull = &in.shape_hull[shape]; break;
-      default:
-        for (int i = 0; i < 3; ++i) c.size[i] = T(in.shape_size[i][shape]);
-        break;
-    }
-    return c;
-  }
-  /// ShapeCore::center() of such a core: the hull's centroid, the origin for the other types of this path.
-  static Vec3<T> center(const typename G::SideStart& c) {
-    return c.hull ? hull_centroid<T>(*c.hull) : Vec3<T>::Zero();
+  /// Shape `shape`'s core by make_core()'s rules, read from the ShapeTable's per-shape arrays once per run of a
+  /// pair's samples.
+  static ShapeCore<T> core_of(const PairView& in, std::uint32_t shape) {
+    ShapeView v;
+    v.type = in.shape_type[shape];
+    for (int i = 0; i < 3; ++i) v.size[i] = in.shape_size[i][shape];
+    v.inflation = in.shape_inflation[shape];
+    if (v.type == ShapeType::convex) v.hull = &in.shape_hull[shape];
+    return make_core<T>(v);
   }
 
   struct Source {
@@ -68,12 +54,12 @@ template <class T> struct WideGjkSamples {
     void share(std::uint32_t ia, std::uint32_t ib) {
       shape_a = ia;
       shape_b = ib;
-      shared.A = side(shapes, ia, shared.radius_a);
-      shared.B = side(shapes, ib, shared.radius_b);
+      shared.core_a = core_of(shapes, ia);
+      shared.core_b = core_of(shapes, ib);
       shared.bounding_a = shapes.bounding_radii[ia];
       shared.bounding_b = shapes.bounding_radii[ib];
-      shared.center_a = center(shared.A);
-      shared.center_b = center(shared.B);
+      shared.center_a = shared.core_a.center();
+      shared.center_b = shared.core_b.center();
     }
 
     /// setup_pair_into() and set_gjk_parameters() for the next sample (gjk_limits() from its own |t|, the warm
@@ -83,12 +69,12 @@ template <class T> struct WideGjkSamples {
       const std::size_t s = next++;
       if (in.shape_a[s] != shape_a || in.shape_b[s] != shape_b) share(in.shape_a[s], in.shape_b[s]);
       typename G::LaneStart q;
-      q.A = shared.A;
-      q.B = shared.B;
+      q.A = G::side_start(shared.core_a);
+      q.B = G::side_start(shared.core_b);
       for (int e = 0; e < 9; ++e) q.R[e] = T(in.R[e][s]);
       const double tx = in.t[0][s], ty = in.t[1][s], tz = in.t[2][s];
       q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
-      const GjkLimits<T> g = gjk_limits<T>(shared.radius_a, shared.radius_b, shared.bounding_a, shared.bounding_b,
+      const GjkLimits<T> g = gjk_limits<T>(shared.core_a.radius, shared.core_b.radius, shared.bounding_a, shared.bounding_b,
                                            std::sqrt((tx * tx + ty * ty) + tz * tz), options);
       q.tolerance = g.tolerance;
       q.relative = g.relative;
@@ -111,7 +97,7 @@ template <class T> struct WideGjkSamples {
       }
       G::start_lane(L, l, q, std::int64_t(s));
       sample[l] = std::uint32_t(s);
-      completion[l] = {shared.radius_a, shared.radius_b, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
+      completion[l] = {shared.core_a.radius, shared.core_b.radius, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
       return true;
     }
 
