@@ -4,8 +4,9 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
-#include <utility>
+#include <memory>
 
 namespace batchcol {
 namespace {
@@ -61,39 +62,48 @@ struct CollapsePlan {
     return (ref & kLeafBit) ? 0.0 : cost[ref][j - 1];
   }
 
+  // Bottom-up and in parallel, as the binary refit (ray_bvh.cpp): from every leaf up, the first child to arrive at
+  // a node stops and the second computes it, so each node is computed once, after both children (acq_rel on the
+  // counter publishes the first child's row). Each row depends on its children's rows only: the same for any
+  // thread count.
   void plan(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
-    const std::size_t n = bvh.nodes().size();
-    cost.assign(n, {}), left.assign(n, {});
-    // Post-order without recursion: a node is finished after both children (the tree may be 64 levels deep).
-    std::vector<std::pair<std::uint32_t, bool>> stack{{0u, false}};
-    while (!stack.empty()) {
-      const auto [x, children_done] = stack.back();
-      stack.pop_back();
-      const BvhNode& node = bvh.nodes()[x];
-      if (!children_done) {
-        stack.push_back({x, true});
-        for (std::uint32_t c : node.child)
-          if (!(c & kLeafBit)) stack.push_back({c, false});
-        continue;
-      }
-      const std::uint32_t a = node.child[0], b = node.child[1];
-      // best[j - 1]: the children spread over j slots (j >= 2), k of them to child 0.
-      double best[kWideArity];
-      std::uint8_t best_k[kWideArity];
-      for (int j = 2; j <= kWideArity; ++j) {
-        best[j - 1] = INFINITY, best_k[j - 1] = 1;
-        for (int k = 1; k < j; ++k) {
-          const double c = of(a, k) + of(b, j - k);
-          if (c < best[j - 1]) best[j - 1] = c, best_k[j - 1] = static_cast<std::uint8_t>(k);
+    const std::size_t n = bvh.nodes().size(), leaves = bvh.leaf_count();
+    cost.resize(n), left.resize(n);
+    std::unique_ptr<std::atomic<std::uint32_t>[]> arrivals(new std::atomic<std::uint32_t>[n]);
+    for (std::size_t i = 0; i < n; ++i) arrivals[i].store(0, std::memory_order_relaxed);
+    const std::vector<std::uint32_t>& parent = bvh.parents();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k < r.end(); ++k) {
+        std::uint32_t x = parent[n + k];
+        for (;;) {
+          if (arrivals[x].fetch_add(1, std::memory_order_acq_rel) == 0) break;
+          compute(bvh, boxes, x);
+          if (x == 0) break;
+          x = parent[x];
         }
       }
-      const double as_node = half_area(box_of_ref(bvh, boxes, x)) + best[kWideArity - 1];
-      cost[x][0] = as_node, left[x][0] = 0;
-      for (int j = 2; j <= kWideArity; ++j) {
-        const bool spread = best[j - 1] < as_node;
-        cost[x][j - 1] = spread ? best[j - 1] : as_node;
-        left[x][j - 1] = spread ? best_k[j - 1] : 0;
+    });
+  }
+
+  void compute(const RayBvh& bvh, const broadphase::AabbSoa& boxes, std::uint32_t x) {
+    const BvhNode& node = bvh.nodes()[x];
+    const std::uint32_t a = node.child[0], b = node.child[1];
+    // best[j - 1]: the children spread over j slots (j >= 2), k of them to child 0.
+    double best[kWideArity];
+    std::uint8_t best_k[kWideArity];
+    for (int j = 2; j <= kWideArity; ++j) {
+      best[j - 1] = INFINITY, best_k[j - 1] = 1;
+      for (int k = 1; k < j; ++k) {
+        const double c = of(a, k) + of(b, j - k);
+        if (c < best[j - 1]) best[j - 1] = c, best_k[j - 1] = static_cast<std::uint8_t>(k);
       }
+    }
+    const double as_node = half_area(box_of_ref(bvh, boxes, x)) + best[kWideArity - 1];
+    cost[x][0] = as_node, left[x][0] = 0;
+    for (int j = 2; j <= kWideArity; ++j) {
+      const bool spread = best[j - 1] < as_node;
+      cost[x][j - 1] = spread ? best[j - 1] : as_node;
+      left[x][j - 1] = spread ? best_k[j - 1] : 0;
     }
   }
 
