@@ -35,8 +35,8 @@ using detail::printable;
 // shape indices range-checked in finish().
 class BatchReader {
  public:
-  static constexpr const char* kTopLevelKeys[] = {"shapes", "pairs", "rays", "query", "solver", "tolerance",
-                                                  "precision", "margin"};
+  static constexpr const char* kTopLevelKeys[] = {"shapes", "pairs", "rays", "objects", "query", "solver",
+                                                  "tolerance", "precision", "margin"};
 
   BatchReader(const std::string& source, const std::string& base_dir, std::size_t text_bytes)
       : source_(source), base_dir_(base_dir), text_bytes_(text_bytes) {}
@@ -48,18 +48,29 @@ class BatchReader {
     if (array == "pairs" && i == 0) file_.pairs.reserve(text_bytes_ / 14 + 1);
     if (array == "shapes") file_.shapes.add(read_shape(v, "/shapes/" + std::to_string(i)));
     else if (array == "rays") read_ray(v, "/rays/" + std::to_string(i), file_);
+    else if (array == "objects") objects_seen_ = true, read_object(v, "/objects/" + std::to_string(i), file_);
     else read_pair(v, "/pairs/" + std::to_string(i), file_);
   }
   void array_end(const std::string& array) {
     if (array == "shapes") shapes_done_ = true;
+    if (array == "objects") objects_seen_ = true;
   }
 
   BatchFile finish(const json& root) {
     if (!root.is_object()) fail("", "the top level must be an object, got " + describe(root));
     check_keys(root, "", kTopLevelKeys);
     array_field(root, "", "shapes");
-    if (root.contains("pairs") || !root.contains("rays")) array_field(root, "", "pairs");  // a file of rays needs no pairs
+    // A file of rays or a ray scene needs no pairs.
+    if (root.contains("pairs") || !(root.contains("rays") || root.contains("objects"))) array_field(root, "", "pairs");
     if (root.contains("rays")) array_field(root, "", "rays");
+    file_.has_objects = root.contains("objects");
+    if (file_.has_objects) array_field(root, "", "objects");
+    // Whether rays are scene rays depends on a key that may come after them: checked once the whole file is read.
+    if (file_.has_objects && first_shape_ray_) scene_ray_with_shape(*first_shape_ray_);
+    if (!file_.has_objects && first_scene_ray_) {
+      fail("/rays/" + std::to_string(*first_scene_ray_) + "/shape",
+           "required field is missing (rays without a shape need \"objects\" to be cast against)");
+    }
     if (!shapes_checked_) {  // pairs came before the shapes: check their indices now
       const std::size_t n = file_.shapes.size();
       for (std::size_t i = 0; i < file_.pairs.size(); ++i)
@@ -69,6 +80,14 @@ class BatchReader {
                                                              " is out of range (the batch has " + std::to_string(n) +
                                                              " shapes)");
           }
+    }
+    if (!objects_checked_) {  // objects came before the shapes
+      const std::size_t n = file_.shapes.size();
+      for (std::size_t i = 0; i < file_.objects.size(); ++i)
+        if (file_.objects[i].shape >= n)
+          fail("/objects/" + std::to_string(i) + "/shape", "shape index " + std::to_string(file_.objects[i].shape) +
+                                                             " is out of range (the batch has " + std::to_string(n) +
+                                                             " shapes)");
     }
     if (!rays_checked_) {  // rays came before the shapes
       const std::size_t n = file_.shapes.size();
@@ -333,18 +352,57 @@ class BatchReader {
   // error naming it rather than the per-ray invalid status of the API: a zero direction, a negative t_max.
   void read_ray(const json& v, const std::string& p, BatchFile& file) {
     object_value(v, p);
+    if (!v.contains("shape") && !v.contains("pose")) return read_scene_ray(v, p, file);
+    if (!first_shape_ray_) first_shape_ray_ = file.rays.size() + file.scene_rays.size();
+    if (objects_seen_) scene_ray_with_shape(*first_shape_ray_);  // else finish() decides
     check_keys(v, p, {"shape", "pose", "origin", "direction", "t_max"});
     // As for pairs: before the shapes array has ended, finish() checks the index's range.
     rays_checked_ = rays_checked_ && shapes_done_;
     const std::size_t count = shapes_done_ ? file.shapes.size() : std::size_t{1} << 32;
     const std::uint32_t shape = shape_index(field(v, p, "shape"), p + "/shape", count);
     const Pose pose = v.contains("pose") ? read_pose(v["pose"], p + "/pose") : Pose::identity();
+    const Ray ray = read_ray_line(v, p);
+    file.rays.add(shape, pose, ray.origin, ray.direction, ray.t_max);
+  }
+
+  [[noreturn]] void scene_ray_with_shape(std::size_t i) const {
+    fail("/rays/" + std::to_string(i) + "/shape",
+         "the rays of a file with \"objects\" are cast against the objects: give no 'shape' or 'pose'");
+  }
+
+  // A ray of a scene file (one with "objects"): origin, direction and t_max only.
+  void read_scene_ray(const json& v, const std::string& p, BatchFile& file) {
+    if (!first_scene_ray_) first_scene_ray_ = file.rays.size() + file.scene_rays.size();
+    check_keys(v, p, {"origin", "direction", "t_max"});
+    const Ray ray = read_ray_line(v, p);
+    file.scene_rays.add(ray.origin, ray.direction, ray.t_max);
+  }
+
+  struct Ray {
+    Eigen::Vector3d origin, direction;
+    double t_max;
+  };
+
+  // The checks are those of detail::ray_is_valid() (a ray it would mark invalid_input is an error here): JSON numbers
+  // are finite already; |d|^2 must not underflow to 0 (the kernels divide by it), so a direction of 1e-200 counts as
+  // zero.
+  Ray read_ray_line(const json& v, const std::string& p) const {
     const Eigen::Vector3d origin = vec3(field(v, p, "origin"), p + "/origin");
     const Eigen::Vector3d direction = vec3(field(v, p, "direction"), p + "/direction");
     if (!(direction.squaredNorm() > 0.0)) fail(p + "/direction", "the direction must not be zero");
     // JSON has no infinity: an absent t_max is +inf.
     const double t_max = v.contains("t_max") ? non_negative(v["t_max"], p + "/t_max") : INFINITY;
-    file.rays.add(shape, pose, origin, direction, t_max);
+    return {origin, direction, t_max};
+  }
+
+  // An object of a ray scene: a shape index and a pose.
+  void read_object(const json& v, const std::string& p, BatchFile& file) {
+    object_value(v, p);
+    check_keys(v, p, {"shape", "pose"});
+    objects_checked_ = objects_checked_ && shapes_done_;
+    const std::size_t count = shapes_done_ ? file.shapes.size() : std::size_t{1} << 32;
+    const std::uint32_t shape = shape_index(field(v, p, "shape"), p + "/shape", count);
+    file.objects.push_back({shape, v.contains("pose") ? read_pose(v["pose"], p + "/pose") : Pose::identity()});
   }
 
   const std::string& source_;
@@ -354,6 +412,9 @@ class BatchReader {
   bool shapes_done_ = false;
   bool shapes_checked_ = true;  // no pair has skipped the range check so far
   bool rays_checked_ = true;    // no ray has skipped the range check so far
+  bool objects_checked_ = true;  // no object has skipped the range check so far
+  bool objects_seen_ = false;    // an "objects" element or the array's end has been read
+  std::optional<std::size_t> first_shape_ray_, first_scene_ray_;  // index in "rays" of the first of each kind
 };
 
 }  // namespace
@@ -373,7 +434,7 @@ BatchFile parse_batch_json(const std::string& text, const std::string& source, c
   for (const char* key : BatchReader::kTopLevelKeys) allowed.emplace_back(key);
   detail::JsonConsumer consumer{[&](const std::string& array, std::size_t i, const json& v) { reader.element(array, i, v); },
                                 [&](const std::string& array) { reader.array_end(array); }};
-  detail::StreamingDom builder(text, root, {"shapes", "pairs", "rays"}, allowed, consumer);
+  detail::StreamingDom builder(text, root, {"shapes", "pairs", "rays", "objects"}, allowed, consumer);
   if (!json::sax_parse(text, &builder)) {
     std::string where;
     if (builder.error_index) {

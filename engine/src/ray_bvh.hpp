@@ -42,6 +42,9 @@ class RayBvh {
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   /// The root reference (a leaf when there is one object); only valid when leaf_count() > 0.
   std::uint32_t root() const { return leaf_count() == 1 ? kLeafBit : 0u; }
+  /// Parent node of internal node i (entry i, i in [0, n - 1); the root's entry is unused) and of leaf k (entry
+  /// n - 1 + k), for bottom-up passes over the tree.
+  const std::vector<std::uint32_t>& parents() const { return parent_; }
   /// The box of the single leaf when there is one object.
   const BvhBox& single_box() const { return single_; }
 

@@ -1,8 +1,9 @@
 // An 8-wide BVH collapsed from the binary LBVH (ray_bvh.hpp) for traversal: each node holds the boxes of up to 8
 // children in structure-of-arrays float form, so one SIMD pass tests a ray against all of them (ray_wide_traverse).
-// Collapse (the usual greedy rule, e.g. Wald et al., "Getting rid of packets", RT 2008 for 4-wide): a wide node
-// starts from a binary node's two children and repeatedly opens the internal child of largest surface area until it
-// has 8 children or only leaves. Fewer, fuller nodes mean fewer box tests per ray than the binary tree's pairs.
+// Collapse: each wide node's children are the binary descendants (at most 8) that minimise the expected number of
+// wide-node visits, the sum of the wide nodes' surface areas, chosen by dynamic programming over the binary tree
+// (after Ylitie et al., HPG 2017; ray_wide_bvh.cpp). Fewer, fuller nodes mean fewer box tests per ray than the
+// binary tree's pairs.
 // The topology depends only on the binary tree (built deterministically) and the boxes; every child slot remembers
 // its binary node so a refit is a parallel copy of the binary tree's refitted boxes (exact float min/max).
 #pragma once

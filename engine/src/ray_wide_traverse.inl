@@ -87,8 +87,7 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       if (!pop()) return;
       continue;
     }
-    float entry[kWideArity];
-    __builtin_memcpy(entry, &tn, sizeof entry);
+    const V& entry = tn;  // read lane by lane below (a copy into a float array was split and copied twice)
     // One child reached (the common case deep in the tree): it is next, no sort and no stack.
     if ((bits & (bits - 1)) == 0) {
       const int k = __builtin_ctz(bits);

@@ -1,7 +1,9 @@
 // `batchcol rays`: times ray queries. Scene mode: builds a scene (hulls or mixed primitives), times the LBVH build,
 // its refit after every object moved, and the rays per second of the query; with --peers, the same scene and rays in
 // Embree 3 (build and rays/s) and the agreement of the closest hits. Shape mode: rays against one posed shape each
-// (sphere, box, capsule, hull), double and float. --batch FILE casts the "rays" of a batch file. --out writes the hits as CSV.
+// (sphere, box, capsule, hull), double and float. --batch FILE casts the "rays" of a batch file; --scene FILE casts
+// the "rays" of a batch file with "objects" against those objects, timed as the generated scenes. --out writes the
+// hits as CSV.
 #include "cli/atomic_output.hpp"
 #include "cli/commands.hpp"
 #include "testkit/portable_random.hpp"
@@ -35,7 +37,7 @@ using testkit::RaysSceneSpec;
 
 struct RaysSettings {
   RaysSceneSpec scene;
-  std::string mode = "scene", query = "closest", out, batch;
+  std::string mode = "scene", query = "closest", out, batch, scene_file;
   std::int64_t rays = 1000000;
   int threads = 0, runs = 3, frames = 5, segments = 64;
   bool json = false, peers = false;
@@ -58,6 +60,7 @@ void validate(const RaysSettings& s) {
   check(s.frames >= 1, "--frames must be >= 1");
   check(s.segments >= 3, "--segments must be >= 3");
   check(s.out.empty() || s.mode == "scene" || !s.batch.empty(), "--out is only available with --mode scene or --batch");
+  check(s.scene_file.empty() || s.mode == "scene", "--scene casts against a scene: it cannot be used with --mode shape");
   check(s.query == "closest" || s.query == "any" || s.query == "all",
         "--query " + s.query + ": unknown (valid: closest, any, all)");
   check(!s.peers || peers::have_embree(), "--peers needs Embree 3 (install libembree-dev and rebuild)");
@@ -98,10 +101,35 @@ void write_hits_csv(const RayResults& r, RayQuery q, std::ostream& out) {
   }
 }
 
+// The scene and rays: generated, or from a scene file (objects + rays).
+struct SceneInput {
+  RaysScene world;
+  RayBatch rays;
+};
+
+SceneInput scene_input(const RaysSettings& s) {
+  if (s.scene_file.empty()) {
+    RaysScene world = make_rays_scene(s.scene);
+    RayBatch rays = make_crossing_rays(s.rays, world.half_extent, s.scene.seed);
+    return {std::move(world), std::move(rays)};
+  }
+  BatchFile file = load_batch_file(s.scene_file);
+  check(file.has_objects, s.scene_file + R"(: the file has no "objects" (a scene file places shapes as "objects": )"
+                                         R"([{"shape": i, "pose": {...}}]; --batch casts rays against posed shapes))");
+  check(file.scene_rays.size() > 0, s.scene_file + R"(: the file has no "rays")");
+  RayBatch rays = std::move(file.scene_rays);
+  return {make_rays_scene(std::move(file)), std::move(rays)};
+}
+
 nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
   const RayQuery query = parse_ray_query(s.query);
-  RaysScene world = make_rays_scene(s.scene);
-  const RayBatch rays = make_crossing_rays(s.rays, world.half_extent, s.scene.seed);
+  SceneInput input = scene_input(s);
+  RaysScene& world = input.world;
+  const RayBatch& rays = input.rays;
+  const std::size_t n_rays = rays.size();
+  std::vector<Pose> file_poses;  // a file's scene is cast as given: its poses come back after the refit frames
+  if (!s.scene_file.empty())
+    for (ObjectHandle h : world.handles) file_poses.push_back(world.scene->pose(h));
   RaySceneIndex index;
   std::vector<double> build, boxes, refit, collapse, wide_refit;
   for (int r = 0; r < s.runs; ++r) {
@@ -115,6 +143,10 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
     index.update(*world.scene, s.threads);
     refit.push_back(index.timings().total_ms);
     wide_refit.push_back(index.timings().wide_ms);
+  }
+  if (!file_poses.empty()) {
+    for (std::size_t k = 0; k < file_poses.size(); ++k) world.scene->set_pose(world.handles[k], file_poses[k]);
+    index.update(*world.scene, s.threads);
   }
   RayOptions options;
   options.query = query;
@@ -147,12 +179,12 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
   for (std::uint8_t h : results.hit) hits += h;
   const double cast_ms = median(cast);
   nlohmann::json j = {{"mode", "scene"},
-                      {"shapes", s.scene.shapes},
-                      {"objects", s.scene.objects},
-                      {"rays", s.rays},
+                      {"shapes", s.scene_file.empty() ? s.scene.shapes : "file"},
+                      {"objects", world.handles.size()},
+                      {"rays", n_rays},
                       {"query", s.query},
                       {"threads", s.threads},
-                      {"hit_fraction", double(hits) / double(s.rays)},
+                      {"hit_fraction", double(hits) / double(n_rays)},
                       {"batchcol",
                        {{"build_ms", median(build)},
                         {"build_boxes_ms", median(boxes)},
@@ -160,7 +192,8 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
                         {"refit_ms", median(refit)},
                         {"refit_wide_ms", median(wide_refit)},
                         {"cast_ms", cast_ms},
-                        {"rays_per_s", double(s.rays) / (cast_ms * 1e-3)}}}};
+                        {"rays_per_s", double(n_rays) / (cast_ms * 1e-3)}}}};
+  if (!s.scene_file.empty()) j["scene_file"] = s.scene_file;
   if (query == RayQuery::all) j["all_hit_rows"] = all_rows;
 #ifdef BATCHCOL_HAVE_EMBREE
   if (embree) {
@@ -191,7 +224,7 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
                    {"build_ms", median(commit)},
                    {"build_with_tessellation_ms", median(total)},
                    {"cast_ms", ems},
-                   {"rays_per_s", double(s.rays) / (ems * 1e-3)},
+                   {"rays_per_s", double(n_rays) / (ems * 1e-3)},
                    {"same_hit_or_miss", same_hit},
                    {"same_object", same_object},
                    {"t_within_1e-6_relative", close_t},
@@ -242,6 +275,7 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
 // The rays of a batch file (each against its own posed shape), through cast_rays().
 nlohmann::json run_batch_mode(const RaysSettings& s, RayResults& results) {
   const BatchFile file = load_batch_file(s.batch);
+  check(!file.has_objects, s.batch + R"(: the file has "objects", so its rays are scene rays: cast them with --scene)");
   check(file.rays.size() > 0, s.batch + ": the file has no \"rays\"");
   RayOptions options;
   options.threads = s.threads;
@@ -269,7 +303,10 @@ void print_text(const nlohmann::json& j) {
     return;
   }
   const auto& b = j["batchcol"];
-  std::cout << j["objects"] << ' ' << j["shapes"].get<std::string>() << " objects, " << j["rays"] << " rays, query "
+  std::cout << j["objects"] << ' '
+            << (j.contains("scene_file") ? "objects from " + j["scene_file"].get<std::string>()
+                                         : j["shapes"].get<std::string>() + " objects")
+            << ", " << j["rays"] << " rays, query "
             << j["query"].get<std::string>() << ", hit fraction " << j["hit_fraction"] << '\n'
             << "batchcol: build " << b["build_ms"] << " ms, refit " << b["refit_ms"] << " ms, "
             << b["rays_per_s"].get<double>() / 1e6 << " M rays/s\n";
@@ -319,7 +356,13 @@ Command add_rays_command(CLI::App& parent) {
   app->add_option("--segments", s->segments, "Embree tessellation of cylinders (segments around)")->capture_default_str();
   app->add_option("--seed", s->scene.seed, "Seed of the scene and rays")->capture_default_str();
   app->add_option("--out", s->out, "Write the hits as CSV (scene mode or --batch)");
-  app->add_option("--batch", s->batch, "Cast the \"rays\" of a batch file (each against its posed shape) instead");
+  CLI::Option* batch = app->add_option("--batch", s->batch, "Cast the \"rays\" of a batch file (each against its posed shape) instead");
+  CLI::Option* scene = app->add_option("--scene", s->scene_file,
+                                       "Cast the \"rays\" of a scene file (a batch file with \"objects\") against its objects");
+  // The generator's settings mean nothing for a scene read from a file: refused rather than ignored.
+  for (const char* name : {"--objects", "--rays", "--shapes", "--hull-vertices", "--fill", "--seed"})
+    scene->excludes(app->get_option(name));
+  scene->excludes(batch);
   app->add_flag("--json", s->json, "Print one JSON object");
   app->add_flag("--peers", s->peers, "Also build and cast with Embree 3 and compare the hits");
   return {app, [s] { return run_rays(*s); }};

@@ -2,7 +2,9 @@
 
 #include "testkit/portable_random.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace batchcol::testkit {
 
@@ -35,6 +37,18 @@ RaysScene make_rays_scene(const RaysSceneSpec& spec) {
     const Eigen::Vector3d t(rng.uniform(-s.half_extent, s.half_extent), rng.uniform(-s.half_extent, s.half_extent),
                             rng.uniform(-s.half_extent, s.half_extent));
     s.handles.push_back(s.scene->add(static_cast<std::uint32_t>(rng.index(s.table->size())), {t, rng.rotation()}));
+  }
+  return s;
+}
+
+RaysScene make_rays_scene(BatchFile&& file) {
+  RaysScene s;
+  s.table = std::make_shared<ShapeTable>(std::move(file.shapes));
+  s.scene = std::make_unique<Scene>(s.table);
+  s.handles.reserve(file.objects.size());
+  for (const BatchFile::Object& o : file.objects) {
+    s.handles.push_back(s.scene->add(o.shape, o.pose));
+    s.half_extent = std::max(s.half_extent, o.pose.translation.cwiseAbs().maxCoeff());
   }
   return s;
 }

@@ -1,6 +1,7 @@
 // Scenes and rays of `batchcol rays`: seeded, the same for batchcol and Embree.
 #pragma once
 
+#include <batchcol/io.hpp>
 #include <batchcol/rays.hpp>
 #include <batchcol/scene.hpp>
 
@@ -29,6 +30,9 @@ struct RaysScene {
 /// Objects of radius ~0.5 m spread uniformly in a cube sized so that a ray crossing it meets `fill` objects on
 /// average (cross-section pi r^2 per object). Hulls: 16 distinct hulls shared by the objects.
 RaysScene make_rays_scene(const RaysSceneSpec& spec);
+/// The "objects" of a ray scene file, added in file order (object k gets slot k, generation 0); takes the file's
+/// shapes. half_extent: the largest |coordinate| of an object's position.
+RaysScene make_rays_scene(BatchFile&& file);
 /// Rays from a sphere of radius 2 x half_extent towards uniform points of the cube, unit directions, t_max = inf.
 RayBatch make_crossing_rays(std::int64_t n, double half_extent, std::uint64_t seed);
 /// Moves every object by up to `step` metres and a small rotation (the refit benchmark's frame).

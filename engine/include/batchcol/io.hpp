@@ -24,6 +24,18 @@ struct BatchFile {
   /// identity; t_max optional: +inf; a zero direction or negative t_max is an InputError naming the ray). With
   /// "rays", "pairs" may be left out. `batchcol rays --batch FILE` casts them (cast_rays()).
   ShapeRayBatch rays;
+  /// A ray scene: "objects": [{"shape": i, "pose": {...}}] (pose optional: identity) are placed in a Scene in this
+  /// order (object k gets slot k), and the file's "rays" are then scene rays, cast against all objects:
+  /// [{"origin": [x, y, z], "direction": [x, y, z], "t_max": t}] without "shape" or "pose" (they go to scene_rays,
+  /// and `rays` stays empty). `batchcol rays --scene FILE` casts them (RaySceneIndex). A file without "objects"
+  /// whose rays lack "shape", or one with "objects" whose rays have it, is an InputError naming the first such ray.
+  struct Object {
+    std::uint32_t shape = 0;
+    Pose pose;
+  };
+  std::vector<Object> objects;
+  bool has_objects = false;  // the file has an "objects" key (which may be an empty array)
+  RayBatch scene_rays;
   std::optional<QueryLevel> query;
   std::optional<Solver> solver;
   std::optional<double> tolerance;
