@@ -290,7 +290,6 @@ template <class T> struct WideGjk {
     r.lambda[1] = select(inner, e.u, zero);
     return r;
   }
-  static Proj segment(const V3& qi, const V3& qj, mask i, mask j) { return to_proj(edge(qi, qj, i, j)); }
   static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
     // which 0: the first kept axis (drop + 1) % 3; which 1: the second (drop + 2) % 3.
     if (which == 0) return select(drop0, p.y, select(drop1, p.z, p.x));
@@ -351,16 +350,6 @@ template <class T> struct WideGjk {
     return r;
   }
 
-  /// Triangle p[0], p[1], p[2] (p[2] newest): the reference's triangle(p, 0, 1, 2). `want`: lanes whose result is
-  /// used; the edges are computed only when one of them is outside the face.
-  static Proj triangle(const V3* p, mask want) {
-    const Face f = face(p[0], p[1], p[2]);
-    const Proj in = face_proj(f, splat_mask(0), splat_mask(1), splat_mask(2));
-    if (!any(want & ~f.use)) return in;
-    const Edge ei = edge(p[0], p[2], splat_mask(0), splat_mask(2)), ej = edge(p[1], p[2], splat_mask(1), splat_mask(2));
-    return pick(f.use, in, to_proj(pick(takes_j(f, norm2(ei.x), norm2(ej.x)), ej, ei)));
-  }
-
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
   /// Face m of tetrahedron p[0..3] that keeps vertex 3, per lane (m = 0: old vertices 1, 2; m = 1: 0, 2; m = 2: 0,
@@ -384,82 +373,119 @@ template <class T> struct WideGjk {
     return round;
   }
 
-  /// Tetrahedron p[0..3] (p[3] newest): the reference's tetrahedron(). The three edges to vertex 3 are computed
-  /// once; each round, every lane evaluates the next face keeping vertex 3 that it sees (face m omits vertex m),
-  /// and keeps the closest answer. `want`: lanes whose result is used.
-  static Proj tetrahedron(const V3* p, mask want) {
+  /// GJK's projection step on every live lane at once: the reference's project_origin(p, count + 1) with p[count]
+  /// = s the new support point (segment(), triangle() or tetrahedron() by the lane's size), the same operations
+  /// per lane. The three sizes share their work, since a register's lanes are usually at different sizes (they
+  /// start pairs at different times): every candidate edge keeps the newest vertex, so edge k is edge(p[k], s)
+  /// whatever the lane's size (the segment lanes' segment, the triangle lanes' two edges, the tetrahedron lanes'
+  /// three), computed once; the triangle lanes' face and the tetrahedron lanes' first face are one face() call; and
+  /// one Proj (13 registers) is assembled at the end instead of one per size.
+  AI static Proj project(const V3* p, const V3& s, mask count, mask live) {
     const real zero = splat(T(0));
-    const real V[4] = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]), -det3(p[0], p[1], p[2])};
-    const real total = ((V[0] + V[1]) + V[2]) + V[3];
-    mask inside = total != zero;
-    for (int m = 0; m < 4; ++m) inside &= ~opposite_sign(V[m], total);
-    Proj in = empty();
-    in.count = splat_mask(4);
-    in.contains = splat_mask(-1);
-    for (int m = 0; m < 4; ++m) { in.index[m] = splat_mask(m); in.lambda[m] = V[m] / total; }
-    if (!any(want & ~inside)) return in;
-    // The visible face whose plane is farthest from the origin first (the reference's rule, same arithmetic):
-    // where the origin's projection lies inside it, that is the answer, in one face instead of one round per
-    // visible face (on smooth shapes the origin sees all three new faces of a flat tent, and some lane of a
-    // register nearly always needs the three rounds).
-    mask cand[3];
-    for (int m = 0; m < 3; ++m) cand[m] = want & ~inside & ((total == zero) | opposite_sign(V[m], total));
-    const int I[3] = {1, 0, 0}, J[3] = {2, 2, 1};
-    real far = zero;
-    mask have_first = splat_mask(0), choice = splat_mask(0);
-    for (int m = 0; m < 3; ++m) {
-      const V3 n = cross(sub(p[I[m]], p[3]), sub(p[J[m]], p[3]));
-      const real nn = norm2(n), s = dot(p[3], n);
-      const real q = select(nn > zero, s * (s / nn), splat(T(-1)));
-      const mask take = cand[m] & (~have_first | (q > far));
-      far = select(take, q, far);
-      choice = select(take, splat_mask(m), choice);
-      have_first |= cand[m];
+    const mask three = live & (count == splat_mask(2)), four = live & (count == splat_mask(3));
+    // Only segment lanes (the first iterations of a run, short pairs): the segment alone, as segment() did.
+    if (!any(three | four)) return to_proj(edge(p[0], s, splat_mask(0), count));
+    // Tetrahedron lanes (tetrahedron()): the origin inside, else the faces keeping vertex 3 that it sees (cand[m]:
+    // face m omits vertex m), and the visible face whose plane is farthest from the origin (the reference's rule,
+    // same arithmetic): where the origin's projection lies inside that face, it is the answer, in one face instead
+    // of one round per visible face (on smooth shapes the origin sees all three new faces of a flat tent).
+    real V[4] = {zero, zero, zero, zero}, total = zero;
+    mask inside = splat_mask(0), have_first = splat_mask(0), first_0 = splat_mask(0), first_2 = splat_mask(0);
+    mask cand[3] = {splat_mask(0), splat_mask(0), splat_mask(0)};
+    if (any(four)) {
+      V[0] = det3(p[1], p[2], s), V[1] = -det3(p[0], p[2], s), V[2] = det3(p[0], p[1], s), V[3] = -det3(p[0], p[1], p[2]);
+      total = ((V[0] + V[1]) + V[2]) + V[3];
+      inside = four & (total != zero);
+      for (int m = 0; m < 4; ++m) inside &= ~opposite_sign(V[m], total);
+      for (int m = 0; m < 3; ++m) cand[m] = four & ~inside & ((total == zero) | opposite_sign(V[m], total));
+      const int I[3] = {1, 0, 0}, J[3] = {2, 2, 1};
+      real far = zero;
+      mask choice = splat_mask(0);
+      for (int m = 0; m < 3; ++m) {
+        const V3 n = cross(sub(p[I[m]], s), sub(p[J[m]], s));
+        const real nn = norm2(n), sn = dot(s, n);
+        const real q = select(nn > zero, sn * (sn / nn), splat(T(-1)));
+        const mask take = cand[m] & (~have_first | (q > far));
+        far = select(take, q, far);
+        choice = select(take, splat_mask(m), choice);
+        have_first |= cand[m];
+      }
+      first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
     }
-    mask fi, fj;
-    const mask first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
-    const Face ff = face_keeping_3(p, first_0, first_2, fi, fj);
-    const mask first_ok = have_first & ff.use;
-    const Proj first = face_proj(ff, fi, fj, splat_mask(3));
-    if (!any(want & ~inside & ~first_ok)) return pick(inside, in, first);
-    // Edge e joins old vertex e to vertex 3.
-    const Edge E[3] = {edge(p[0], p[3], splat_mask(0), splat_mask(3)), edge(p[1], p[3], splat_mask(1), splat_mask(3)),
-                       edge(p[2], p[3], splat_mask(2), splat_mask(3))};
-    const real En[3] = {norm2(E[0].x), norm2(E[1].x), norm2(E[2].x)};
-    mask remaining[3], taken[3];
-    for (int m = 0; m < 3; ++m) remaining[m] = cand[m] & ~first_ok;  // the closest of every visible face's answer
-    // The best answer so far: a face interior (x, weights, old vertices i, j) or an edge (best_edge).
-    const real inf = splat(std::numeric_limits<T>::infinity());
-    Face bf;  // its x and weights
-    bf.x = {inf, inf, inf};
+    // One face: the triangle lanes' p0 p1 s (triangle()), the tetrahedron lanes' first face (face_keeping_3()'s
+    // vertices and indices).
+    const mask fi = select(first_0, splat_mask(1), splat_mask(0));
+    const mask fj = select(three, splat_mask(1), select(first_2, splat_mask(1), splat_mask(2)));
+    // Computed whatever the lanes (only segment lanes is rare): no branch, and no default value to write first.
+    const Face f = face(pick(first_0, p[1], p[0]), pick(three, p[1], pick(first_2, p[1], p[2])), s);
+    const mask first_ok = have_first & f.use;
+    // Edges to the new vertex (input indices k and count), where some lane's answer may be one.
+    const mask tri_edges = three & ~f.use, rest = four & ~inside & ~first_ok;
+    // Edge 0 is computed whatever the lanes (segment lanes nearly always need it); edges 1 and 2 start as copies of
+    // it where no lane needs them (registers, not zeroed memory).
+    Edge E[3];
+    real En[3];
+    E[0] = edge(p[0], s, splat_mask(0), count), En[0] = norm2(E[0].x);
+    E[1] = E[0], En[1] = En[0], E[2] = E[0], En[2] = En[0];
+    if (any(tri_edges | rest)) E[1] = edge(p[1], s, splat_mask(1), count), En[1] = norm2(E[1].x);
+    // The tetrahedron lanes whose first face was not the answer: the closest of every visible face's answer.
+    real best_n2 = splat(std::numeric_limits<T>::infinity());
+    Face bf;  // the best face's x and weights (use, via_i, via_j unused)
+    bf.x = {zero, zero, zero};
     for (int m = 0; m < 3; ++m) bf.lambda[m] = zero;
-    real best_n2 = inf;
+    bf.use = bf.via_i = bf.via_j = splat_mask(0);
     mask bi = splat_mask(0), bj = splat_mask(0), best_edge = splat_mask(0), best_use = splat_mask(0);
     mask have = splat_mask(0);
-    for (;;) {
-      const mask round = next_round(remaining, taken);
-      if (!any(round)) break;
-      // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
-      mask i, j;
-      const Face f = face_keeping_3(p, taken[0], taken[2], i, j);
-      const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
-      const mask to_j = takes_j(f, ni, nj);
-      const real n2 = select(f.use, norm2(f.x), select(to_j, nj, ni));
-      const mask take = round & (~have | (n2 < best_n2));
-      best_n2 = select(take, n2, best_n2);
-      best_use = select(take, f.use, best_use);
-      best_edge = select(take, select(to_j, j, i), best_edge);
-      bf.x = pick(take, f.x, bf.x);
-      for (int m = 0; m < 3; ++m) bf.lambda[m] = select(take, f.lambda[m], bf.lambda[m]);
-      bi = select(take, i, bi), bj = select(take, j, bj);
-      have |= round;
+    if (any(rest)) {
+      E[2] = edge(p[2], s, splat_mask(2), count), En[2] = norm2(E[2].x);
+      mask remaining[3], taken[3];
+      for (int m = 0; m < 3; ++m) remaining[m] = cand[m] & ~first_ok;
+      for (;;) {
+        const mask round = next_round(remaining, taken);
+        if (!any(round)) break;
+        // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
+        mask i, j;
+        const Face g = face_keeping_3(p, taken[0], taken[2], i, j);  // p[3] = s in these lanes
+        const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
+        const mask to_j = takes_j(g, ni, nj);
+        const real n2 = select(g.use, norm2(g.x), select(to_j, nj, ni));
+        const mask take = round & (~have | (n2 < best_n2));
+        best_n2 = select(take, n2, best_n2);
+        best_use = select(take, g.use, best_use);
+        best_edge = select(take, select(to_j, j, i), best_edge);
+        bf.x = pick(take, g.x, bf.x);
+        for (int m = 0; m < 3; ++m) bf.lambda[m] = select(take, g.lambda[m], bf.lambda[m]);
+        bi = select(take, i, bi), bj = select(take, j, bj);
+        have |= round;
+      }
     }
-    Edge e = E[0];
-    for (int k = 1; k < 3; ++k) e = pick(best_edge == splat_mask(k), E[k], e);
-    Proj best = pick(best_use, face_proj(bf, bi, bj, splat_mask(3)), to_proj(e));
-    best.x = pick(have, best.x, V3{inf, inf, inf});  // sees only the old face: no candidate
-    best.count = select(have, best.count, splat_mask(0));
-    return pick(inside, in, pick(first_ok, first, best));
+    // The answer: a face (the triangle lanes' face, the first face, the best face) or an edge (the segment, the
+    // triangle lanes' closer edge, the best face's edge).
+    const mask from_best = rest;
+    Edge e = pick(three & takes_j(f, En[0], En[1]), E[1], E[0]);
+    for (int k = 1; k < 3; ++k) e = pick(from_best & (best_edge == splat_mask(k)), E[k], e);
+    const mask use_face = (three & f.use) | first_ok | (from_best & best_use);
+    Face a = f;
+    a.x = pick(from_best, bf.x, f.x);
+    for (int m = 0; m < 3; ++m) a.lambda[m] = select(from_best, bf.lambda[m], f.lambda[m]);
+    Proj r = pick(use_face, face_proj(a, select(from_best, bi, fi), select(from_best, bj, fj), count), to_proj(e));
+    if (any(four)) {
+      // No visible face: no candidate (x infinite, count 0); the origin inside: the whole tetrahedron.
+      const mask none = from_best & ~have;
+      const real inf = splat(std::numeric_limits<T>::infinity());
+      r.x = pick(none, V3{inf, inf, inf}, r.x);
+      r.count = select(none, splat_mask(0), r.count);
+      if (any(inside)) {
+        r.x = pick(inside, V3{zero, zero, zero}, r.x);
+        r.count = select(inside, splat_mask(4), r.count);
+        r.contains = inside;
+        for (int m = 0; m < 4; ++m) {
+          r.index[m] = select(inside, splat_mask(m), r.index[m]);
+          r.lambda[m] = select(inside, V[m] / total, r.lambda[m]);
+        }
+      }
+    }
+    return r;
   }
 
   // ---- The lanes ----
@@ -735,10 +761,22 @@ template <class T> struct WideGjk {
   /// The lanes' loop. `source.load(L, l)` starts the next pair in lane l (false when none is left);
   /// `source.done(L, l, status)` takes lane l's finished pair. L's shape types must be set.
   template <class Source> static void drive(Lanes& L, Source& source, Solver solver, bool points) {
+    loop<false>(L, source, solver, points);
+  }
+  /// drive() for a run whose lanes are all boolean (L.boolean_only in every lane, a boolean batch query): the
+  /// same operations on every value the query reads, without what only the other levels use (points, Newton
+  /// directions, the simplex weights), known at compile time instead of tested per iteration.
+  template <class Source> static void drive_boolean(Lanes& L, Source& source, Solver solver) {
+    loop<true>(L, source, solver, false);
+  }
+
+  template <bool Boolean, class Source> static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     for (int l = 0; l < W; ++l)
       if (!source.load(L, l)) L.pair[l] = -1;
     const real zero = splat(T(0)), one = splat(T(1));
-    const bool newton_run = newton_pair_type(L.A.type, L.B.type);  // else no lane ever has L.newton
+    const bool points = !Boolean && points_;
+    // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
+    const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -768,7 +806,8 @@ template <class T> struct WideGjk {
       const real xx = norm2(x);
       const real xn = wsqrt<T>(xx);
       const mask ends_overlap = live & (xn <= L.touch);
-      const mask ends_collision = live & ~ends_overlap & L.boolean_only & (xn <= L.core_margin);
+      const mask boolean_only = Boolean ? splat_mask(-1) : L.boolean_only;
+      const mask ends_collision = live & ~ends_overlap & boolean_only & (xn <= L.core_margin);
       live &= ~ends_overlap & ~ends_collision;
 
       V3 d = x;
@@ -812,7 +851,7 @@ template <class T> struct WideGjk {
       L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
       L.lower = select(live, wmax(L.lower, lb), L.lower);
       L.direction = pick(live, d, L.direction);
-      const mask ends_separated = live & L.boolean_only & (lb > L.core_margin);
+      const mask ends_separated = live & boolean_only & (lb > L.core_margin);
       live &= ~ends_separated;
 
       const real tol = wmax(L.tolerance, L.relative * xn);
@@ -850,13 +889,7 @@ template <class T> struct WideGjk {
           }
           for (int m = 0; m < 4; ++m) pslot[m] = select(live & (L.count == splat_mask(m)), free, L.slot[m]);
         }
-        const mask n_after = L.count + 1;
-        const mask two = n_after == splat_mask(2), three = n_after == splat_mask(3);
-        Proj proj = empty();
-        if (any(live & two)) proj = pick(two, segment(pw[0], pw[1], splat_mask(0), splat_mask(1)), proj);
-        const mask four = n_after == splat_mask(4);
-        if (any(live & three)) proj = pick(three, triangle(pw, live & three), proj);
-        if (any(live & four)) proj = pick(four, tetrahedron(pw, live & four), proj);
+        const Proj proj = project(pw, sw, L.count, live);
         const real next_xx = norm2(proj.x);
 
         ends_contains = live & proj.contains;
@@ -879,7 +912,7 @@ template <class T> struct WideGjk {
             for (int o = 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
             L.slot[m] = select(moves, q, L.slot[m]);
           }
-          L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);
+          if (!Boolean) L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);  // a boolean output has no weights
         }
         L.count = select(moves, proj.count, L.count);
         L.x = pick(moves, proj.x, L.x);
@@ -895,7 +928,7 @@ template <class T> struct WideGjk {
         //    a flat face or a rim, where the Hessian says nothing, or the end of the arithmetic's resolution);
         //  - the certified gap after this step is still above kNewtonPlainGap x tol: below it, a plain step at x
         //    certifies the witness (the duality gap along x itself, which the termination test needs).
-        const mask newton_lanes = steps & L.newton & ~L.boolean_only;
+        const mask newton_lanes = steps & L.newton & ~boolean_only;
         if (newton_run && any(newton_lanes)) {
           const V3 n = divide(d, dnorm);
           const V3 r = sub(sw, scale(lb, n));

@@ -286,7 +286,8 @@ template <class T> struct WideGjkPairs {
     rows.attach(L.A, L.B);
     Source source{in, options, type_a, type_b, pairs, n, out, fallback};
     source.start_run(L);
-    G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
+    if (options.level == QueryLevel::boolean) G::drive_boolean(L, source, options.solver);  // start_run: all boolean
+    else G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
     return source.fallbacks;
   }
 };
