@@ -84,6 +84,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   const auto sets = runnable_sets();
   int compared = 0, spread = 0;
   long newton_steps = 0, newton_pairs = 0;  // Newton directions taken (reference): the lanes must have run them
+  long feature_pairs = 0;  // ... of them, polytope-curved pairs (feature_direction())
   for (const ShapeType ta : testing::bounded_shape_types()) {
     for (const ShapeType tb : testing::bounded_shape_types()) {
       std::deque<OwnedShapeView> keep;  // the setups' cores point into it: a deque never moves its elements
@@ -95,6 +96,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
         want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
         newton_steps += want.back().newton_steps;
         newton_pairs += want.back().newton_steps > 0 ? 1 : 0;
+        feature_pairs += want.back().newton_steps > 0 && kernels::flat_newton_side(ta, tb) != 0 ? 1 : 0;
         lo = std::min(lo, want.back().iterations);
         hi = std::max(hi, want.back().iterations);
       }
@@ -119,7 +121,10 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   EXPECT_GE(spread, 4) << "lanes should finish at different iterations";
   // Newton directions are for distance / witness lanes of curved pairs only; boolean lanes never take them.
   if (level == QueryLevel::boolean) EXPECT_EQ(newton_steps, 0);
-  else EXPECT_GT(newton_pairs, 50) << "too few pairs took Newton steps to check them lane by lane";
+  else {
+    EXPECT_GT(newton_pairs, 50) << "too few pairs took Newton steps to check them lane by lane";
+    EXPECT_GT(feature_pairs, 20) << "too few polytope-curved pairs took feature Newton steps";
+  }
 }
 
 TEST(WideGjk, EqualsReferenceBitwiseDouble) {

@@ -69,11 +69,8 @@ template <class T> std::array<T, 6> support_hessian(const ShapeCore<T>& core, co
   return h;
 }
 
-/// Newton's direction after the support point w of D in direction -n (unit n, lb = <w, n>, r = w - lb n):
-/// wide_gjk.inl's newton_direction(), where the derivation is: n + delta with (H + lb I) delta = r; step2 =
-/// |delta|^2.
-template <class T>
-Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, const Vec3<T>& r, T lb, T& step2) {
+/// H = H_A(-n) + R H_B(R^T n) R^T as xx, yy, zz, xy, xz, yz: wide_gjk.inl's pair_hessian().
+template <class T> std::array<T, 6> pair_hessian(const MinkowskiDifference<T>& D, const Vec3<T>& n) {
   std::array<T, 6> h{};
   const bool ca = curved_core(D.A->type), cb = curved_core(D.B->type);
   if (ca) h = support_hessian(*D.A, Vec3<T>(-n));
@@ -92,15 +89,85 @@ Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, cons
     if (ca) for (int i = 0; i < 6; ++i) h[i] = h[i] + hb[i];
     else h = hb;
   }
+  return h;
+}
+
+/// (H + lb I)^-1 r by cofactors: wide_gjk.inl's solve().
+template <class T> Vec3<T> newton_solve(const std::array<T, 6>& h, T lb, const Vec3<T>& r) {
   const T a = h[0] + lb, b = h[1] + lb, c = h[2] + lb, p = h[3], q = h[4], t = h[5];
   const T c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
   const T c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
   const T det = (a * c00 + p * c01) + q * c02;
-  const Vec3<T> delta(((c00 * r.x() + c01 * r.y()) + c02 * r.z()) / det,
-                      ((c01 * r.x() + c11 * r.y()) + c12 * r.z()) / det,
-                      ((c02 * r.x() + c12 * r.y()) + c22 * r.z()) / det);
+  return Vec3<T>(((c00 * r.x() + c01 * r.y()) + c02 * r.z()) / det, ((c01 * r.x() + c11 * r.y()) + c12 * r.z()) / det,
+                 ((c02 * r.x() + c12 * r.y()) + c22 * r.z()) / det);
+}
+
+/// Newton's direction after the support point w of D in direction -n (unit n, lb = <w, n>, r = w - lb n):
+/// wide_gjk.inl's newton_direction(), where the derivation is: n + delta with (H + lb I) delta = r; step2 =
+/// |delta|^2.
+template <class T>
+Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, const Vec3<T>& r, T lb, T& step2) {
+  const Vec3<T> delta = newton_solve(pair_hessian(D, n), lb, r);
   step2 = norm2(delta);
   return Vec3<T>(n.x() + delta.x(), n.y() + delta.y(), n.z() + delta.z());
+}
+
+// The wide kernel's V3 arithmetic, in its association order.
+template <class T> T wdot(const Vec3<T>& a, const Vec3<T>& b) { return (a.x() * b.x() + a.y() * b.y()) + a.z() * b.z(); }
+template <class T> Vec3<T> wcross(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.y() * b.z() - a.z() * b.y(), a.z() * b.x() - a.x() * b.z(), a.x() * b.y() - a.y() * b.x());
+}
+template <class T> Vec3<T> wscale(T s, const Vec3<T>& a) { return Vec3<T>(s * a.x(), s * a.y(), s * a.z()); }
+template <class T> Vec3<T> wdivide(const Vec3<T>& a, T s) { return Vec3<T>(a.x() / s, a.y() / s, a.z() / s); }
+template <class T> Vec3<T> wsub(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.x() - b.x(), a.y() - b.y(), a.z() - b.z());
+}
+template <class T> Vec3<T> wadd(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.x() + b.x(), a.y() + b.y(), a.z() + b.z());
+}
+
+/// Newton's direction for a polytope against a curved core (flat_newton_side()): wide_gjk.inl's
+/// feature_direction(), where the derivation is. S: the simplex after this iteration's projection; s: the support
+/// point in direction -n.
+template <class T>
+Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, const Vec3<T>& n,
+                          const SupportPoint<T>& s, T& step2) {
+  const bool fa = flat_newton_side(D.A->type, D.B->type) == 1;
+  const auto flat = [&](int m) { return fa ? S.v[m].a : S.v[m].b; };
+  const Vec3<T> p0 = flat(0);
+  const Vec3<T> y = fa ? wsub(p0, s.b) : wsub(s.a, p0);
+  const T lb = wdot(y, n);
+  const Vec3<T> r = wsub(y, wscale(lb, n));
+  const std::array<T, 6> h = pair_hessian(D, n);
+  const bool has1 = S.count > 1 && !(flat(1) == p0);
+  const bool has2 = S.count > 2 && !(flat(2) == p0) && !(flat(2) == flat(1));
+  const Vec3<T> e1 = S.count > 1 ? wsub(flat(1), p0) : Vec3<T>::Zero();
+  const Vec3<T> e2 = S.count > 2 ? wsub(flat(2), p0) : Vec3<T>::Zero();
+  const Vec3<T> m = wcross(e1, e2);
+  const T mm = wdot(m, m);
+  const bool is_face = has1 && has2 && mm > T(1e-12) * (wdot(e1, e1) * wdot(e2, e2));
+  const bool is_edge = !is_face && (has1 || has2);
+  Vec3<T> delta;
+  if (is_face) {
+    const T sq = std::sqrt(mm);
+    const Vec3<T> f = wdivide(m, wdot(m, n) < T(0) ? -sq : sq);
+    delta = wsub(f, n);
+  } else if (is_edge) {
+    const Vec3<T> e = has1 ? e1 : e2;
+    const Vec3<T> c = wcross(n, e);
+    const T cn = std::sqrt(wdot(c, c));
+    const Vec3<T> u = wdivide(c, cn);
+    const Vec3<T> v = wdivide(wsub(e, wscale(wdot(e, n), n)), cn);
+    const T alpha = -wdot(n, e) / cn;
+    const Vec3<T> hu((h[0] * u.x() + h[3] * u.y()) + h[4] * u.z(), (h[3] * u.x() + h[1] * u.y()) + h[5] * u.z(),
+                     (h[4] * u.x() + h[5] * u.y()) + h[2] * u.z());
+    const T beta = (wdot(u, y) - alpha * wdot(v, hu)) / (wdot(u, hu) + lb);
+    delta = wadd(wscale(alpha, v), wscale(beta, u));
+  } else {
+    delta = newton_solve(h, lb, r);
+  }
+  step2 = wdot(delta, delta);
+  return wadd(n, delta);
 }
 
 template <class T>
@@ -123,6 +190,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   bool newton_next = false;
   Vec3<T> newton_dir = Vec3<T>::Zero();
   T newton_step2 = T(0);  // |delta|^2 of the step that chose newton_dir
+  const bool flat_pair = flat_newton_side(D.A->type, D.B->type) != 0;  // feature_direction()
+  T newton_gap = T(0);    // flat pairs: the certified gap when the last Newton choice was made
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
@@ -206,14 +275,36 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     d_prev = d;
     last_s = s.w;
     // Newton's direction for the next iteration (wide_gjk.inl: when, and why).
-    if (newton) {
+    if (newton && (!flat_pair || lb > T(0))) {  // polytope pairs: only separated along d (wide_gjk.inl)
       const Vec3<T> n(d.x() / d_norm, d.y() / d_norm, d.z() / d_norm);
-      const Vec3<T> res(s.w.x() - lb * n.x(), s.w.y() - lb * n.y(), s.w.z() - lb * n.z());
       T step2 = T(0);
-      const Vec3<T> nd = newton_direction(D, n, res, lb, step2);
+      Vec3<T> nd;
+      T shrunk;
+      if (flat_pair) {
+        nd = feature_direction(D, S, n, s, step2);
+        // The tilt towards x's offset from the line along nd (wide_gjk.inl says why).
+        const Vec3<T> t = wsub(x, wscale(wdot(x, nd) / wdot(nd, nd), nd));
+        const T tn = std::sqrt(wdot(t, t));
+        const T eps = std::sqrt((T(0.2) * tol) / norm3(s.w));
+        if (tn > T(0)) nd = wadd(nd, wscale(eps / tn, t));
+        shrunk = T(0.25) * newton_step2 + T(4) * (eps * eps);
+      } else {
+        const Vec3<T> res(s.w.x() - lb * n.x(), s.w.y() - lb * n.y(), s.w.z() - lb * n.z());
+        nd = newton_direction(D, n, res, lb, step2);
+        shrunk = T(0.25) * newton_step2;
+      }
       const bool valid = lb > T(0);
-      if (newton_step && !(valid && step2 <= T(0.25) * newton_step2)) newton = false;
-      if (newton && valid && step2 <= T(kNewtonSwitch * kNewtonSwitch) && next_xn - lower_bound > T(kNewtonPlainGap) * tol) {
+      const bool failed = newton_step && !(valid && step2 <= shrunk);
+      bool skip = false;  // flat pairs: a failed step skips one Newton choice instead of ending them
+      if (flat_pair) {
+        const T gap = next_xn - lower_bound;
+        skip = failed || (newton_step && !(gap <= T(0.5) * newton_gap));
+        newton_gap = gap;
+      } else if (failed) {
+        newton = false;
+      }
+      if (newton && !skip && valid && step2 <= T(kNewtonSwitch * kNewtonSwitch) &&
+          next_xn - lower_bound > T(kNewtonPlainGap) * tol) {
         newton_dir = nd;
         newton_step2 = step2;
         newton_next = true;
