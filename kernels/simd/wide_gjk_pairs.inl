@@ -261,6 +261,10 @@ template <class T> struct WideGjkPairs {
         out.iterations[i] = int(L.k[l]);
         return;
       }
+      if (status == GjkStatus::converged || status == GjkStatus::max_iterations) {
+        converged(L, l, status);
+        return;
+      }
       GjkResult<T> g;
       G::finish(L, l, status, g, witness);
       const LanePair& lp = lane[l];
@@ -273,6 +277,47 @@ template <class T> struct WideGjkPairs {
         return;
       }
       write_pair_output(r, lp.Ra, lp.ta, lp.pair, options.level, out);
+    }
+
+    /// A distance / witness query's usual ending (GJK converged, or its budget ran out with x away from the
+    /// origin): complete_from_gjk() and write_pair_output() for it, with their operations in their order, straight
+    /// from the lane, without the GjkResult (the simplex, ~40 values), the PairOutput and the out-of-line
+    /// completion (finish() + complete_from_gjk() + write_pair_output() were ~300 instructions per demo pair,
+    /// AVX2). Values the query level does not write are not computed.
+    void converged(const Lanes& L, int l, GjkStatus status) {
+      const LanePair& lp = lane[l];
+      const std::uint32_t i = lp.pair;
+      const Vec3<T> x = G::get_lane(L.x, l);
+      // complete_from_gjk()'s own expression, g.x.norm(), not norm3(): Eigen reduces a 3-vector of doubles as
+      // (x^2 + y^2) + z^2 but one of floats as x^2 + (y^2 + z^2) (measured with GCC 12, Eigen 3.4, on SSE2, AVX2
+      // and AVX-512 flags alike), so only the same call gives the same bits in both precisions.
+      const T xn = x.norm();
+      out.status[i] = status == GjkStatus::max_iterations ? Status::max_iterations : Status::converged;
+      out.collide[i] = L.lower[l] > L.core_margin[l] ? 0 : 1;  // finish(): !(lower bound > core margin)
+      const QueryLevel level = options.level;
+      if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(xn - lp.radii);
+      if (level >= QueryLevel::witness) {
+        const Vec3<T> n = -x / xn;
+        // GjkResult::witness_a() / witness_b(): sum of lambda[m] times the vertex's point, from zero, in m order.
+        Vec3<T> pa = Vec3<T>::Zero(), pb = Vec3<T>::Zero();
+        const int count = int(L.count[l]);
+        for (int m = 0; m < count; ++m) {
+          const int q = int(L.slot[m][l]) & 3;
+          const T lambda = L.lambda[m][l];
+          pa += lambda * G::get_lane(L.a[q], l);
+          pb += lambda * G::get_lane(L.b[q], l);
+        }
+        const Vec3<T> wa = pa + lp.radius_a * n, wb = pb - lp.radius_b * n;
+        const auto put = [&](double* const* dst, const Eigen::Vector3d& v) {
+          for (int c = 0; c < 3; ++c) dst[c][i] = v[c];
+        };
+        put(out.witness_a, mul<double>(lp.Ra, wa.template cast<double>()) + lp.ta);
+        put(out.witness_b, mul<double>(lp.Ra, wb.template cast<double>()) + lp.ta);
+        put(out.normal, mul<double>(lp.Ra, n.template cast<double>()));
+      }
+      const Eigen::Vector3d d = mul<double>(lp.Ra, G::get_lane(L.direction, l).template cast<double>());
+      for (int c = 0; c < 3; ++c) out.direction[c][i] = d[c];
+      out.iterations[i] = int(L.k[l]);
     }
   };
 
