@@ -39,13 +39,34 @@ template <class T> struct WideGjkPairs {
     std::uint64_t left = 0;
   };
 
+  /// x, y, z and a zero in one 32-byte vector: the output's rotation column by column, so that A's frame to the
+  /// world is three broadcasts, three products and two sums per vector instead of nine products and six sums
+  /// (element i of (c0 x + c1 y) + c2 z is mul()'s (R(i, 0) x + R(i, 1) y) + R(i, 2) z: the same bits).
+  typedef double d4 __attribute__((vector_size(4 * sizeof(double))));
+
   /// What a lane keeps of its pair until it finishes: where the answer goes and what completing it needs beyond
   /// the lane's own tolerance, touch (= the floor) and core margin.
   struct LanePair {
     std::uint32_t pair = 0;
-    Eigen::Matrix3d Ra;
-    Eigen::Vector3d ta;  // only at QueryLevel::witness (the only level that writes world points)
+    d4 Ra[3] = {};  // A's world rotation by columns (lane 3 stays 0)
+    d4 ta = {};     // only at QueryLevel::witness (the only level that writes world points)
     T radius_a, radius_b, radii, scale;
+
+    /// dst[c][i] = component c of R v (+ t with `translate`) for v in A's frame: write_pair_output()'s
+    /// mul<double>(Ra, v) (+ ta). (No d4 by value: the scalar build has no AVX, and -Wpsabi warns of the ABI.)
+    void put_world(double* const* dst, std::size_t i, const Vec3<T>& v, bool translate) const {
+      d4 r = (Ra[0] * double(v.x()) + Ra[1] * double(v.y())) + Ra[2] * double(v.z());
+      if (translate) r += ta;
+      dst[0][i] = r[0];
+      dst[1][i] = r[1];
+      dst[2][i] = r[2];
+    }
+    Eigen::Matrix3d rotation() const {
+      Eigen::Matrix3d R;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) R(i, j) = Ra[j][i];
+      return R;
+    }
   };
 
   /// W pairs' values of precision T in double-width registers (Wd lanes): the side stage's arithmetic is T's,
@@ -220,7 +241,7 @@ template <class T> struct WideGjkPairs {
       LanePair& lp = lane[l];
       lp.pair = c.pair[s];
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) lp.Ra(i, j) = c.Ra[3 * i + j][s];
+        for (int j = 0; j < 3; ++j) lp.Ra[j][i] = c.Ra[3 * i + j][s];
       if (witness)
         for (int i = 0; i < 3; ++i) lp.ta[i] = c.ta[i][s];
       lp.radius_a = c.radius_a[s];
@@ -256,8 +277,7 @@ template <class T> struct WideGjkPairs {
         const std::uint32_t i = lp.pair;
         out.status[i] = Status::converged;
         out.collide[i] = status == GjkStatus::collision_proven ? 1 : 0;
-        const Eigen::Vector3d d = mul<double>(lp.Ra, G::get_lane(L.direction, l).template cast<double>());
-        for (int c = 0; c < 3; ++c) out.direction[c][i] = d[c];
+        lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
         out.iterations[i] = int(L.k[l]);
         return;
       }
@@ -276,7 +296,8 @@ template <class T> struct WideGjkPairs {
         fallback[fallbacks++] = lp.pair;
         return;
       }
-      write_pair_output(r, lp.Ra, lp.ta, lp.pair, options.level, out);
+      const Eigen::Vector3d ta(lp.ta[0], lp.ta[1], lp.ta[2]);
+      write_pair_output(r, lp.rotation(), ta, lp.pair, options.level, out);
     }
 
     /// A distance / witness query's usual ending (GJK converged, or its budget ran out with x away from the
@@ -307,16 +328,11 @@ template <class T> struct WideGjkPairs {
           pa += lambda * G::get_lane(L.a[q], l);
           pb += lambda * G::get_lane(L.b[q], l);
         }
-        const Vec3<T> wa = pa + lp.radius_a * n, wb = pb - lp.radius_b * n;
-        const auto put = [&](double* const* dst, const Eigen::Vector3d& v) {
-          for (int c = 0; c < 3; ++c) dst[c][i] = v[c];
-        };
-        put(out.witness_a, mul<double>(lp.Ra, wa.template cast<double>()) + lp.ta);
-        put(out.witness_b, mul<double>(lp.Ra, wb.template cast<double>()) + lp.ta);
-        put(out.normal, mul<double>(lp.Ra, n.template cast<double>()));
+        lp.put_world(out.witness_a, i, pa + lp.radius_a * n, true);
+        lp.put_world(out.witness_b, i, pb - lp.radius_b * n, true);
+        lp.put_world(out.normal, i, n, false);
       }
-      const Eigen::Vector3d d = mul<double>(lp.Ra, G::get_lane(L.direction, l).template cast<double>());
-      for (int c = 0; c < 3; ++c) out.direction[c][i] = d[c];
+      lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
       out.iterations[i] = int(L.k[l]);
     }
   };
