@@ -285,6 +285,10 @@ template <class T> struct WideGjkPairs {
         converged(L, l, status);
         return;
       }
+      if (status == GjkStatus::overlap && options.level != QueryLevel::penetration) {  // penetration: EPA below
+        overlapping(L, l);
+        return;
+      }
       GjkResult<T> g;
       G::finish(L, l, status, g, witness);
       const LanePair& lp = lane[l];
@@ -331,6 +335,27 @@ template <class T> struct WideGjkPairs {
         lp.put_world(out.witness_a, i, pa + lp.radius_a * n, true);
         lp.put_world(out.witness_b, i, pb - lp.radius_b * n, true);
         lp.put_world(out.normal, i, n, false);
+      }
+      lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
+      out.iterations[i] = int(L.k[l]);
+    }
+
+    /// Overlapping cores below QueryLevel::penetration (no EPA): complete_from_gjk() answers collide with no
+    /// distance, no witness and no normal (its PairOutput's NaNs), which write_pair_output() maps to the world like
+    /// any point; the same operations here on the same NaNs, without the GjkResult and the out-of-line calls (a
+    /// mixed batch like the demo's ends many of its GJK pairs this way).
+    void overlapping(const Lanes& L, int l) {
+      const LanePair& lp = lane[l];
+      const std::uint32_t i = lp.pair;
+      out.status[i] = Status::converged;
+      out.collide[i] = 1;
+      const QueryLevel level = options.level;
+      if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(quiet_nan<T>());
+      if (level >= QueryLevel::witness) {
+        const Vec3<T> none = Vec3<T>::Constant(quiet_nan<T>());
+        lp.put_world(out.witness_a, i, none, true);
+        lp.put_world(out.witness_b, i, none, true);
+        lp.put_world(out.normal, i, none, false);
       }
       lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
       out.iterations[i] = int(L.k[l]);
