@@ -38,6 +38,13 @@ template <class T> struct WideGjk {
   static real splat(T v) { return real{} + v; }
   static mask splat_mask(Int v) { return mask{} + v; }
   static mask truth(bool b) { return splat_mask(b ? Int(-1) : Int(0)); }
+  /// The lanes whose bit is set in `bits`, as a mask: a broadcast, an and and a compare against the constant
+  /// lane bits, where a loop of W lane inserts cost 12-28 instructions per call (measured in drive(), AVX2).
+  static mask lanes_of(std::uint32_t bits) {
+    mask lane_bit;
+    for (int l = 0; l < W; ++l) lane_bit[l] = Int(Int(1) << l);  // folded to a constant
+    return (splat_mask(Int(bits)) & lane_bit) != splat_mask(0);
+  }
   static mask opposite_sign(real a, real b) {
     const real zero = splat(T(0));
     return ((a > zero) & (b < zero)) | ((a < zero) & (b > zero));
@@ -520,8 +527,7 @@ template <class T> struct WideGjk {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
-    mask m = splat_mask(0);
-    for (int l = 0; l < W; ++l) m[l] = (L.fresh >> l & 1u) ? -1 : 0;
+    const mask m = lanes_of(L.fresh);
     L.w[0] = pick(m, sw, L.w[0]);
     L.a[0] = pick(m, sa, L.a[0]);  // start_lane() set slot[0] = 0
     L.b[0] = pick(m, sb, L.b[0]);
@@ -841,8 +847,13 @@ template <class T> struct WideGjk {
   }
 
   template <bool Boolean, class Source> static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
-    for (int l = 0; l < W; ++l)
-      if (!source.load(L, l)) L.pair[l] = -1;
+    // Lanes holding a pair, kept as bits beside L.pair (rebuilding them from L.pair and the live mask from them
+    // lane by lane cost ~55 instructions per demo pair, AVX2).
+    std::uint32_t active = 0;
+    for (int l = 0; l < W; ++l) {
+      if (source.load(L, l)) active |= 1u << l;
+      else L.pair[l] = -1;
+    }
     const real zero = splat(T(0)), one = splat(T(1));
     const bool points = !Boolean && points_;
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
@@ -851,26 +862,22 @@ template <class T> struct WideGjk {
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
-      if (!source.load(L, l)) L.pair[l] = -1;
-    };
-    const auto active_bits = [&] {
-      std::uint32_t bits = 0;
-      for (int l = 0; l < W; ++l) bits |= (L.pair[l] >= 0 ? 1u : 0u) << l;
-      return bits;
+      if (!source.load(L, l)) L.pair[l] = -1, active &= ~(1u << l);
     };
 
-    for (std::uint32_t active = active_bits(); active != 0; active = active_bits()) {
+    while (active != 0) {
       start(L);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
         const mask touching = norm(L.x) <= L.touch;
-        for (int l = 0; l < W; ++l)
-          if (bits >> l & 1u) close(l, touching[l] ? GjkStatus::overlap : GjkStatus::max_iterations);
+        for (std::uint32_t left = bits; left != 0; left &= left - 1) {
+          const int l = __builtin_ctz(left);
+          close(l, touching[l] ? GjkStatus::overlap : GjkStatus::max_iterations);
+        }
         continue;  // refilled lanes start with k = 0
       }
-      mask live = splat_mask(0);
-      for (int l = 0; l < W; ++l) live[l] = (active >> l & 1u) ? -1 : 0;
+      mask live = lanes_of(active);
       L.k = select(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
 
       const V3 x = L.x;
@@ -1056,8 +1063,10 @@ template <class T> struct WideGjk {
       const std::uint32_t b_overlap = lane_bits(ends_overlap | ends_contains | ends_stall_overlap);
       const std::uint32_t b_collision = lane_bits(ends_collision), b_separated = lane_bits(ends_separated);
       const std::uint32_t b_converged = lane_bits(ends_converged), b_stall = lane_bits(ends_stall);
-      if ((b_overlap | b_collision | b_separated | b_converged | b_stall) == 0) continue;
-      for (int l = 0; l < W; ++l) {
+      // Only the lanes that end, in lane order (a pass over all W lanes cost ~40 instructions per demo pair).
+      for (std::uint32_t left = b_overlap | b_collision | b_separated | b_converged | b_stall; left != 0;
+           left &= left - 1) {
+        const int l = __builtin_ctz(left);
         const std::uint32_t bit = 1u << l;
         if (b_overlap & bit) close(l, GjkStatus::overlap);
         else if (b_collision & bit) close(l, GjkStatus::collision_proven);

@@ -39,13 +39,34 @@ template <class T> struct WideGjkPairs {
     std::uint64_t left = 0;
   };
 
+  /// x, y, z and a zero in one 32-byte vector: the output's rotation column by column, so that A's frame to the
+  /// world is three broadcasts, three products and two sums per vector instead of nine products and six sums
+  /// (element i of (c0 x + c1 y) + c2 z is mul()'s (R(i, 0) x + R(i, 1) y) + R(i, 2) z: the same bits).
+  typedef double d4 __attribute__((vector_size(4 * sizeof(double))));
+
   /// What a lane keeps of its pair until it finishes: where the answer goes and what completing it needs beyond
   /// the lane's own tolerance, touch (= the floor) and core margin.
   struct LanePair {
     std::uint32_t pair = 0;
-    Eigen::Matrix3d Ra;
-    Eigen::Vector3d ta;  // only at QueryLevel::witness (the only level that writes world points)
+    d4 Ra[3] = {};  // A's world rotation by columns (lane 3 stays 0)
+    d4 ta = {};     // only at QueryLevel::witness (the only level that writes world points)
     T radius_a, radius_b, radii, scale;
+
+    /// dst[c][i] = component c of R v (+ t with `translate`) for v in A's frame: write_pair_output()'s
+    /// mul<double>(Ra, v) (+ ta). (No d4 by value: the scalar build has no AVX, and -Wpsabi warns of the ABI.)
+    void put_world(double* const* dst, std::size_t i, const Vec3<T>& v, bool translate) const {
+      d4 r = (Ra[0] * double(v.x()) + Ra[1] * double(v.y())) + Ra[2] * double(v.z());
+      if (translate) r += ta;
+      dst[0][i] = r[0];
+      dst[1][i] = r[1];
+      dst[2][i] = r[2];
+    }
+    Eigen::Matrix3d rotation() const {
+      Eigen::Matrix3d R;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) R(i, j) = Ra[j][i];
+      return R;
+    }
   };
 
   /// W pairs' values of precision T in double-width registers (Wd lanes): the side stage's arithmetic is T's,
@@ -220,7 +241,7 @@ template <class T> struct WideGjkPairs {
       LanePair& lp = lane[l];
       lp.pair = c.pair[s];
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) lp.Ra(i, j) = c.Ra[3 * i + j][s];
+        for (int j = 0; j < 3; ++j) lp.Ra[j][i] = c.Ra[3 * i + j][s];
       if (witness)
         for (int i = 0; i < 3; ++i) lp.ta[i] = c.ta[i][s];
       lp.radius_a = c.radius_a[s];
@@ -256,9 +277,16 @@ template <class T> struct WideGjkPairs {
         const std::uint32_t i = lp.pair;
         out.status[i] = Status::converged;
         out.collide[i] = status == GjkStatus::collision_proven ? 1 : 0;
-        const Eigen::Vector3d d = mul<double>(lp.Ra, G::get_lane(L.direction, l).template cast<double>());
-        for (int c = 0; c < 3; ++c) out.direction[c][i] = d[c];
+        lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
         out.iterations[i] = int(L.k[l]);
+        return;
+      }
+      if (status == GjkStatus::converged || status == GjkStatus::max_iterations) {
+        converged(L, l, status);
+        return;
+      }
+      if (status == GjkStatus::overlap && options.level != QueryLevel::penetration) {  // penetration: EPA below
+        overlapping(L, l);
         return;
       }
       GjkResult<T> g;
@@ -272,7 +300,66 @@ template <class T> struct WideGjkPairs {
         fallback[fallbacks++] = lp.pair;
         return;
       }
-      write_pair_output(r, lp.Ra, lp.ta, lp.pair, options.level, out);
+      const Eigen::Vector3d ta(lp.ta[0], lp.ta[1], lp.ta[2]);
+      write_pair_output(r, lp.rotation(), ta, lp.pair, options.level, out);
+    }
+
+    /// A distance / witness query's usual ending (GJK converged, or its budget ran out with x away from the
+    /// origin): complete_from_gjk() and write_pair_output() for it, with their operations in their order, straight
+    /// from the lane, without the GjkResult (the simplex, ~40 values), the PairOutput and the out-of-line
+    /// completion (finish() + complete_from_gjk() + write_pair_output() were ~300 instructions per demo pair,
+    /// AVX2). Values the query level does not write are not computed.
+    void converged(const Lanes& L, int l, GjkStatus status) {
+      const LanePair& lp = lane[l];
+      const std::uint32_t i = lp.pair;
+      const Vec3<T> x = G::get_lane(L.x, l);
+      // complete_from_gjk()'s own expression, g.x.norm(), not norm3(): Eigen reduces a 3-vector of doubles as
+      // (x^2 + y^2) + z^2 but one of floats as x^2 + (y^2 + z^2) (measured with GCC 12, Eigen 3.4, on SSE2, AVX2
+      // and AVX-512 flags alike), so only the same call gives the same bits in both precisions.
+      const T xn = x.norm();
+      out.status[i] = status == GjkStatus::max_iterations ? Status::max_iterations : Status::converged;
+      out.collide[i] = L.lower[l] > L.core_margin[l] ? 0 : 1;  // finish(): !(lower bound > core margin)
+      const QueryLevel level = options.level;
+      if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(xn - lp.radii);
+      if (level >= QueryLevel::witness) {
+        const Vec3<T> n = -x / xn;
+        // GjkResult::witness_a() / witness_b(): sum of lambda[m] times the vertex's point, from zero, in m order.
+        Vec3<T> pa = Vec3<T>::Zero(), pb = Vec3<T>::Zero();
+        const int count = int(L.count[l]);
+        for (int m = 0; m < count; ++m) {
+          const int q = int(L.slot[m][l]) & 3;
+          const T lambda = L.lambda[m][l];
+          pa += lambda * G::get_lane(L.a[q], l);
+          pb += lambda * G::get_lane(L.b[q], l);
+        }
+        lp.put_world(out.witness_a, i, pa + lp.radius_a * n, true);
+        lp.put_world(out.witness_b, i, pb - lp.radius_b * n, true);
+        lp.put_world(out.normal, i, n, false);
+      }
+      lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
+      out.iterations[i] = int(L.k[l]);
+    }
+
+    /// Overlapping cores below QueryLevel::penetration (no EPA): complete_from_gjk() answers collide with no
+    /// distance, no witness and no normal (its PairOutput's NaNs), which write_pair_output() maps to the world like
+    /// any point; the same operations here on the same NaNs, without the GjkResult and the out-of-line calls (a
+    /// mixed batch like the demo's ends many of its GJK pairs this way). Out of line: inlined into drive(), it cost
+    /// the loop of every other pair ~0.5% (box-cylinder witness 6720 -> 6760 instructions per pair, AVX2).
+    __attribute__((noinline)) void overlapping(const Lanes& L, int l) {
+      const LanePair& lp = lane[l];
+      const std::uint32_t i = lp.pair;
+      out.status[i] = Status::converged;
+      out.collide[i] = 1;
+      const QueryLevel level = options.level;
+      if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(quiet_nan<T>());
+      if (level >= QueryLevel::witness) {
+        const Vec3<T> none = Vec3<T>::Constant(quiet_nan<T>());
+        lp.put_world(out.witness_a, i, none, true);
+        lp.put_world(out.witness_b, i, none, true);
+        lp.put_world(out.normal, i, none, false);
+      }
+      lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
+      out.iterations[i] = int(L.k[l]);
     }
   };
 
