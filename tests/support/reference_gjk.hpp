@@ -112,11 +112,7 @@ Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, cons
   return Vec3<T>(n.x() + delta.x(), n.y() + delta.y(), n.z() + delta.z());
 }
 
-// The wide kernel's V3 arithmetic, in its association order.
-template <class T> T wdot(const Vec3<T>& a, const Vec3<T>& b) { return (a.x() * b.x() + a.y() * b.y()) + a.z() * b.z(); }
-template <class T> Vec3<T> wcross(const Vec3<T>& a, const Vec3<T>& b) {
-  return Vec3<T>(a.y() * b.z() - a.z() * b.y(), a.z() * b.x() - a.x() * b.z(), a.x() * b.y() - a.y() * b.x());
-}
+// The wide kernel's V3 arithmetic, in its association order (with kernels/math.hpp's dot3 and cross3).
 template <class T> Vec3<T> wscale(T s, const Vec3<T>& a) { return Vec3<T>(s * a.x(), s * a.y(), s * a.z()); }
 template <class T> Vec3<T> wdivide(const Vec3<T>& a, T s) { return Vec3<T>(a.x() / s, a.y() / s, a.z() / s); }
 template <class T> Vec3<T> wsub(const Vec3<T>& a, const Vec3<T>& b) {
@@ -136,37 +132,37 @@ Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, 
   const auto flat = [&](int m) { return fa ? S.v[m].a : S.v[m].b; };
   const Vec3<T> p0 = flat(0);
   const Vec3<T> y = fa ? wsub(p0, s.b) : wsub(s.a, p0);
-  const T lb = wdot(y, n);
+  const T lb = dot3(y, n);
   const Vec3<T> r = wsub(y, wscale(lb, n));
   const std::array<T, 6> h = pair_hessian(D, n);
   const bool has1 = S.count > 1 && !(flat(1) == p0);
   const bool has2 = S.count > 2 && !(flat(2) == p0) && !(flat(2) == flat(1));
   const Vec3<T> e1 = S.count > 1 ? wsub(flat(1), p0) : Vec3<T>::Zero();
   const Vec3<T> e2 = S.count > 2 ? wsub(flat(2), p0) : Vec3<T>::Zero();
-  const Vec3<T> m = wcross(e1, e2);
-  const T mm = wdot(m, m);
-  const bool is_face = has1 && has2 && mm > T(1e-12) * (wdot(e1, e1) * wdot(e2, e2));
+  const Vec3<T> m = cross3(e1, e2);
+  const T mm = dot3(m, m);
+  const bool is_face = has1 && has2 && mm > T(1e-12) * (dot3(e1, e1) * dot3(e2, e2));
   const bool is_edge = !is_face && (has1 || has2);
   Vec3<T> delta;
   if (is_face) {
     const T sq = std::sqrt(mm);
-    const Vec3<T> f = wdivide(m, wdot(m, n) < T(0) ? -sq : sq);
+    const Vec3<T> f = wdivide(m, dot3(m, n) < T(0) ? -sq : sq);
     delta = wsub(f, n);
   } else if (is_edge) {
     const Vec3<T> e = has1 ? e1 : e2;
-    const Vec3<T> c = wcross(n, e);
-    const T cn = std::sqrt(wdot(c, c));
+    const Vec3<T> c = cross3(n, e);
+    const T cn = std::sqrt(dot3(c, c));
     const Vec3<T> u = wdivide(c, cn);
-    const Vec3<T> v = wdivide(wsub(e, wscale(wdot(e, n), n)), cn);
-    const T alpha = -wdot(n, e) / cn;
+    const Vec3<T> v = wdivide(wsub(e, wscale(dot3(e, n), n)), cn);
+    const T alpha = -dot3(n, e) / cn;
     const Vec3<T> hu((h[0] * u.x() + h[3] * u.y()) + h[4] * u.z(), (h[3] * u.x() + h[1] * u.y()) + h[5] * u.z(),
                      (h[4] * u.x() + h[5] * u.y()) + h[2] * u.z());
-    const T beta = (wdot(u, y) - alpha * wdot(v, hu)) / (wdot(u, hu) + lb);
+    const T beta = (dot3(u, y) - alpha * dot3(v, hu)) / (dot3(u, hu) + lb);
     delta = wadd(wscale(alpha, v), wscale(beta, u));
   } else {
     delta = newton_solve(h, lb, r);
   }
-  step2 = wdot(delta, delta);
+  step2 = dot3(delta, delta);
   return wadd(n, delta);
 }
 
@@ -283,8 +279,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       if (flat_pair) {
         nd = feature_direction(D, S, n, s, step2);
         // The tilt towards x's offset from the line along nd (wide_gjk.inl says why).
-        const Vec3<T> t = wsub(x, wscale(wdot(x, nd) / wdot(nd, nd), nd));
-        const T tn = std::sqrt(wdot(t, t));
+        const Vec3<T> t = wsub(x, wscale(dot3(x, nd) / dot3(nd, nd), nd));
+        const T tn = std::sqrt(dot3(t, t));
         const T eps = std::sqrt((T(0.2) * tol) / norm3(s.w));
         if (tn > T(0)) nd = wadd(nd, wscale(eps / tn, t));
         shrunk = T(0.25) * newton_step2 + T(4) * (eps * eps);
