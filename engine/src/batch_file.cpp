@@ -72,31 +72,17 @@ class BatchReader {
            "required field is missing (rays without a shape need \"objects\" to be cast against)");
     }
     if (!shapes_checked_) {  // pairs came before the shapes: check their indices now
-      const std::size_t n = file_.shapes.size();
-      for (std::size_t i = 0; i < file_.pairs.size(); ++i)
-        for (const auto& [index, name] : {std::pair{file_.pairs.shape_a[i], "a"}, std::pair{file_.pairs.shape_b[i], "b"}})
-          if (index >= n) {
-            fail("/pairs/" + std::to_string(i) + "/" + name, "shape index " + std::to_string(index) +
-                                                             " is out of range (the batch has " + std::to_string(n) +
-                                                             " shapes)");
-          }
+      for (std::size_t i = 0; i < file_.pairs.size(); ++i) {
+        late_index(file_.pairs.shape_a[i], "/pairs/" + std::to_string(i) + "/a");
+        late_index(file_.pairs.shape_b[i], "/pairs/" + std::to_string(i) + "/b");
+      }
     }
-    if (!objects_checked_) {  // objects came before the shapes
-      const std::size_t n = file_.shapes.size();
+    if (!objects_checked_)  // objects came before the shapes
       for (std::size_t i = 0; i < file_.objects.size(); ++i)
-        if (file_.objects[i].shape >= n)
-          fail("/objects/" + std::to_string(i) + "/shape", "shape index " + std::to_string(file_.objects[i].shape) +
-                                                             " is out of range (the batch has " + std::to_string(n) +
-                                                             " shapes)");
-    }
-    if (!rays_checked_) {  // rays came before the shapes
-      const std::size_t n = file_.shapes.size();
+        late_index(file_.objects[i].shape, "/objects/" + std::to_string(i) + "/shape");
+    if (!rays_checked_)  // rays came before the shapes
       for (std::size_t i = 0; i < file_.rays.shape.size(); ++i)
-        if (file_.rays.shape[i] >= n)
-          fail("/rays/" + std::to_string(i) + "/shape", "shape index " + std::to_string(file_.rays.shape[i]) +
-                                                          " is out of range (the batch has " + std::to_string(n) +
-                                                          " shapes)");
-    }
+        late_index(file_.rays.shape[i], "/rays/" + std::to_string(i) + "/shape");
     if (root.contains("query")) file_.query = parse_named(root["query"], "/query", parse_query_level);
     if (root.contains("solver")) file_.solver = parse_named(root["solver"], "/solver", parse_solver);
     if (root.contains("precision")) file_.precision = parse_named(root["precision"], "/precision", parse_precision);
@@ -363,6 +349,14 @@ class BatchReader {
     const Pose pose = v.contains("pose") ? read_pose(v["pose"], p + "/pose") : Pose::identity();
     const Ray ray = read_ray_line(v, p);
     file.rays.add(shape, pose, ray.origin, ray.direction, ray.t_max);
+  }
+
+  // The range check of a shape index read before the "shapes" array had ended (shape_index() could not do it then).
+  void late_index(std::uint32_t index, const std::string& pointer) const {
+    const std::size_t n = file_.shapes.size();
+    if (index >= n)
+      fail(pointer, "shape index " + std::to_string(index) + " is out of range (the batch has " + std::to_string(n) +
+                        " shapes)");
   }
 
   [[noreturn]] void scene_ray_with_shape(std::size_t i) const {
