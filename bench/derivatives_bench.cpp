@@ -3,6 +3,7 @@
 // pairs.
 // Reports pairs per second of wall time (derivative pairs, not samples; TBB threads work outside the main
 // thread, so CPU time would miss them); compare rows of one run, the machine is shared.
+#include "derivative_pairs.hpp"
 #include "support/derivative_reference.hpp"
 
 #include <benchmark/benchmark.h>
@@ -24,7 +25,28 @@ Workload workload(ShapeType type) {
   return w;
 }
 
-// range(0): 0 ellipsoids, 1 hulls; range(1): -1 witness query only, else the DerivativeMethod; range(2): M.
+// The floor of any derivative pass: only the 120 output doubles per pair, written as the lanes write a whole block
+// (8 consecutive pairs of each SoA array in turn), on the same task ranges and threads as differentiate().
+void write_outputs_only(DerivativeResults& d) {
+  const std::size_t n = d.status.size();
+  double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
+                             d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
+                             d.witness_b_wrt_a.data.data(),     d.witness_b_wrt_b.data.data(),
+                             d.normal_wrt_a.data.data(),        d.normal_wrt_b.data.data()};
+  detail::for_pairs(0, n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t first = begin; first < end; first += 8) {
+      const std::size_t count = std::min<std::size_t>(8, end - first);
+      for (int a = 0; a < 8; ++a)
+        for (int k = 0, rows = a < 2 ? 6 : 18; k < rows; ++k) {
+          double* row = arrays[a] + k * n + first;
+          for (std::size_t j = 0; j < count; ++j) row[j] = static_cast<double>(k + j);
+        }
+    }
+  });
+}
+
+// range(0): 0 ellipsoids, 1 hulls; range(1): -1 witness query only, -2 the output write only (no query), else the
+// DerivativeMethod; range(2): M.
 void BM_Derivatives(benchmark::State& state) {
   const Workload w = workload(state.range(0) == 0 ? ShapeType::ellipsoid : ShapeType::convex);
   QueryOptions q;
@@ -34,7 +56,14 @@ void BM_Derivatives(benchmark::State& state) {
   PairResults r;
   DerivativeResults d;
   std::string label = state.range(0) == 0 ? "ellipsoids " : "hulls ";
-  if (state.range(1) < 0) {
+  if (state.range(1) == -2) {
+    label += "output write only";
+    d.resize(w.batch.size(), false);
+    for (auto _ : state) {
+      write_outputs_only(d);
+      benchmark::DoNotOptimize(d.witness_a_wrt_b.data.data());
+    }
+  } else if (state.range(1) < 0) {
     label += "witness query";
     for (auto _ : state) {
       collide(w.shapes, w.batch, q, r);
@@ -56,6 +85,7 @@ void BM_Derivatives(benchmark::State& state) {
 void rows(benchmark::internal::Benchmark* b) {
   for (int family : {0, 1}) {
     b->Args({family, -1, 1});
+    b->Args({family, -2, 1});
     b->Args({family, static_cast<int>(DerivativeMethod::analytic), 1});
     for (int method : {static_cast<int>(DerivativeMethod::smoothed0), static_cast<int>(DerivativeMethod::smoothed1)})
       for (int M : {4, 16, 64}) b->Args({family, method, M});
