@@ -7,6 +7,10 @@
 #include "support/derivative_reference.hpp"
 
 #include <benchmark/benchmark.h>
+#include <emmintrin.h>
+
+#include <algorithm>
+#include <cstdint>
 
 namespace {
 
@@ -25,9 +29,10 @@ Workload workload(ShapeType type) {
   return w;
 }
 
-// The floor of any derivative pass: only the 120 output doubles per pair, written as the lanes write a whole block
-// (8 consecutive pairs of each SoA array in turn), on the same task ranges and threads as differentiate().
-void write_outputs_only(DerivativeResults& d) {
+// The floor of any derivative pass: only the 120 output doubles per pair, a whole block of 8 consecutive pairs of
+// each SoA array in turn (one cache line per array), on the same task ranges and threads as differentiate();
+// `streamed`: with non-temporal stores, as StoreBlock::flush() writes whole blocks, else ordinary stores.
+void write_outputs_only(DerivativeResults& d, bool streamed) {
   const std::size_t n = d.status.size();
   double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
                              d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
@@ -39,13 +44,19 @@ void write_outputs_only(DerivativeResults& d) {
       for (int a = 0; a < 8; ++a)
         for (int k = 0, rows = a < 2 ? 6 : 18; k < rows; ++k) {
           double* row = arrays[a] + k * n + first;
-          for (std::size_t j = 0; j < count; ++j) row[j] = static_cast<double>(k + j);
+          if (streamed && count == 8 && reinterpret_cast<std::uintptr_t>(row) % 16 == 0) {
+            for (std::size_t j = 0; j < 8; j += 2) _mm_stream_pd(row + j, _mm_set_pd(k + j + 1.0, k + j + 0.0));
+          } else {
+            for (std::size_t j = 0; j < count; ++j) row[j] = static_cast<double>(k + j);
+          }
         }
     }
+    _mm_sfence();
   });
 }
 
-// range(0): 0 ellipsoids, 1 hulls; range(1): -1 witness query only, -2 the output write only (no query), else the
+// range(0): 0 ellipsoids, 1 hulls; range(1): -1 witness query only, -2 / -3 the output write only (no query;
+// ordinary / streamed stores), else the
 // DerivativeMethod; range(2): M.
 void BM_Derivatives(benchmark::State& state) {
   const Workload w = workload(state.range(0) == 0 ? ShapeType::ellipsoid : ShapeType::convex);
@@ -56,11 +67,12 @@ void BM_Derivatives(benchmark::State& state) {
   PairResults r;
   DerivativeResults d;
   std::string label = state.range(0) == 0 ? "ellipsoids " : "hulls ";
-  if (state.range(1) == -2) {
-    label += "output write only";
+  if (state.range(1) <= -2) {
+    const bool streamed = state.range(1) == -3;
+    label += streamed ? "output write only, streamed" : "output write only";
     d.resize(w.batch.size(), false);
     for (auto _ : state) {
-      write_outputs_only(d);
+      write_outputs_only(d, streamed);
       benchmark::DoNotOptimize(d.witness_a_wrt_b.data.data());
     }
   } else if (state.range(1) < 0) {
@@ -86,6 +98,7 @@ void rows(benchmark::internal::Benchmark* b) {
   for (int family : {0, 1}) {
     b->Args({family, -1, 1});
     b->Args({family, -2, 1});
+    b->Args({family, -3, 1});
     b->Args({family, static_cast<int>(DerivativeMethod::analytic), 1});
     for (int method : {static_cast<int>(DerivativeMethod::smoothed0), static_cast<int>(DerivativeMethod::smoothed1)})
       for (int M : {4, 16, 64}) b->Args({family, method, M});
