@@ -63,15 +63,17 @@ void StoreBlock::flush() {
     // of a block are 8 n bytes apart, for power-of-two batch sizes all in one L1 set and a few L2 sets, so
     // ordinary stores (each a read for ownership of a line evicted before the block is done) made the lanes'
     // stores the slowest part of the pass; streamed, a row goes out in one write-combined line and the caches keep
-    // what the next pairs read. Rows of a vector are 16-byte aligned (malloc); a misaligned one is copied.
-    for (int k = 0; k < kEntries; ++k) {
-      if (reinterpret_cast<std::uintptr_t>(rows[k]) % 16 == 0) {
+    // what the next pairs read. Rows of a vector are 16-byte aligned (malloc) when n and the block's first pair
+    // are even; otherwise the block is copied.
+    bool aligned = n % 2 == 0 && first_ % 2 == 0;  // then every row is aligned when the arrays are
+    for (double* array : arrays) aligned = aligned && reinterpret_cast<std::uintptr_t>(array) % 16 == 0;
+    if (aligned) {
+      for (int k = 0; k < kEntries; ++k)
         for (std::size_t j = 0; j < kStride; j += 2) _mm_stream_pd(rows[k] + j, _mm_load_pd(buf_[k] + j));
-      } else {
-        std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
-      }
+      _mm_sfence();  // the streamed lines are visible before the task ends
+    } else {
+      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
     }
-    _mm_sfence();  // the streamed lines are visible before the task ends
   } else {
     for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
   }
