@@ -31,7 +31,8 @@ Workload workload(ShapeType type) {
 
 // The floor of any derivative pass: only the 120 output doubles per pair, a whole block of 8 consecutive pairs of
 // each SoA array in turn (one cache line per array), on the same task ranges and threads as differentiate();
-// `streamed`: with non-temporal stores, as StoreBlock::flush() writes whole blocks, else ordinary stores.
+// `streamed`: with non-temporal stores (one write-combined line per row; tried for StoreBlock::flush(), branch
+// dhull-nt), else ordinary stores.
 void write_outputs_only(DerivativeResults& d, bool streamed) {
   const std::size_t n = d.status.size();
   double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),

@@ -6,11 +6,8 @@
 #include "derivative_support.hpp"
 #include "shape_table_access.hpp"
 
-#include <emmintrin.h>
-
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -52,30 +49,22 @@ void StoreBlock::flush() {
   int e = 0;
   for (int a = 0; a < 8; ++a)
     for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
-  if (smooth_.count > 0 || polytope_.count > 0) {
-    double* buffer_rows[kEntries];
-    for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
-    if (smooth_.count > 0) smooth_.solve(buffer_rows);
-    if (polytope_.count > 0) polytope_.solve(buffer_rows);
-  }
-  if (count_ == kStride) {
-    // A full block: each row is one whole cache line of its array, written with non-temporal stores. The 120 rows
-    // of a block are 8 n bytes apart, for power-of-two batch sizes all in one L1 set and a few L2 sets, so
-    // ordinary stores (each a read for ownership of a line evicted before the block is done) made the lanes'
-    // stores the slowest part of the pass; streamed, a row goes out in one write-combined line and the caches keep
-    // what the next pairs read. Rows of a vector are 16-byte aligned (malloc) when n and the block's first pair
-    // are even; otherwise the block is copied.
-    bool aligned = n % 2 == 0 && first_ % 2 == 0;  // then every row is aligned when the arrays are
-    for (double* array : arrays) aligned = aligned && reinterpret_cast<std::uintptr_t>(array) % 16 == 0;
-    if (aligned) {
-      for (int k = 0; k < kEntries; ++k)
-        for (std::size_t j = 0; j < kStride; j += 2) _mm_stream_pd(rows[k] + j, _mm_load_pd(buf_[k] + j));
-      _mm_sfence();  // the streamed lines are visible before the task ends
-    } else {
-      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
-    }
+  if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
+    smooth_.solve(rows);
+  } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
+    polytope_.solve(rows);
   } else {
-    for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
+    if (smooth_.count > 0 || polytope_.count > 0) {
+      double* buffer_rows[kEntries];
+      for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
+      if (smooth_.count > 0) smooth_.solve(buffer_rows);
+      if (polytope_.count > 0) polytope_.solve(buffer_rows);
+    }
+    if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
+      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
+    } else {
+      for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k]);
+    }
   }
   smooth_.clear();
   polytope_.clear();
