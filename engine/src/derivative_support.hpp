@@ -42,8 +42,10 @@ SupportJacobian support_jacobian(const Shape& shape, const Eigen::Vector3d& u, c
 /// exposed vertices' u.v agree to the rounding of the dot products and of n (~1e-16 r and ~1e-16 r / distance
 /// rad for GJK's witness points at distance 1e-4..1 r), while the next vertex lies lower by its distance to the
 /// feature times the angle between n and the feature's other faces, which is 1e-9 r only within a nano-radian
-/// of a face-face or edge-face contact (non-unique witness points either way). Measured on hull pairs: see
-/// exposed_support_jacobian().
+/// of a face-face or edge-face contact (non-unique witness points either way). Measured on saved batches of hulls
+/// against hulls and boxes (convex8 / 250 / 940; distant, close, overlapping): exposed vertices' gaps <= 3.7e-13 r,
+/// the next vertex's >= 2.9e-7 r (convex940), >= 2.9e-5 r (convex8). Against ellipsoids and cylinders the exposed
+/// gaps reach 2.6e-7 r (GJK's normal is not exact there): those pairs keep support_jacobian()'s witness test.
 constexpr double kExposedFeature = 1e-9;
 
 /// The feature of a hull (`count` vertices, x y z each) exposed by the local direction u: 0 a vertex, 1 an edge
