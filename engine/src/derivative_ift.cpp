@@ -55,6 +55,91 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
   add_rigid(102, n, false);
 }
 
+// Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
+// with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
+using V = double __attribute__((vector_size(16)));
+
+V load(const double* p) {
+  V v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Lanes l, l + 1 of the three rows of a lane array (a vector per lane).
+template <std::size_t N> void load3(const double (&rows)[3][N], std::size_t l, V (&v)[3]) {
+  for (int i = 0; i < 3; ++i) v[i] = load(&rows[i][l]);
+}
+
+// Writes the 120 entries of a register of lanes through put(e, value): the distance gradients by the envelope
+// theorem from n, x_a, x_b, and for each entry (i, j) of the 3x6 derivatives with respect to the twist of a, given
+// by entry(i, j, wa, wb, dn) (dx_a/dxi_a, dx_b/dxi_a, dn/dxi_a), those and the twist of b's by the rigid-motion
+// identity (write_from_twist_a()'s order and formulas).
+template <class Put, class Entry>
+void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
+  put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
+  put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
+  put(6, n[0]), put(7, n[1]), put(8, n[2]);
+  put(9, xb[1] * n[2] - xb[2] * n[1]), put(10, xb[2] * n[0] - xb[0] * n[2]), put(11, xb[0] * n[1] - xb[1] * n[0]);
+  // Unrolled: with (i, j) constants the case tests vanish and the operands stay in registers; rolled, GCC kept
+  // this a loop over stack arrays with the tests inside (~2.8x the instructions of the PolytopeLanes solve).
+#pragma GCC unroll 3
+  for (int i = 0; i < 3; ++i)
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      const int e = 6 * i + j;
+      V wa, wb, dn;
+      entry(i, j, wa, wb, dn);
+      put(12 + e, wa);  // witness_a_a
+      put(48 + e, wb);  // witness_b_a
+      put(84 + e, dn);  // normal_a
+      // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
+      if (j < 3) {
+        const double one = i == j ? 1.0 : 0.0;
+        put(30 + e, one - wa), put(66 + e, one - wb), put(102 + e, 0.0 - dn);
+      } else if (j - 3 == i) {
+        put(30 + e, 0.0 - wa), put(66 + e, 0.0 - wb), put(102 + e, 0.0 - dn);
+      } else {
+        const int k = j - 3, other = 3 - i - k;
+        // -[x]x(i, k) = eps(i, k, other) x_other
+        if ((i + 1) % 3 == k) {
+          put(30 + e, xa[other] - wa), put(66 + e, xb[other] - wb), put(102 + e, n[other] - dn);
+        } else {
+          put(30 + e, -xa[other] - wa), put(66 + e, -xb[other] - wb), put(102 + e, -n[other] - dn);
+        }
+      }
+    }
+}
+
+// Runs body(l, both, put) for every register of two lanes l, l + 1 < count (both: the second lane is used), put(e,
+// v) writing entry e of the register to out[e][column[lane]]. Compiled twice, so that the common case (a full block
+// of whole registers to consecutive columns) has a fixed trip count, whole-vector stores and no per-store test.
+template <std::size_t kLanes, class Body>
+void run_lanes(std::size_t count, const std::size_t* column, double* const* out, const Body& body) {
+  bool columns_in_order = count == kLanes;
+  for (std::size_t l = 0; l < count; ++l) columns_in_order = columns_in_order && column[l] == l;
+  const auto run = [&](auto in_order_tag) {
+    constexpr bool in_order = decltype(in_order_tag)::value;
+    const std::size_t lanes = in_order ? kLanes : count;
+    for (std::size_t l = 0; l < lanes; l += 2) {
+      const bool both = in_order || l + 1 < count;
+      // Typed stores (a vector of doubles, 8-byte aligned), not memcpy: a memcpy may alias anything, so the compiler
+      // reloaded out and l through the closure before each of the 120 stores (~300 instructions per pair).
+      using Unaligned = double __attribute__((vector_size(16), aligned(8)));
+      const auto put = [out, column, l, both](int e, V v) {
+        if (in_order && both) {
+          *reinterpret_cast<Unaligned*>(out[e] + l) = v;
+        } else {
+          out[e][column[l]] = v[0];
+          if (both) out[e][column[l + 1]] = v[1];
+        }
+      };
+      body(l, put);
+    }
+  };
+  if (columns_in_order) run(std::true_type{});
+  else run(std::false_type{});
+}
+
 }  // namespace
 
 // Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
@@ -67,27 +152,10 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
 // whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
 // per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
 void SmoothLanes::solve(double* const* out) const {
-  // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
-  // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
-  using V = double __attribute__((vector_size(16)));
-  const auto load = [](const double* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
-  bool columns_in_order = count == kLanes;
-  for (std::size_t l = 0; l < count; ++l) columns_in_order = columns_in_order && column[l] == l;
-  // Compiled twice, so that the common case (a full block of whole registers to consecutive columns) has a fixed
-  // trip count and no per-store test.
-  const auto run = [&](auto in_order_tag) {
-  constexpr bool in_order = decltype(in_order_tag)::value;
-  const std::size_t lanes = in_order ? kLanes : count;
-  for (std::size_t l = 0; l < lanes; l += 2) {
-    const bool both = in_order || l + 1 < count;
+  run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
     const V d = load(&sd[l]);
-    const V n[3] = {load(&this->n[0][l]), load(&this->n[1][l]), load(&this->n[2][l])};
-    const V xa[3] = {load(&this->xa[0][l]), load(&this->xa[1][l]), load(&this->xa[2][l])};
-    const V xb[3] = {load(&this->xb[0][l]), load(&this->xb[1][l]), load(&this->xb[2][l])};
+    V n[3], xa[3], xb[3];
+    load3(this->n, l, n), load3(this->xa, l, xa), load3(this->xb, l, xb);
     // The support-map Jacobians (world_support_jacobian()'s formula and order of operations; it is even in n).
     const auto curvature = [&](const Side& side, V (&H)[3][3]) {
       V R[3][3], B[3][3], Bn[3];
@@ -135,47 +203,97 @@ void SmoothLanes::solve(double* const* out) const {
       }
     V nY[6];
     for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    const auto put = [&](int e, V v) {
-      if (in_order && both) {
-        std::memcpy(&out[e][l], &v, sizeof v);
-      } else {
-        out[e][column[l]] = v[0];
-        if (both) out[e][column[l + 1]] = v[1];
-      }
-    };
-    put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
-    put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
-    put(6, n[0]), put(7, n[1]), put(8, n[2]);
-    put(9, xb[1] * n[2] - xb[2] * n[1]), put(10, xb[2] * n[0] - xb[0] * n[2]), put(11, xb[0] * n[1] - xb[1] * n[0]);
+    put_outputs(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
+      wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
+      wa = wb + d * Y[i][j];
+      dn = n[i] * nY[j] - Y[i][j];
+    });
+  });
+}
+
+// PolytopeLanes: polytope_jacobians()'s closed forms with their case-dependent parts in P, G and W (see the header):
+//   no flats: P = G = W = 0 (y = F / sd, both points rigid);   a has none: G = 0, W = I (dx_b = P F);
+//   b has none: G = P [n]x, W = 0;   edge A of a, edge B of b: G = B' (A x n)^T / (A . B'), W = B A'^T / (B . A')
+//   (A' = n x A, B' = n x B).
+bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
+  const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
+  const Eigen::Vector3d& nv = g.normal;
+  const std::size_t l = count;
+  const auto set = [&](double (*m)[kLanes], int i, int j, double v) { m[3 * i + j][l] = v; };
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) set(P, i, j, 0.0), set(G, i, j, 0.0), set(W, i, j, 0.0);
+  if (k == 1) {  // one edge (flats are unit and orthogonal to n): P = c c^T; G = P [n]x = c (c x n)^T for a's edge
+    const Eigen::Vector3d c = ka > 0 ? g.flat_a.col(0) : g.flat_b.col(0);
+    const Eigen::Vector3d cn = c.cross(nv);
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 6; ++j) {
-        const int e = 6 * i + j;
-        const V wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
-        const V wa = wb + d * Y[i][j];
-        const V dn = n[i] * nY[j] - Y[i][j];
-        put(12 + e, wa);  // witness_a_a
-        put(48 + e, wb);  // witness_b_a
-        put(84 + e, dn);  // normal_a
-        // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
-        if (j < 3) {
-          const double one = i == j ? 1.0 : 0.0;
-          put(30 + e, one - wa), put(66 + e, one - wb), put(102 + e, 0.0 - dn);
-        } else if (j - 3 == i) {
-          put(30 + e, 0.0 - wa), put(66 + e, 0.0 - wb), put(102 + e, 0.0 - dn);
-        } else {
-          const int k = j - 3, other = 3 - i - k;
-          // -[x]x(i, k) = eps(i, k, other) x_other
-          if ((i + 1) % 3 == k) {
-            put(30 + e, xa[other] - wa), put(66 + e, xb[other] - wb), put(102 + e, n[other] - dn);
-          } else {
-            put(30 + e, -xa[other] - wa), put(66 + e, -xb[other] - wb), put(102 + e, -n[other] - dn);
-          }
-        }
+      for (int j = 0; j < 3; ++j) {
+        set(P, i, j, c(i) * c(j));
+        if (ka > 0) set(G, i, j, c(i) * cn(j));
       }
+    if (kb > 0)
+      for (int i = 0; i < 3; ++i) set(W, i, i, 1.0);
+  } else if (k == 2) {  // two independent flats orthogonal to n span its tangent plane: P = I - n n^T
+    if (ka == 1) {  // edge A against edge B; independent when A . (n x B) = +-|A x B| is not ~0 (polytope_jacobians'
+                    // test: what is left of one unit flat after removing the other)
+      const Eigen::Vector3d A = g.flat_a.col(0), B = g.flat_b.col(0);
+      const Eigen::Vector3d B_perp = nv.cross(B), A_perp = nv.cross(A), An = A.cross(nv);
+      const double s = A.dot(B_perp);
+      if (!(std::abs(s) > 1e-6)) return false;
+      const double t = B.dot(A_perp);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) set(G, i, j, B_perp(i) * (An(j) / s)), set(W, i, j, B(i) * (A_perp(j) / t));
+    } else if (ka == 2) {  // a's face against b's vertex: G = P [n]x = [n]x (n^T [n]x = 0)
+      set(G, 0, 1, -nv.z()), set(G, 0, 2, nv.y()), set(G, 1, 0, nv.z());
+      set(G, 1, 2, -nv.x()), set(G, 2, 0, -nv.y()), set(G, 2, 1, nv.x());
+    } else {  // a's vertex against b's face
+      for (int i = 0; i < 3; ++i) set(W, i, i, 1.0);
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) set(P, i, j, (i == j ? 1.0 : 0.0) - nv(i) * nv(j));
   }
-  };
-  if (columns_in_order) run(std::true_type{});
-  else run(std::false_type{});
+  ++count;
+  column[l] = col;
+  sd[l] = g.distance;
+  for (int i = 0; i < 3; ++i) n[i][l] = nv(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+  return true;
+}
+
+void PolytopeLanes::solve(double* const* out) const {
+  run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
+    const V d = load(&sd[l]);
+    V n[3], xa[3], xb[3];
+    load3(this->n, l, n), load3(this->xa, l, xa), load3(this->xb, l, xb);
+    const V inv = 1.0 / d;
+    // Y = y and R = F - sd y = [P, -[x_a]x + (I - P) [x_a]x - sd G]; row i of M [x]x is (row i of M) x x.
+    V Y[3][6], R[3][6];
+    for (int i = 0; i < 3; ++i) {
+      V Ip[3], Gi[3];
+      for (int j = 0; j < 3; ++j) {
+        const V p = load(&P[3 * i + j][l]);
+        Ip[j] = (i == j ? 1.0 : 0.0) - p;
+        Gi[j] = load(&G[3 * i + j][l]);
+        Y[i][j] = Ip[j] * inv;
+        R[i][j] = p;
+      }
+      const V c[3] = {Ip[1] * xa[2] - Ip[2] * xa[1], Ip[2] * xa[0] - Ip[0] * xa[2], Ip[0] * xa[1] - Ip[1] * xa[0]};
+      for (int j = 0; j < 3; ++j) {
+        Y[i][3 + j] = Gi[j] - c[j] * inv;
+        R[i][3 + j] = c[j] - d * Gi[j];
+      }
+    }
+    // -[x_a]x: x_2 at (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+    R[0][4] += xa[2], R[0][5] -= xa[1], R[1][3] -= xa[2], R[1][5] += xa[0], R[2][3] += xa[1], R[2][4] -= xa[0];
+    V Wr[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) Wr[i][j] = load(&W[3 * i + j][l]);
+    V nY[6];
+    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
+    put_outputs(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
+      wb = Wr[i][0] * R[0][j] + Wr[i][1] * R[1][j] + Wr[i][2] * R[2][j];
+      wa = wb + d * Y[i][j];
+      dn = n[i] * nY[j] - Y[i][j];
+    });
+  });
 }
 
 void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,

@@ -108,6 +108,35 @@ struct SmoothLanes {
   void solve(double* const* out) const;
 };
 
+/// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two
+/// independent flats in all (vertex-vertex, vertex-edge, vertex-face, edge-edge) of a block of up to kLanes pairs,
+/// solved across the lanes as SmoothLanes solves the smooth ones. Their saddle-point system has M0 = sd I, so the
+/// solution for the twist of a (derivative_ift.cpp, polytope_jacobians()) is, with F = [I, -[x_a]x] and P the
+/// projector on the flats' span,
+///   y = [(I - P) / sd, -(I - P) [x_a]x / sd + G],   dx_b/dxi_a = W (F - sd y),   dx_a/dxi_a = dx_b/dxi_a + sd y,
+///   dn/dxi_a = -(I - n n^T) y,
+/// where only the 3x3 blocks P, G (the constraint part) and W (the part of the multipliers on b's flats) depend on
+/// the case: add() computes them per pair in scalars, solve() does the 3x6 products and the 120 outputs in lanes.
+struct PolytopeLanes {
+  static constexpr std::size_t kLanes = 8;
+  alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes];
+  alignas(64) double P[9][kLanes], G[9][kLanes], W[9][kLanes];
+  std::size_t column[kLanes];
+  std::size_t count = 0;
+  void clear() { count = 0; }
+  /// The next lane takes pair g (g.H_a = g.H_b = 0, separated beyond the singularity threshold, flats_a + flats_b
+  /// <= 2), for output column `column`. Returns false, taking no lane, when two flats are dependent (parallel
+  /// edges): the general path decides.
+  bool add(std::size_t column, const PairGeometry& g);
+  /// As SmoothLanes::solve().
+  void solve(double* const* out) const;
+};
+
+/// True when the pair can take PolytopeLanes (no curvature, separated, at most two flats).
+inline bool polytope_pair(const PairGeometry& g) {
+  return g.flats_a + g.flats_b <= 2 && g.distance > 1e-9 * g.scale && g.H_a.isZero(0.0) && g.H_b.isZero(0.0);
+}
+
 /// True when the pair takes SmoothLanes: no flats and separated beyond the singularity threshold.
 inline bool smooth_pair(const PairGeometry& g) {
   return g.flats_a + g.flats_b == 0 && g.distance > 1e-9 * g.scale;

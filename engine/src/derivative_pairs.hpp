@@ -62,6 +62,12 @@ class StoreBlock {
     slot(i);
     smooth_.add(count_ - 1, g, curved_a, curved_b);
   }
+  /// Queues pair i (polytope_pair(g)) for the block's PolytopeLanes; returns null, or pair i's slot to be written by
+  /// the caller when its flats are dependent (no lane taken).
+  double* add_polytope(std::size_t i, const PairGeometry& g) {
+    double* s = slot(i);
+    return polytope_.add(count_ - 1, g) ? nullptr : s;
+  }
   void flush();
 
   DerivativeResults& d;
@@ -69,6 +75,7 @@ class StoreBlock {
  private:
   alignas(64) double buf_[kEntries][kStride] = {};
   SmoothLanes smooth_{};  // value-initialised: an unused register half is computed (not written) on initialised numbers
+  PolytopeLanes polytope_{};
   std::size_t first_ = 0, count_ = 0;
 };
 

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
 namespace batchcol::detail {
 namespace {
@@ -140,6 +142,84 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   }
   if (r > 0.0) J.H += r * (Eigen::Matrix3d::Identity() - u * u.transpose());
   J.zero = J.zero && r == 0.0 && J.flats == 0;
+  return J;
+}
+
+int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,
+                    Eigen::Vector3d& edge) {
+  const auto vertex = [&](std::size_t k) { return Eigen::Vector3d(vertices[3 * k], vertices[3 * k + 1], vertices[3 * k + 2]); };
+  // The same expression in both passes, so that the maximum's own vertex compares equal to it; small hulls keep
+  // the heights of the first pass.
+  const auto height = [&](std::size_t k) {
+    return u.x() * vertices[3 * k] + u.y() * vertices[3 * k + 1] + u.z() * vertices[3 * k + 2];
+  };
+  constexpr std::size_t kKept = 16;
+  double kept[kKept];
+  // Two vertices per SSE2 register (vector extensions, the scalar expression's operations and order: the same
+  // bits): the 6 coordinates of vertices k, k + 1 are three unaligned pairs (x y, z x', y' z').
+  using V = double __attribute__((vector_size(16)));
+  const auto load = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const V uxy = {u.x(), u.y()}, uzx = {u.z(), u.x()}, uyz = {u.y(), u.z()};
+  V top = {-inf, -inf};
+  std::size_t k = 0;
+  for (const std::size_t paired = std::min(count, kKept) & ~std::size_t{1}; k < paired; k += 2) {
+    const double* p = vertices + 3 * k;
+    const V a = load(p) * uxy, b = load(p + 2) * uzx, c = load(p + 4) * uyz;
+    const V x = {a[0], b[1]}, y = {a[1], c[0]}, z = {b[0], c[1]};
+    const V h2 = (x + y) + z;
+    std::memcpy(&kept[k], &h2, sizeof h2);
+    top = h2 > top ? h2 : top;
+  }
+  double h = std::max(top[0], top[1]);
+  for (; k < count; ++k) {
+    const double d = height(k);
+    if (k < kKept) kept[k] = d;
+    h = std::max(h, d);
+  }
+  const double floor = h - tolerance;
+  std::size_t first = count, second = count;
+  // Returns true at a face: a third exposed vertex off the line of the first two.
+  const auto exposed = [&](std::size_t k) {
+    if (first == count) {
+      first = k;
+    } else if (second == count) {
+      second = k;
+    } else {
+      const Eigen::Vector3d e1 = vertex(second) - vertex(first), e2 = vertex(k) - vertex(first);
+      return e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm();
+    }
+    return false;
+  };
+  if (count <= kKept) {  // the kept heights (a separate loop: the compiler recomputed them in a shared one)
+    for (k = 0; k < count; ++k)
+      if (kept[k] >= floor && exposed(k)) return 2;
+  } else {
+    for (k = 0; k < count; ++k)
+      if ((k < kKept ? kept[k] : height(k)) >= floor && exposed(k)) return 2;
+  }
+  if (second == count) return 0;
+  edge = vertex(second) - vertex(first);
+  return 1;
+}
+
+SupportJacobian exposed_support_jacobian(const Shape& s, const Eigen::Vector3d& u) {
+  SupportJacobian J;
+  const std::vector<Eigen::Vector3d>& v = s.hull->vertices;
+  Eigen::Vector3d e;
+  const int feature = exposed_feature(v.front().data(), v.size(), u, kExposedFeature * s.bounding_radius(), e);
+  if (feature == 2) {
+    const Eigen::Vector3d t = u.unitOrthogonal();
+    add_flat(J, u, t, 1.0);
+    add_flat(J, u, u.cross(t), 1.0);
+  } else if (feature == 1) {
+    add_flat(J, u, e, e.norm());
+  }
+  J.zero = J.flats == 0;
   return J;
 }
 

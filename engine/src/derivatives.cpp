@@ -51,11 +51,14 @@ void StoreBlock::flush() {
     for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
   if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
     smooth_.solve(rows);
+  } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
+    polytope_.solve(rows);
   } else {
-    if (smooth_.count > 0) {
+    if (smooth_.count > 0 || polytope_.count > 0) {
       double* buffer_rows[kEntries];
       for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
-      smooth_.solve(buffer_rows);
+      if (smooth_.count > 0) smooth_.solve(buffer_rows);
+      if (polytope_.count > 0) polytope_.solve(buffer_rows);
     }
     if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
       for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k], buf_[k], sizeof buf_[k]);
@@ -64,6 +67,7 @@ void StoreBlock::flush() {
     }
   }
   smooth_.clear();
+  polytope_.clear();
   count_ = 0;
 }
 
@@ -98,9 +102,81 @@ void size_for(DerivativeResults& d, std::size_t n, bool smoothed) {
 
 namespace {
 
+// The analytic derivative of a separated pair of hulls without inflation (the polytope common case), without
+// differentiate_pair()'s general setup: no rotation matrices (the quaternions turn n into each local frame and an
+// edge back), the features from the vertices n exposes (exposed_feature()), straight into PolytopeLanes. The same
+// features, statuses and formulas as the general path; false (nothing written) for any other pair.
+bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+               StoreBlock& out) {
+  if (results.status[i] != Status::converged) return false;
+  const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
+  if (a >= shapes.size() || b >= shapes.size()) return false;
+  const auto& types = ShapeTableAccess::types(shapes);
+  const auto& inflations = ShapeTableAccess::inflations(shapes);
+  if (types[a] != ShapeType::convex || types[b] != ShapeType::convex || inflations[a] != 0.0 ||
+      inflations[b] != 0.0)
+    return false;
+  const auto& radii = ShapeTableAccess::bounding_radii(shapes);
+  PairGeometry g;
+  g.distance = results.distance[i];
+  g.scale = radii[a] + radii[b];
+  if (!(g.distance > 1e-9 * g.scale) || !std::isfinite(g.distance)) return false;  // touching, penetrating: general
+  g.witness_a = results.witness_a[i];
+  g.witness_b = results.witness_b[i];
+  g.normal = results.normal[i];
+  if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite()) return false;
+  g.H_a.setZero();
+  g.H_b.setZero();
+  const auto& hulls = ShapeTableAccess::hulls(shapes);
+  const auto side = [&](std::uint32_t s, const Eigen::Quaterniond& q, double sign, Eigen::Matrix<double, 3, 2>& flat) {
+    const Eigen::Quaterniond unit = q.normalized();
+    const Eigen::Vector3d u = sign * (unit.conjugate() * g.normal);
+    Eigen::Vector3d edge;
+    const int feature =
+        exposed_feature(hulls[s].vertices, hulls[s].vertex_count, u, kExposedFeature * radii[s], edge);
+    if (feature == 1) {
+      Eigen::Vector3d e = unit * edge;
+      const double length = e.norm();
+      e -= g.normal.dot(e) * g.normal;
+      if (e.norm() > 1e-6 * length) {  // add_flat()'s test
+        flat.col(0) = e.normalized();
+        return 1;
+      }
+      return 0;
+    }
+    return feature;  // a face's flats are only needed by the general path below (PolytopeLanes uses n)
+  };
+  g.flats_a = side(a, batch.rotation_a[i], 1.0, g.flat_a);
+  g.flats_b = side(b, batch.rotation_b[i], -1.0, g.flat_b);
+  const DerivativeStatus status =
+      g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
+  DerivativeResults& d = out.d;
+  double* slot = nullptr;
+  if (polytope_pair(g)) {
+    slot = out.add_polytope(i, g);
+    if (!slot) {
+      d.status[i] = status;
+      return true;
+    }
+  }
+  // A face's flats: the tangent plane of n (support_jacobian() projects them on it too).
+  const auto face = [&](int flats, Eigen::Matrix<double, 3, 2>& flat) {
+    if (flats != 2) return;
+    const Eigen::Vector3d t = g.normal.unitOrthogonal();
+    flat.col(0) = t;
+    flat.col(1) = g.normal.cross(t);
+  };
+  face(g.flats_a, g.flat_a);
+  face(g.flats_b, g.flat_b);
+  const IftFlags J = implicit_jacobians(g, slot ? slot : out.slot(i), StoreBlock::kStride);
+  d.status[i] = J.dependent ? DerivativeStatus::nonsmooth : J.singular ? DerivativeStatus::singular : status;
+  return true;
+}
+
 // One pair, analytic or smoothed1. The support directions are n for a and -n for b, taken to each local frame.
 void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                         const DerivativeOptions& o, std::size_t i, StoreBlock& out) {
+  if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out)) return;
   DerivativeResults& d = out.d;
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;
@@ -115,6 +191,13 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     // Spheres and ellipsoids (no features, no flats): their support-map Jacobian is left to the lanes of
     // SmoothLanes (or computed below when the other side has flats); the others go through their local frame,
     // where the features are tested.
+    const auto plain_polytope = [](const Shape& s) {
+      return s.inflation == 0.0 &&
+             (s.type == ShapeType::convex || s.type == ShapeType::box || s.type == ShapeType::triangle);
+    };
+    // Separated pairs only: GJK ends on the exact features. (EPA's normals were exact on the saved overlapping hull
+    // batches too, but EPA stops at a tolerance, and those pairs take the general solve anyway.)
+    const bool exact_normal = g.distance > 0.0 && plain_polytope(a) && plain_polytope(b);
     const auto side = [&](const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& witness,
                           const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H, int& flats,
                           Eigen::Matrix<double, 3, 2>& flat, bool& zero, bool& approximate, CurvedSide& curved) {
@@ -124,8 +207,12 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
         curved.round = s.inflation + (s.type == ShapeType::sphere ? s.size.x() : 0.0);
         return;
       }
-      const Eigen::Vector3d u = sign * (R.transpose() * g.normal), p = R.transpose() * (witness - t);
-      const SupportJacobian J = support_jacobian(s, u, p);
+      const Eigen::Vector3d u = sign * (R.transpose() * g.normal);
+      // Against a polytope, a hull's feature is the one n exposes (exposed_support_jacobian()); otherwise the
+      // witness's position decides (GJK's normal is not exact against curved shapes).
+      const SupportJacobian J = exact_normal && s.type == ShapeType::convex
+                                    ? exposed_support_jacobian(s, u)
+                                    : support_jacobian(s, u, R.transpose() * (witness - t));
       // Polytopes without inflation have no curvature: skip the two 3x3 products.
       if (J.H.isZero(0.0)) H.setZero();
       else H = R * J.H * R.transpose();
@@ -145,7 +232,7 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     } else if (zero_a || zero_b) {
       status = DerivativeStatus::zero_curvature;
     }
-    // Two polytope vertices (no curvature, no flats): polytope_jacobians' closed form, cheaper than a lane.
+    // Polytopes without inflation (no curvature) go to PolytopeLanes below.
     if (smooth_pair(g) && (curved_a.R || curved_b.R || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
       out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);
       d.status[i] = status;
@@ -161,12 +248,19 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1) * R_a.transpose();
     g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2) * R_b.transpose();
   }
-  if (smooth_pair(g)) {
+  double* slot = nullptr;
+  if (o.method == DerivativeMethod::analytic && polytope_pair(g)) {
+    slot = out.add_polytope(i, g);
+    if (!slot) {
+      d.status[i] = status;
+      return;
+    }
+  } else if (smooth_pair(g)) {
     out.add_smooth(i, g);
     d.status[i] = status;
     return;
   }
-  const IftFlags J = implicit_jacobians(g, out.slot(i), StoreBlock::kStride);
+  const IftFlags J = implicit_jacobians(g, slot ? slot : out.slot(i), StoreBlock::kStride);
   d.status[i] = J.dependent ? DerivativeStatus::nonsmooth : J.singular ? DerivativeStatus::singular : status;
 }
 

@@ -1,0 +1,113 @@
+// Analytic derivatives of hull pairs: the contact features read from the vertices the normal exposes
+// (exposed_feature()) and the polytope pairs solved in lanes (PolytopeLanes), on configurations whose features are
+// known, and bitwise determinism over thread counts on batches of hulls only (whole lane blocks).
+#include "batchcol/batchcol.hpp"
+#include "support/derivative_reference.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace batchcol::testing {
+namespace {
+
+std::vector<Eigen::Vector3d> cube_corners() {
+  std::vector<Eigen::Vector3d> p;
+  for (int k = 0; k < 8; ++k) p.emplace_back(k & 1 ? 1.0 : -1.0, k & 2 ? 1.0 : -1.0, k & 4 ? 1.0 : -1.0);
+  return p;
+}
+
+struct Case {
+  const char* what;
+  Pose b;
+  DerivativeStatus expected;
+};
+
+// Two 2 m cube hulls, a at the origin; b placed so that the closest features are known.
+TEST(DerivativesPolytope, HullFeaturesAreTheOnesTheNormalExposes) {
+  ShapeTable shapes;
+  const auto cube = shapes.add(Shape::convex(cube_corners()));
+  const double s3 = std::sqrt(3.0);
+  const Eigen::Quaterniond quarter_turn(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d(1, 1, 0).normalized()));
+  const Eigen::Quaterniond corner_first =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(-1, 0, 0));
+  const Case cases[] = {
+      // b's face x = -1 parallel to a's face x = 1: the witness points are not unique.
+      {"face-face", Pose::from_translation({3.0, 0.2, 0.1}), DerivativeStatus::nonsmooth},
+      // a's edge (1, 1, z) and b's edge (2, 2, z): parallel edges.
+      {"parallel edges", Pose::from_translation({3.0, 3.0, 0.3}), DerivativeStatus::nonsmooth},
+      // b turned a quarter about (1, 1, 0): its edge between the faces facing a, (2, 2, 0.3) + t (1, -1, 0), crosses
+      // over a's edge (1, 1, z).
+      {"crossing edges", {{3.0, 3.0, 0.3}, quarter_turn}, DerivativeStatus::smooth},
+      // b's corner (-1, -1, -1) turned to -x, at (1.5, 0.2, 0.1) over a's face x = 1.
+      {"vertex-face", {{1.5 + s3, 0.2, 0.1}, corner_first}, DerivativeStatus::zero_curvature},
+      // corner (1, 1, 1) against corner (2, 2, 2).
+      {"vertex-vertex", Pose::from_translation({3.0, 3.0, 3.0}), DerivativeStatus::zero_curvature},
+  };
+  PairBatch batch;
+  for (const Case& c : cases) batch.add(cube, Pose::identity(), cube, c.b);
+  QueryOptions q;
+  q.level = QueryLevel::witness;
+  PairResults r;
+  DerivativeResults d;
+  differentiate(shapes, batch, q, DerivativeOptions{}, r, d);
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    SCOPED_TRACE(cases[i].what);
+    ASSERT_EQ(r.status[i], Status::converged);
+    EXPECT_EQ(to_string(d.status[i]), std::string(to_string(cases[i].expected)));
+    EXPECT_TRUE(d.distance_gradient_b[i].allFinite());
+    const bool defined = cases[i].expected != DerivativeStatus::nonsmooth;
+    EXPECT_EQ(d.witness_a_wrt_b[i].allFinite(), defined);
+  }
+  // Crossing edges: b's twist moves a's witness along a's edge (z) by b's edge's motion, the point where they cross;
+  // a translation of b along z carries the crossing point with it (d witness_a_z / d v_z = 1), one along b's edge
+  // does not move it.
+  const Mat36 J = d.witness_a_wrt_b[2];
+  EXPECT_NEAR(J(2, 2), 1.0, 1e-12);
+  EXPECT_NEAR(J(2, 0) - J(2, 1), 0.0, 1e-12);  // along (1, -1, 0)
+  EXPECT_NEAR(J(0, 2), 0.0, 1e-12);           // a's witness stays on its edge (x = y = 1)
+  EXPECT_NEAR(J(1, 2), 0.0, 1e-12);
+  // Vertex-face: b's vertex is the witness on b and moves rigidly with b; a's witness slides with it on the face.
+  const Mat36 Jb = d.witness_b_wrt_b[3], Ja = d.witness_a_wrt_b[3];
+  EXPECT_NEAR(Jb(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(Ja(1, 1), 1.0, 1e-12);
+  EXPECT_NEAR(Ja(0, 0), 0.0, 1e-12);  // not off the face
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+// Hulls only: every 8-pair block is a whole block of polytope lanes, written straight to the output arrays, and the
+// task ranges split the batch differently for each thread count.
+TEST(DerivativesPolytope, HullPairsBitwiseIdenticalForAnyThreadCount) {
+  Rng rng(19);
+  ShapeTable shapes;
+  const PairBatch batch = random_separated_pairs(rng, shapes, {ShapeType::convex}, 1201);
+  DerivativeResults d[3];
+  PairResults r;
+  QueryOptions q;
+  const int threads[3] = {1, 2, 3};
+  for (int k = 0; k < 3; ++k) {
+    q.threads = threads[k];
+    differentiate(shapes, batch, q, DerivativeOptions{}, r, d[k]);
+  }
+  int defined = 0;
+  for (std::size_t i = 0; i < batch.size(); ++i) defined += d[0].status[i] != DerivativeStatus::no_witness;
+  EXPECT_GE(defined, 1150);
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_EQ(d[0].status, d[k].status);
+    EXPECT_TRUE(same_bits(d[0].distance_gradient_a.data, d[k].distance_gradient_a.data));
+    EXPECT_TRUE(same_bits(d[0].distance_gradient_b.data, d[k].distance_gradient_b.data));
+    EXPECT_TRUE(same_bits(d[0].witness_a_wrt_a.data, d[k].witness_a_wrt_a.data));
+    EXPECT_TRUE(same_bits(d[0].witness_a_wrt_b.data, d[k].witness_a_wrt_b.data));
+    EXPECT_TRUE(same_bits(d[0].witness_b_wrt_a.data, d[k].witness_b_wrt_a.data));
+    EXPECT_TRUE(same_bits(d[0].witness_b_wrt_b.data, d[k].witness_b_wrt_b.data));
+    EXPECT_TRUE(same_bits(d[0].normal_wrt_a.data, d[k].normal_wrt_a.data));
+    EXPECT_TRUE(same_bits(d[0].normal_wrt_b.data, d[k].normal_wrt_b.data));
+  }
+}
+
+}  // namespace
+}  // namespace batchcol::testing
