@@ -75,20 +75,23 @@ template <class T> struct GjkResult {
 /// Momentum steps allowed in a row without closing a tenth of the certified gap before plain GJK takes over.
 constexpr int kMaxStaleMomentumSteps = 4;
 
-/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment; box and triangle
-/// too, but see flat_newton_side()): near the optimum their witness lies inside a face or an edge (a feature)
-/// spanned by support vertices.
-constexpr bool polytope_core(ShapeType t) { return t == ShapeType::convex || t == ShapeType::capsule; }
-/// Pairs of a polytope and an ellipsoid take feature Newton directions (wide_gjk.inl's feature_direction()):
-/// 1 when A is the polytope, 2 when B is, 0 for the other pair types. Not against cylinders and cones: their caps
-/// and side lines are flat features of the curved side too, which feature_direction() does not model; there the
-/// iterations fell by only 7-13% and the instructions per pair rose (callgrind, AVX2, close witness, 4000 pairs:
-/// box-cylinder 7220 -> 8851, capsule-cylinder 5926 -> 6702, cylinder-convex8 8304 -> 9608, box-cone 5897 -> 7296).
-/// Not boxes either: box-ellipsoid went from 18.7 to 12.2 mean iterations, but the feature direction's arithmetic
-/// ate the saving (witness double 9669 -> 9317, distance 8640 -> 9214, witness float 5011 -> 5663 instructions).
-/// Triangles (like a box face) are left out with them, unmeasured.
-constexpr int flat_newton_side(ShapeType a, ShapeType b) {
-  return polytope_core(a) && b == ShapeType::ellipsoid ? 1 : polytope_core(b) && a == ShapeType::ellipsoid ? 2 : 0;
+/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment, box, triangle):
+/// near the optimum their witness lies inside a face or an edge (a feature) spanned by support vertices.
+constexpr bool flat_core(ShapeType t) {
+  return t == ShapeType::convex || t == ShapeType::capsule || t == ShapeType::box || t == ShapeType::triangle;
+}
+/// Cores curved in one direction only and ruled in the other (cylinder, cone): their support is a rim point, or
+/// jumps along a side line or around a cap's rim, where the side line or the cap is a feature as a polytope's.
+constexpr bool ruled_core(ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; }
+constexpr bool feature_core(ShapeType t) { return flat_core(t) || ruled_core(t); }
+/// Cores whose support function is curved somewhere (a non-zero Hessian).
+constexpr bool curved_core_type(ShapeType t) {
+  return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
+}
+/// Pairs that take feature Newton directions (wide_gjk.inl's feature_direction()): a curved core against a flat or
+/// ruled one (or two ruled ones).
+constexpr bool feature_pair_type(ShapeType a, ShapeType b) {
+  return (curved_core_type(a) || curved_core_type(b)) && (feature_core(a) || feature_core(b));
 }
 
 /// Pair types whose distance / witness lanes take Newton search directions (wide_gjk.inl): an ellipsoid (curved in
@@ -98,14 +101,14 @@ constexpr int flat_newton_side(ShapeType a, ShapeType b) {
 /// mostly refused and only costs its computation. Measured, instructions per pair (callgrind, AVX2, close witness):
 /// ellipsoid-ellipsoid 14572 -> 6848, cylinder-ellipsoid 12316 -> 10417, but box-ellipsoid 9764 -> 10397,
 /// cylinder-cylinder 9765 -> 11042, box-cylinder 7357 -> 8751 with every curved pair type enabled.
-/// A polytope against a curved core (flat_newton_side()) takes them too, with the residual taken from the feature of
-/// the polytope that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
+/// A flat or ruled core against a curved one (feature_pair_type()) takes them too, with the residual taken from the
+/// features that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
 constexpr bool newton_pair_type(ShapeType a, ShapeType b) {
   const auto round = [](ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::sphere || t == ShapeType::cylinder || t == ShapeType::cone;
   };
   return (a == ShapeType::ellipsoid && round(b)) || (b == ShapeType::ellipsoid && round(a)) ||
-         flat_newton_side(a, b) != 0;
+         feature_pair_type(a, b);
 }
 
 /// Newton search directions (distance / witness queries on curved cores, wide_gjk.inl): a Newton step is taken

@@ -169,46 +169,65 @@ template <class T> struct WideGjk {
   static constexpr bool curved(ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
   }
-  /// Hessian of the support function h(u) = max <p, u> of a curved core at the unit direction u (its own frame):
-  /// the Jacobian of the support map, which moves the support point along the boundary as u turns. It has u in
-  /// its null space (h is 1-homogeneous).
-  ///   ellipsoid, radii r, q = diag(r) u, g = diag(r) q / |q| (the support point): (diag(r^2) - g g^T) / |q|;
-  ///   cylinder / cone rim, radius r, rho = |u_xy|: (r / rho^3) [uy^2, -ux uy; -ux uy, ux^2] in the xy block
-  ///   (r times the projector orthogonal to the axis and to the radial direction, over rho); zero on a cone's apex
-  ///   and where rho = 0 (the support map jumps there).
+  /// Hessian of the support function h(u) = max <p, u> of a cylinder or cone at the unit direction u (its own
+  /// frame): the Jacobian of the support map, which moves the support point along the boundary as u turns. It has u
+  /// in its null space (h is 1-homogeneous). Rim of radius r, rho = |u_xy|: (r / rho^3) [uy^2, -ux uy; -ux uy, ux^2]
+  /// in the xy block (r times the projector orthogonal to the axis and to the radial direction, over rho); zero on
+  /// a cone's apex and where rho = 0 (the support map jumps there). A's side only: B's is rim_hessian(), and an
+  /// ellipsoid's is ellipsoid_hessian().
   static Sym support_hessian(const Side& s, const V3& u) {
     const real zero = splat(T(0));
     Sym h{zero, zero, zero, zero, zero, zero};
-    if (s.type == ShapeType::ellipsoid) {
-      const V3 q = {s.s0 * u.x, s.s1 * u.y, s.s2 * u.z};
-      const real m = norm(q);
-      const V3 g = {(s.s0 * q.x) / m, (s.s1 * q.y) / m, (s.s2 * q.z) / m};
-      const mask ok = m > zero;
-      h.xx = select(ok, (s.s0 * s.s0 - g.x * g.x) / m, zero);
-      h.yy = select(ok, (s.s1 * s.s1 - g.y * g.y) / m, zero);
-      h.zz = select(ok, (s.s2 * s.s2 - g.z * g.z) / m, zero);
-      h.xy = select(ok, -(g.x * g.y) / m, zero);
-      h.xz = select(ok, -(g.x * g.z) / m, zero);
-      h.yz = select(ok, -(g.y * g.z) / m, zero);
-    } else if (s.type == ShapeType::cylinder || s.type == ShapeType::cone) {
-      const real rho2 = u.x * u.x + u.y * u.y;
-      const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
-      mask ok = rho2 > zero;
-      if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
-      h.xx = select(ok, (k * u.y) * u.y, zero);
-      h.yy = select(ok, (k * u.x) * u.x, zero);
-      h.xy = select(ok, -((k * u.x) * u.y), zero);
-    }
+    const real rho2 = u.x * u.x + u.y * u.y;
+    const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
+    mask ok = rho2 > zero;
+    if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
+    h.xx = select(ok, (k * u.y) * u.y, zero);
+    h.yy = select(ok, (k * u.x) * u.x, zero);
+    h.xy = select(ok, -((k * u.x) * u.y), zero);
     return h;
   }
-  /// R h R^T (R row-major): B's Hessian in A's frame.
-  static Sym rotate(const real* R, const Sym& h) {
-    const real H[9] = {h.xx, h.xy, h.xz, h.xy, h.yy, h.yz, h.xz, h.yz, h.zz};
-    real M[9];
+  /// An ellipsoid's support Hessian in A's frame from its support point: g = the support point's offset from the
+  /// centre (A's frame), u the unit direction, M = R diag(r^2) R^T (R the ellipsoid's rotation in A's frame):
+  /// (M - g g^T) / m, m = <g, u> = |diag(r) R^T u|. The same matrix as R (diag(r^2) - g_B g_B^T) R^T / m in exact
+  /// arithmetic (g = R g_B, g_B the support point in the ellipsoid's frame), without the two 3x3 products and the
+  /// ellipsoid's own norm and divisions: the support point is already there.
+  AI static Sym ellipsoid_hessian(const Sym& M, const V3& g, const V3& u) {
+    const real zero = splat(T(0));
+    const real m = dot(g, u);
+    const mask ok = m > zero;
+    const real im = splat(T(1)) / m;
+    return {select(ok, (M.xx - g.x * g.x) * im, zero), select(ok, (M.yy - g.y * g.y) * im, zero),
+            select(ok, (M.zz - g.z * g.z) * im, zero), select(ok, (M.xy - g.x * g.y) * im, zero),
+            select(ok, (M.xz - g.x * g.z) * im, zero), select(ok, (M.yz - g.y * g.z) * im, zero)};
+  }
+  /// R diag(r^2) R^T (R row-major): an ellipsoid's metric in A's frame.
+  AI static Sym ellipsoid_metric(const Side& s, const real* R) {
+    const real q[3] = {s.s0 * s.s0, s.s1 * s.s1, s.s2 * s.s2};
+    real P[9];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) M[3 * i + j] = (R[3 * i] * H[j] + R[3 * i + 1] * H[3 + j]) + R[3 * i + 2] * H[6 + j];
-    const auto e = [&](int i, int j) { return (M[3 * i] * R[3 * j] + M[3 * i + 1] * R[3 * j + 1]) + M[3 * i + 2] * R[3 * j + 2]; };
+      for (int k = 0; k < 3; ++k) P[3 * i + k] = R[3 * i + k] * q[k];
+    const auto e = [&](int i, int j) { return (P[3 * i] * R[3 * j] + P[3 * i + 1] * R[3 * j + 1]) + P[3 * i + 2] * R[3 * j + 2]; };
     return {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
+  }
+  /// A cylinder's or cone's rim Hessian in A's frame at the unit direction n (B's side, rotation R): with the axis
+  /// a = R e_z and c = a x n (= R (e_z x R^T n), |c| = rho), support_hessian()'s (r / rho^3) [uy^2, -ux uy; ..]
+  /// rotated is (r / rho^3) c c^T: a cross product and an outer product instead of R H R^T's two 3x3 products.
+  AI static Sym rim_hessian(const Side& s, const real* R, const V3& n) {
+    const real zero = splat(T(0));
+    const V3 axis = {R[2], R[5], R[8]};
+    const V3 c = cross(axis, n);
+    const real rho2 = norm2(c);
+    const real rho = wsqrt<T>(rho2);
+    mask ok = rho2 > zero;
+    if (s.type == ShapeType::cone) {
+      const real uz = dot(axis, n);
+      ok &= ~(s.s1 * uz >= (-s.s1) * uz + s.s0 * rho);  // support()'s apex test
+    }
+    const real k = s.s0 / (rho2 * rho);
+    const V3 kc = scale(k, c);
+    return {select(ok, kc.x * c.x, zero), select(ok, kc.y * c.y, zero), select(ok, kc.z * c.z, zero),
+            select(ok, kc.x * c.y, zero), select(ok, kc.x * c.z, zero), select(ok, kc.y * c.z, zero)};
   }
 
   /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
@@ -711,21 +730,32 @@ template <class T> struct WideGjk {
   /// second-order step on the dual variable n, with the support functions' Hessians as curvature.
   /// Out of line: taken in a few iterations of some pairs; inlined, it grew drive() enough for GCC to outline
   /// support() (measured: +3% instructions on boolean ellipsoid pairs, which never take Newton steps).
-  __attribute__((noinline)) static V3 newton_direction(const Lanes& L, const V3& n, const V3& r, real lb, real& step2) {
-    const V3 delta = solve(pair_hessian(L, n), lb, r);
+  __attribute__((noinline)) static V3 newton_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
+                                                       const V3& r, real lb, real& step2) {
+    const V3 delta = solve(pair_hessian(L, n, sa, sb), lb, r);
     step2 = norm2(delta);
     return add(n, delta);
   }
-  /// H = H_A(-n) + R H_B(R^T n) R^T, the curved sides' support Hessians at the unit direction n (A's frame).
-  AI static Sym pair_hessian(const Lanes& L, const V3& n) {
+  /// H = H_A(-n) + R H_B(R^T n) R^T, the curved sides' support Hessians at the unit direction n (A's frame), from
+  /// the support points sa = s_A(-n), sb = s_B(n) (A's frame). An ellipsoid's and a B rim's are formed in A's
+  /// frame directly (ellipsoid_hessian(), rim_hessian()); A's rim is support_hessian()'s (no rotation).
+  AI static Sym pair_hessian(const Lanes& L, const V3& n, const V3& sa, const V3& sb) {
     Sym h{};
     const bool ca = curved(L.A.type), cb = curved(L.B.type);
-    if (ca) h = support_hessian(L.A, neg(n));
+    if (ca) {
+      if (L.A.type == ShapeType::ellipsoid) {
+        const real zero = splat(T(0));
+        const Sym M{L.A.s0 * L.A.s0, L.A.s1 * L.A.s1, L.A.s2 * L.A.s2, zero, zero, zero};
+        h = ellipsoid_hessian(M, sa, neg(n));
+      } else {
+        h = support_hessian(L.A, neg(n));
+      }
+    }
     if (cb) {
       const real* R = L.R;
-      const V3 n_in_b = {(R[0] * n.x + R[3] * n.y) + R[6] * n.z, (R[1] * n.x + R[4] * n.y) + R[7] * n.z,
-                         (R[2] * n.x + R[5] * n.y) + R[8] * n.z};
-      const Sym hb = rotate(R, support_hessian(L.B, n_in_b));
+      const Sym hb = L.B.type == ShapeType::ellipsoid
+                         ? ellipsoid_hessian(ellipsoid_metric(L.B, R), sub(sb, V3{L.t[0], L.t[1], L.t[2]}), n)
+                         : rim_hessian(L.B, R, n);
       if (ca) h = {h.xx + hb.xx, h.yy + hb.yy, h.zz + hb.zz, h.xy + hb.xy, h.xz + hb.xz, h.yz + hb.yz};
       else h = hb;
     }
@@ -741,48 +771,106 @@ template <class T> struct WideGjk {
             ((c02 * r.x + c12 * r.y) + c22 * r.z) / det};
   }
 
-  /// Newton's direction for a polytope against a curved core (flat_newton_side()), after the support point
-  /// (sa, sb) in direction -n. At the optimum the polytope's witness lies inside a feature F (vertex, edge or face)
-  /// whose vertices the simplex holds (their polytope points: the flat side's slots), while its support jumps
-  /// between F's vertices as n turns: the residual of the raw support point does not vanish there, so the
-  /// unknowns are n and the weights on F, y(n, t) = (p0 + E t) - s_B(n) (or s_A(-n) - (p0 + E t)), and the
-  /// equations are P y = 0 (y parallel to n) and n orthogonal to F's edges E. Linearised at n (the curved
-  /// side moves by -H delta, H its support Hessian, lb = <y, n>):
-  ///   vertex: (H + lb I) delta = P y, as newton_direction();
-  ///   edge e: delta = alpha v + beta u (v = P e / |P e|, u = n x e / |n x e|): alpha turns n orthogonal to e,
-  ///     beta = (<u, y> - alpha u^T H v) / (u^T H u + lb), the u component of the first equation (E t has none);
-  ///   face: n is the face's normal (the two constraints fix it).
-  /// The curvature of the curved side turns n across F; the simplex (GJK's own projection) settles the point
-  /// along F. step2 = |delta|^2; NaN where F is degenerate (refused by the caller's comparisons). Lanes outside
-  /// `use` (those that cannot take the step) get an unspecified direction.
-  __attribute__((noinline)) static V3 feature_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
-                                                        mask use, real& step2) {
+  /// A side's feature at the optimum, as seen from the simplex's points of that side (feature_direction()):
+  /// an edge direction `e` (where `edge`) or a face normal `m` (where `face`), and the point `p0` the residual is
+  /// taken from. Flat cores (flat_core()): the simplex's distinct points span a vertex, an edge or a face. Cylinders
+  /// and cones (ruled_core()): a side line (two simplex points on different rims, or a cone's apex and its rim)
+  /// is an edge along the line, two points of one cap's rim at least a tenth of the radius apart are the cap (a
+  /// face, normal the axis); otherwise the side is curved there (its rim Hessian) and p0 is its support point.
+  struct Feature {
+    V3 e, m, p0;
+    mask edge, face;
+  };
+  /// Side `a_side` (A or B) of the simplex; `fresh`: its support point in direction -n (A) or n (B).
+  AI static Feature side_feature(const Lanes& L, bool a_side, const V3& fresh) {
     const real zero = splat(T(0));
-    const bool fa = flat_newton_side(L.A.type, L.B.type) == 1;
+    const Side& S = a_side ? L.A : L.B;
+    const V3* v = a_side ? L.a : L.b;
     V3 p[3];
     for (int m = 0; m < 3; ++m) {
-      const V3* v = fa ? L.a : L.b;
       V3 q = v[0];
       for (int o = 1; o < 4; ++o) q = pick(L.slot[m] == splat_mask(o), v[o], q);
       p[m] = q;
     }
-    // F from the simplex's distinct polytope points (exact copies of vertices: compared bitwise).
-    const mask has1 = (L.count > splat_mask(1)) & ~equal(p[1], p[0]);
-    const mask has2 = (L.count > splat_mask(2)) & ~equal(p[2], p[0]) & ~equal(p[2], p[1]);
-    const V3 e1 = sub(p[1], p[0]), e2 = sub(p[2], p[0]);
-    const V3 m = cross(e1, e2);
-    const real mm = norm2(m);
-    const mask is_face = has1 & has2 & (mm > T(1e-12) * (norm2(e1) * norm2(e2)));
-    const mask is_edge = ~is_face & (has1 | has2);
+    const mask in1 = L.count > splat_mask(1), in2 = L.count > splat_mask(2);
+    Feature f;
+    if (flat_core(S.type)) {
+      // Exact copies of vertices: compared bitwise.
+      const mask has1 = in1 & ~equal(p[1], p[0]);
+      const mask has2 = in2 & ~equal(p[2], p[0]) & ~equal(p[2], p[1]);
+      const V3 e1 = sub(p[1], p[0]), e2 = sub(p[2], p[0]);
+      f.m = cross(e1, e2);
+      f.face = has1 & has2 & (norm2(f.m) > T(1e-12) * (norm2(e1) * norm2(e2)));
+      f.edge = ~f.face & (has1 | has2);
+      f.e = pick(has1, e1, e2);
+      f.p0 = p[0];
+      return f;
+    }
+    // Cylinder or cone: axial coordinates of the points (A's axis is e_z at the origin, B's is R e_z at t).
+    const real* R = L.R;
+    const V3 axis = a_side ? V3{zero, zero, splat(T(1))} : V3{R[2], R[5], R[8]};
+    const V3 c = a_side ? V3{zero, zero, zero} : V3{L.t[0], L.t[1], L.t[2]};
+    mask up[3];
+    for (int m = 0; m < 3; ++m) up[m] = dot(sub(p[m], c), axis) > zero;  // top rim / apex
+    const real far2 = (T(0.01) * S.s0) * S.s0;  // (r / 10)^2
+    const auto split = [&](int i, int j) { return up[i] ^ up[j]; };
+    const auto cap = [&](int i, int j) {
+      return ~(up[i] ^ up[j]) & (norm2(sub(p[j], p[i])) > far2) & (S.type == ShapeType::cone ? ~up[i] : splat_mask(-1));
+    };
+    const mask s01 = in1 & split(0, 1), s02 = in2 & split(0, 2), s12 = in2 & split(1, 2);
+    f.edge = s01 | s02 | s12;
+    f.face = ~f.edge & ((in1 & cap(0, 1)) | (in2 & (cap(0, 2) | cap(1, 2))));
+    if (S.type == ShapeType::cylinder) {
+      f.e = axis;
+    } else {  // the generator from the apex to the rim point
+      const V3 e01 = sub(p[1], p[0]), e02 = sub(p[2], p[0]), e12 = sub(p[2], p[1]);
+      f.e = pick(s01, e01, pick(s02, e02, e12));
+    }
+    f.m = axis;
+    f.p0 = fresh;
+    return f;
+  }
+
+  /// Newton's direction for a pair with a flat or ruled side (feature_pair_type()), after the support point
+  /// (sa, sb) in direction -n. At the optimum a flat side's witness lies inside a feature F (vertex, edge or face)
+  /// whose vertices the simplex holds (that side's points of its slots), while its support jumps between F's
+  /// vertices as n turns; a cylinder's or cone's support jumps likewise between the ends of a side line or around
+  /// a cap's rim (side_feature()). The residual of the raw support point does not vanish there, so the unknowns
+  /// are n and the weights on the features, y(n, t) = (p_A + E_A t_A) - (p_B + E_B t_B), and the equations are
+  /// P y = 0 (y parallel to n) and n orthogonal to the features' edges. Linearised at n (a curved part moves by
+  /// -H delta, H the pair's support Hessian, lb = <y, n>):
+  ///   no edge: (H + lb I) delta = P y, as newton_direction();
+  ///   one edge direction e: delta = alpha v + beta u (v = P e / |P e|, u = n x e / |n x e|): alpha turns n
+  ///     orthogonal to e, beta = (<u, y> - alpha u^T H v) / (u^T H u + lb), the u component of the first equation;
+  ///   a face, or two independent edges (one per side): n is their normal (the two constraints fix it).
+  /// The curvature turns n across the features; the simplex (GJK's own projection) settles the point along them.
+  /// step2 = |delta|^2; NaN where a feature is degenerate (refused by the caller's comparisons). Lanes outside
+  /// `use` (those that cannot take the step) get an unspecified direction.
+  __attribute__((noinline)) static V3 feature_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
+                                                        mask use, real& step2) {
+    const real zero = splat(T(0));
+    const mask none = splat_mask(0);
+    const bool fa = feature_core(L.A.type), fb = feature_core(L.B.type);
+    Feature A{}, B{};
+    if (fa) A = side_feature(L, true, sa);
+    else A.p0 = sa, A.edge = none, A.face = none;
+    if (fb) B = side_feature(L, false, sb);
+    else B.p0 = sb, B.edge = none, B.face = none;
+    // Two edges, one per side: the face of D they span, unless parallel.
+    const V3 eab = cross(A.e, B.e);
+    const mask two = A.edge & B.edge & (norm2(eab) > T(1e-12) * (norm2(A.e) * norm2(B.e)));
+    const mask is_face = A.face | B.face | two;
+    const V3 fm = pick(A.face, A.m, pick(B.face, B.m, eab));
+    const mask is_edge = ~is_face & (A.edge | B.edge);
     // Only the branches the lanes in `use` need (the others' results are not read): a face needs no curvature.
     V3 delta = {zero, zero, zero};
     if (any(use & ~is_face)) {
-      const V3 y = fa ? sub(p[0], sb) : sub(sa, p[0]);
+      const V3 y = sub(A.p0, B.p0);
       const real lb = dot(y, n);
-      const Sym h = pair_hessian(L, n);
+      const Sym h = pair_hessian(L, n, sa, sb);
       if (any(use & ~is_face & ~is_edge)) delta = solve(h, lb, sub(y, scale(lb, n)));  // vertex
       if (any(use & is_edge)) {
-        const V3 e = pick(has1, e1, e2);
+        const V3 e = pick(A.edge, A.e, B.e);
         const V3 c = cross(n, e);
         const real cn = norm(c);  // |P e|
         const V3 u = divide(c, cn);
@@ -795,8 +883,8 @@ template <class T> struct WideGjk {
       }
     }
     if (any(use & is_face)) {
-      const real s = wsqrt<T>(mm);
-      const V3 f = divide(m, select(dot(m, n) < zero, -s, s));
+      const real s = norm(fm);
+      const V3 f = divide(fm, select(dot(fm, n) < zero, -s, s));
       delta = pick(is_face, sub(f, n), delta);
     }
     step2 = norm2(delta);
@@ -858,7 +946,7 @@ template <class T> struct WideGjk {
     const bool points = !Boolean && points_;
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
-    const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
+    const bool flat_run = !Boolean && feature_pair_type(L.A.type, L.B.type);  // feature_direction()
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -1034,7 +1122,7 @@ template <class T> struct WideGjk {
             shrunk = T(0.25) * L.newton_step2 + T(4) * (eps * eps);  // the tilt is no step of Newton's
           } else {
             const V3 r = sub(sw, scale(lb, n));
-            nd = newton_direction(L, n, r, lb, step2);
+            nd = newton_direction(L, n, sa, sb, r, lb, step2);
             shrunk = T(0.25) * L.newton_step2;
           }
           const mask valid = lb > zero;
