@@ -75,23 +75,28 @@ template <class T> struct GjkResult {
 /// Momentum steps allowed in a row without closing a tenth of the certified gap before plain GJK takes over.
 constexpr int kMaxStaleMomentumSteps = 4;
 
-/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment, box, triangle):
-/// near the optimum their witness lies inside a face or an edge (a feature) spanned by support vertices.
-constexpr bool flat_core(ShapeType t) {
-  return t == ShapeType::convex || t == ShapeType::capsule || t == ShapeType::box || t == ShapeType::triangle;
+/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment, box; triangle
+/// too, but see flat_newton_side()): near the optimum their witness lies inside a face or an edge (a feature)
+/// spanned by support vertices.
+constexpr bool polytope_core(ShapeType t) {
+  return t == ShapeType::convex || t == ShapeType::capsule || t == ShapeType::box;
 }
-/// Cores curved in one direction only and ruled in the other (cylinder, cone): their support is a rim point, or
-/// jumps along a side line or around a cap's rim, where the side line or the cap is a feature as a polytope's.
-constexpr bool ruled_core(ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; }
-constexpr bool feature_core(ShapeType t) { return flat_core(t) || ruled_core(t); }
-/// Cores whose support function is curved somewhere (a non-zero Hessian).
-constexpr bool curved_core_type(ShapeType t) {
-  return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
-}
-/// Pairs that take feature Newton directions (wide_gjk.inl's feature_direction()): a curved core against a flat or
-/// ruled one (or two ruled ones).
-constexpr bool feature_pair_type(ShapeType a, ShapeType b) {
-  return (curved_core_type(a) || curved_core_type(b)) && (feature_core(a) || feature_core(b));
+/// Pairs of a polytope and an ellipsoid take feature Newton directions (wide_gjk.inl's feature_direction()):
+/// 1 when A is the polytope, 2 when B is, 0 for the other pair types.
+/// Boxes joined once pair_hessian() formed the ellipsoid's Hessian from its support point (no R H R^T): box-ellipsoid
+/// 18.7 -> 12.2 mean iterations and 8743 -> 8232 instructions per pair (callgrind, AVX2, close witness double);
+/// before, the step's arithmetic ate the saving (9669 -> 9317 ... +7%).
+/// Not against cylinders and cones, although their side lines and caps were tried as features as well (a side
+/// line as an edge along the axis or the generator, a cap as a face; branch `flat`, commit 58e3fc2): the iterations
+/// fell (box-cylinder 13.6 -> 11.5, capsule-cylinder 9.6 -> 7.2, cylinder-cylinder 18.8 -> 15.4, cylinder-convex8
+/// 14.6 -> 11.9, box-cone 10.8 -> 10.4, cone-cone 15.8 -> 15.8), but not enough to pay for the step (instructions
+/// per pair: box-cylinder 6437 -> 7776, capsule-cylinder 4899 -> 5062, cylinder-cylinder 8709 -> 10434,
+/// cylinder-cone 8203 -> 10792, box-cone 5179 -> 7026, cone-cone 7392 -> 10833, capsule-cone 3739 -> 4718), and
+/// cylinder-ellipsoid / cone-ellipsoid took more iterations than with newton_direction() (15.0 -> 17.1,
+/// 15.4 -> 19.3). (A cone's generator has its rim's curvature scaled by the distance from the apex, which the rim
+/// Hessian does not model: likely why cone rows gained least.) Triangles are left out, unmeasured.
+constexpr int flat_newton_side(ShapeType a, ShapeType b) {
+  return polytope_core(a) && b == ShapeType::ellipsoid ? 1 : polytope_core(b) && a == ShapeType::ellipsoid ? 2 : 0;
 }
 
 /// Pair types whose distance / witness lanes take Newton search directions (wide_gjk.inl): an ellipsoid (curved in
@@ -101,14 +106,14 @@ constexpr bool feature_pair_type(ShapeType a, ShapeType b) {
 /// mostly refused and only costs its computation. Measured, instructions per pair (callgrind, AVX2, close witness):
 /// ellipsoid-ellipsoid 14572 -> 6848, cylinder-ellipsoid 12316 -> 10417, but box-ellipsoid 9764 -> 10397,
 /// cylinder-cylinder 9765 -> 11042, box-cylinder 7357 -> 8751 with every curved pair type enabled.
-/// A flat or ruled core against a curved one (feature_pair_type()) takes them too, with the residual taken from the
-/// features that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
+/// A polytope against a curved core (flat_newton_side()) takes them too, with the residual taken from the feature of
+/// the polytope that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
 constexpr bool newton_pair_type(ShapeType a, ShapeType b) {
   const auto round = [](ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::sphere || t == ShapeType::cylinder || t == ShapeType::cone;
   };
   return (a == ShapeType::ellipsoid && round(b)) || (b == ShapeType::ellipsoid && round(a)) ||
-         feature_pair_type(a, b);
+         flat_newton_side(a, b) != 0;
 }
 
 /// Newton search directions (distance / witness queries on curved cores, wide_gjk.inl): a Newton step is taken

@@ -771,106 +771,48 @@ template <class T> struct WideGjk {
             ((c02 * r.x + c12 * r.y) + c22 * r.z) / det};
   }
 
-  /// A side's feature at the optimum, as seen from the simplex's points of that side (feature_direction()):
-  /// an edge direction `e` (where `edge`) or a face normal `m` (where `face`), and the point `p0` the residual is
-  /// taken from. Flat cores (flat_core()): the simplex's distinct points span a vertex, an edge or a face. Cylinders
-  /// and cones (ruled_core()): a side line (two simplex points on different rims, or a cone's apex and its rim)
-  /// is an edge along the line, two points of one cap's rim at least a tenth of the radius apart are the cap (a
-  /// face, normal the axis); otherwise the side is curved there (its rim Hessian) and p0 is its support point.
-  struct Feature {
-    V3 e, m, p0;
-    mask edge, face;
-  };
-  /// Side `a_side` (A or B) of the simplex; `fresh`: its support point in direction -n (A) or n (B).
-  AI static Feature side_feature(const Lanes& L, bool a_side, const V3& fresh) {
-    const real zero = splat(T(0));
-    const Side& S = a_side ? L.A : L.B;
-    const V3* v = a_side ? L.a : L.b;
-    V3 p[3];
-    for (int m = 0; m < 3; ++m) {
-      V3 q = v[0];
-      for (int o = 1; o < 4; ++o) q = pick(L.slot[m] == splat_mask(o), v[o], q);
-      p[m] = q;
-    }
-    const mask in1 = L.count > splat_mask(1), in2 = L.count > splat_mask(2);
-    Feature f;
-    if (flat_core(S.type)) {
-      // Exact copies of vertices: compared bitwise.
-      const mask has1 = in1 & ~equal(p[1], p[0]);
-      const mask has2 = in2 & ~equal(p[2], p[0]) & ~equal(p[2], p[1]);
-      const V3 e1 = sub(p[1], p[0]), e2 = sub(p[2], p[0]);
-      f.m = cross(e1, e2);
-      f.face = has1 & has2 & (norm2(f.m) > T(1e-12) * (norm2(e1) * norm2(e2)));
-      f.edge = ~f.face & (has1 | has2);
-      f.e = pick(has1, e1, e2);
-      f.p0 = p[0];
-      return f;
-    }
-    // Cylinder or cone: axial coordinates of the points (A's axis is e_z at the origin, B's is R e_z at t).
-    const real* R = L.R;
-    const V3 axis = a_side ? V3{zero, zero, splat(T(1))} : V3{R[2], R[5], R[8]};
-    const V3 c = a_side ? V3{zero, zero, zero} : V3{L.t[0], L.t[1], L.t[2]};
-    mask up[3];
-    for (int m = 0; m < 3; ++m) up[m] = dot(sub(p[m], c), axis) > zero;  // top rim / apex
-    const real far2 = (T(0.01) * S.s0) * S.s0;  // (r / 10)^2
-    const auto split = [&](int i, int j) { return up[i] ^ up[j]; };
-    const auto cap = [&](int i, int j) {
-      return ~(up[i] ^ up[j]) & (norm2(sub(p[j], p[i])) > far2) & (S.type == ShapeType::cone ? ~up[i] : splat_mask(-1));
-    };
-    const mask s01 = in1 & split(0, 1), s02 = in2 & split(0, 2), s12 = in2 & split(1, 2);
-    f.edge = s01 | s02 | s12;
-    f.face = ~f.edge & ((in1 & cap(0, 1)) | (in2 & (cap(0, 2) | cap(1, 2))));
-    if (S.type == ShapeType::cylinder) {
-      f.e = axis;
-    } else {  // the generator from the apex to the rim point
-      const V3 e01 = sub(p[1], p[0]), e02 = sub(p[2], p[0]), e12 = sub(p[2], p[1]);
-      f.e = pick(s01, e01, pick(s02, e02, e12));
-    }
-    f.m = axis;
-    f.p0 = fresh;
-    return f;
-  }
-
-  /// Newton's direction for a pair with a flat or ruled side (feature_pair_type()), after the support point
-  /// (sa, sb) in direction -n. At the optimum a flat side's witness lies inside a feature F (vertex, edge or face)
-  /// whose vertices the simplex holds (that side's points of its slots), while its support jumps between F's
-  /// vertices as n turns; a cylinder's or cone's support jumps likewise between the ends of a side line or around
-  /// a cap's rim (side_feature()). The residual of the raw support point does not vanish there, so the unknowns
-  /// are n and the weights on the features, y(n, t) = (p_A + E_A t_A) - (p_B + E_B t_B), and the equations are
-  /// P y = 0 (y parallel to n) and n orthogonal to the features' edges. Linearised at n (a curved part moves by
-  /// -H delta, H the pair's support Hessian, lb = <y, n>):
-  ///   no edge: (H + lb I) delta = P y, as newton_direction();
-  ///   one edge direction e: delta = alpha v + beta u (v = P e / |P e|, u = n x e / |n x e|): alpha turns n
-  ///     orthogonal to e, beta = (<u, y> - alpha u^T H v) / (u^T H u + lb), the u component of the first equation;
-  ///   a face, or two independent edges (one per side): n is their normal (the two constraints fix it).
-  /// The curvature turns n across the features; the simplex (GJK's own projection) settles the point along them.
-  /// step2 = |delta|^2; NaN where a feature is degenerate (refused by the caller's comparisons). Lanes outside
+  /// Newton's direction for a polytope against a curved core (flat_newton_side()), after the support point
+  /// (sa, sb) in direction -n. At the optimum the polytope's witness lies inside a feature F (vertex, edge or face)
+  /// whose vertices the simplex holds (their polytope points: the flat side's slots), while its support jumps
+  /// between F's vertices as n turns: the residual of the raw support point does not vanish there, so the
+  /// unknowns are n and the weights on F, y(n, t) = (p0 + E t) - s_B(n) (or s_A(-n) - (p0 + E t)), and the
+  /// equations are P y = 0 (y parallel to n) and n orthogonal to F's edges E. Linearised at n (the curved
+  /// side moves by -H delta, H its support Hessian, lb = <y, n>):
+  ///   vertex: (H + lb I) delta = P y, as newton_direction();
+  ///   edge e: delta = alpha v + beta u (v = P e / |P e|, u = n x e / |n x e|): alpha turns n orthogonal to e,
+  ///     beta = (<u, y> - alpha u^T H v) / (u^T H u + lb), the u component of the first equation (E t has none);
+  ///   face: n is the face's normal (the two constraints fix it).
+  /// The curvature of the curved side turns n across F; the simplex (GJK's own projection) settles the point
+  /// along F. step2 = |delta|^2; NaN where F is degenerate (refused by the caller's comparisons). Lanes outside
   /// `use` (those that cannot take the step) get an unspecified direction.
   __attribute__((noinline)) static V3 feature_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
                                                         mask use, real& step2) {
     const real zero = splat(T(0));
-    const mask none = splat_mask(0);
-    const bool fa = feature_core(L.A.type), fb = feature_core(L.B.type);
-    Feature A{}, B{};
-    if (fa) A = side_feature(L, true, sa);
-    else A.p0 = sa, A.edge = none, A.face = none;
-    if (fb) B = side_feature(L, false, sb);
-    else B.p0 = sb, B.edge = none, B.face = none;
-    // Two edges, one per side: the face of D they span, unless parallel.
-    const V3 eab = cross(A.e, B.e);
-    const mask two = A.edge & B.edge & (norm2(eab) > T(1e-12) * (norm2(A.e) * norm2(B.e)));
-    const mask is_face = A.face | B.face | two;
-    const V3 fm = pick(A.face, A.m, pick(B.face, B.m, eab));
-    const mask is_edge = ~is_face & (A.edge | B.edge);
+    const bool fa = flat_newton_side(L.A.type, L.B.type) == 1;
+    V3 p[3];
+    for (int m = 0; m < 3; ++m) {
+      const V3* v = fa ? L.a : L.b;
+      V3 q = v[0];
+      for (int o = 1; o < 4; ++o) q = pick(L.slot[m] == splat_mask(o), v[o], q);
+      p[m] = q;
+    }
+    // F from the simplex's distinct polytope points (exact copies of vertices: compared bitwise).
+    const mask has1 = (L.count > splat_mask(1)) & ~equal(p[1], p[0]);
+    const mask has2 = (L.count > splat_mask(2)) & ~equal(p[2], p[0]) & ~equal(p[2], p[1]);
+    const V3 e1 = sub(p[1], p[0]), e2 = sub(p[2], p[0]);
+    const V3 m = cross(e1, e2);
+    const real mm = norm2(m);
+    const mask is_face = has1 & has2 & (mm > T(1e-12) * (norm2(e1) * norm2(e2)));
+    const mask is_edge = ~is_face & (has1 | has2);
     // Only the branches the lanes in `use` need (the others' results are not read): a face needs no curvature.
     V3 delta = {zero, zero, zero};
     if (any(use & ~is_face)) {
-      const V3 y = sub(A.p0, B.p0);
+      const V3 y = fa ? sub(p[0], sb) : sub(sa, p[0]);
       const real lb = dot(y, n);
       const Sym h = pair_hessian(L, n, sa, sb);
       if (any(use & ~is_face & ~is_edge)) delta = solve(h, lb, sub(y, scale(lb, n)));  // vertex
       if (any(use & is_edge)) {
-        const V3 e = pick(A.edge, A.e, B.e);
+        const V3 e = pick(has1, e1, e2);
         const V3 c = cross(n, e);
         const real cn = norm(c);  // |P e|
         const V3 u = divide(c, cn);
@@ -883,8 +825,8 @@ template <class T> struct WideGjk {
       }
     }
     if (any(use & is_face)) {
-      const real s = norm(fm);
-      const V3 f = divide(fm, select(dot(fm, n) < zero, -s, s));
+      const real s = wsqrt<T>(mm);
+      const V3 f = divide(m, select(dot(m, n) < zero, -s, s));
       delta = pick(is_face, sub(f, n), delta);
     }
     step2 = norm2(delta);
@@ -946,7 +888,7 @@ template <class T> struct WideGjk {
     const bool points = !Boolean && points_;
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
-    const bool flat_run = !Boolean && feature_pair_type(L.A.type, L.B.type);  // feature_direction()
+    const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);

@@ -153,92 +153,45 @@ Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, cons
   return Vec3<T>(n.x() + delta.x(), n.y() + delta.y(), n.z() + delta.z());
 }
 
-/// A side's feature as the simplex sees it: wide_gjk.inl's side_feature(), where the rules are. fresh: the side's
-/// support point in direction -n (A) or n (B).
-template <class T> struct Feature {
-  Vec3<T> e = Vec3<T>::Zero(), m = Vec3<T>::Zero(), p0 = Vec3<T>::Zero();
-  bool edge = false, face = false;
-};
-template <class T>
-Feature<T> side_feature(const MinkowskiDifference<T>& D, const Simplex<T>& S, bool a_side, const Vec3<T>& fresh) {
-  const ShapeCore<T>& core = a_side ? *D.A : *D.B;
-  const auto at = [&](int m) { return a_side ? S.v[m].a : S.v[m].b; };
-  Feature<T> f;
-  if (flat_core(core.type)) {
-    const Vec3<T> p0 = at(0);
-    const bool has1 = S.count > 1 && !(at(1) == p0);
-    const bool has2 = S.count > 2 && !(at(2) == p0) && !(at(2) == at(1));
-    const Vec3<T> e1 = S.count > 1 ? wsub(at(1), p0) : Vec3<T>::Zero();
-    const Vec3<T> e2 = S.count > 2 ? wsub(at(2), p0) : Vec3<T>::Zero();
-    f.m = cross3(e1, e2);
-    f.face = has1 && has2 && dot3(f.m, f.m) > T(1e-12) * (dot3(e1, e1) * dot3(e2, e2));
-    f.edge = !f.face && (has1 || has2);
-    f.e = has1 ? e1 : e2;
-    f.p0 = p0;
-    return f;
-  }
-  const auto& R = D.b_in_a.R;
-  const Vec3<T> axis = a_side ? Vec3<T>(T(0), T(0), T(1)) : Vec3<T>(R(0, 2), R(1, 2), R(2, 2));
-  const Vec3<T> c = a_side ? Vec3<T>::Zero() : D.b_in_a.t;
-  bool up[3] = {false, false, false};
-  for (int m = 0; m < S.count && m < 3; ++m) up[m] = dot3(wsub(at(m), c), axis) > T(0);
-  const T far2 = (T(0.01) * core.size.x()) * core.size.x();
-  const auto cap = [&](int i, int j) {
-    return up[i] == up[j] && dot3(wsub(at(j), at(i)), wsub(at(j), at(i))) > far2 &&
-           (core.type != ShapeType::cone || !up[i]);
-  };
-  const bool s01 = S.count > 1 && up[0] != up[1], s02 = S.count > 2 && up[0] != up[2],
-             s12 = S.count > 2 && up[1] != up[2];
-  f.edge = s01 || s02 || s12;
-  f.face = !f.edge && ((S.count > 1 && cap(0, 1)) || (S.count > 2 && (cap(0, 2) || cap(1, 2))));
-  if (core.type == ShapeType::cylinder) f.e = axis;
-  else if (s01) f.e = wsub(at(1), at(0));
-  else if (s02) f.e = wsub(at(2), at(0));
-  else if (S.count > 2) f.e = wsub(at(2), at(1));
-  f.m = axis;
-  f.p0 = fresh;
-  return f;
-}
-
-/// Newton's direction for a pair with a flat or ruled side (feature_pair_type()): wide_gjk.inl's
+/// Newton's direction for a polytope against a curved core (flat_newton_side()): wide_gjk.inl's
 /// feature_direction(), where the derivation is. S: the simplex after this iteration's projection; s: the support
 /// point in direction -n.
 template <class T>
 Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, const Vec3<T>& n,
                           const SupportPoint<T>& s, T& step2) {
-  Feature<T> A, B;
-  if (feature_core(D.A->type)) A = side_feature(D, S, true, s.a);
-  else A.p0 = s.a;
-  if (feature_core(D.B->type)) B = side_feature(D, S, false, s.b);
-  else B.p0 = s.b;
-  const Vec3<T> eab = cross3(A.e, B.e);
-  const bool two = A.edge && B.edge && dot3(eab, eab) > T(1e-12) * (dot3(A.e, A.e) * dot3(B.e, B.e));
-  const bool is_face = A.face || B.face || two;
-  const Vec3<T> fm = A.face ? A.m : B.face ? B.m : eab;
-  const bool is_edge = !is_face && (A.edge || B.edge);
+  const bool fa = flat_newton_side(D.A->type, D.B->type) == 1;
+  const auto flat = [&](int m) { return fa ? S.v[m].a : S.v[m].b; };
+  const Vec3<T> p0 = flat(0);
+  const Vec3<T> y = fa ? wsub(p0, s.b) : wsub(s.a, p0);
+  const T lb = dot3(y, n);
+  const Vec3<T> r = wsub(y, wscale(lb, n));
+  const std::array<T, 6> h = pair_hessian(D, n, s);
+  const bool has1 = S.count > 1 && !(flat(1) == p0);
+  const bool has2 = S.count > 2 && !(flat(2) == p0) && !(flat(2) == flat(1));
+  const Vec3<T> e1 = S.count > 1 ? wsub(flat(1), p0) : Vec3<T>::Zero();
+  const Vec3<T> e2 = S.count > 2 ? wsub(flat(2), p0) : Vec3<T>::Zero();
+  const Vec3<T> m = cross3(e1, e2);
+  const T mm = dot3(m, m);
+  const bool is_face = has1 && has2 && mm > T(1e-12) * (dot3(e1, e1) * dot3(e2, e2));
+  const bool is_edge = !is_face && (has1 || has2);
   Vec3<T> delta;
   if (is_face) {
-    const T sq = std::sqrt(dot3(fm, fm));
-    const Vec3<T> f = wdivide(fm, dot3(fm, n) < T(0) ? -sq : sq);
+    const T sq = std::sqrt(mm);
+    const Vec3<T> f = wdivide(m, dot3(m, n) < T(0) ? -sq : sq);
     delta = wsub(f, n);
+  } else if (is_edge) {
+    const Vec3<T> e = has1 ? e1 : e2;
+    const Vec3<T> c = cross3(n, e);
+    const T cn = std::sqrt(dot3(c, c));
+    const Vec3<T> u = wdivide(c, cn);
+    const Vec3<T> v = wdivide(wsub(e, wscale(dot3(e, n), n)), cn);
+    const T alpha = -dot3(n, e) / cn;
+    const Vec3<T> hu((h[0] * u.x() + h[3] * u.y()) + h[4] * u.z(), (h[3] * u.x() + h[1] * u.y()) + h[5] * u.z(),
+                     (h[4] * u.x() + h[5] * u.y()) + h[2] * u.z());
+    const T beta = (dot3(u, y) - alpha * dot3(v, hu)) / (dot3(u, hu) + lb);
+    delta = wadd(wscale(alpha, v), wscale(beta, u));
   } else {
-    const Vec3<T> y = wsub(A.p0, B.p0);
-    const T lb = dot3(y, n);
-    const std::array<T, 6> h = pair_hessian(D, n, s);
-    if (is_edge) {
-      const Vec3<T> e = A.edge ? A.e : B.e;
-      const Vec3<T> c = cross3(n, e);
-      const T cn = std::sqrt(dot3(c, c));
-      const Vec3<T> u = wdivide(c, cn);
-      const Vec3<T> v = wdivide(wsub(e, wscale(dot3(e, n), n)), cn);
-      const T alpha = -dot3(n, e) / cn;
-      const Vec3<T> hu((h[0] * u.x() + h[3] * u.y()) + h[4] * u.z(), (h[3] * u.x() + h[1] * u.y()) + h[5] * u.z(),
-                       (h[4] * u.x() + h[5] * u.y()) + h[2] * u.z());
-      const T beta = (dot3(u, y) - alpha * dot3(v, hu)) / (dot3(u, hu) + lb);
-      delta = wadd(wscale(alpha, v), wscale(beta, u));
-    } else {
-      delta = newton_solve(h, lb, wsub(y, wscale(lb, n)));
-    }
+    delta = newton_solve(h, lb, r);
   }
   step2 = dot3(delta, delta);
   return wadd(n, delta);
@@ -264,7 +217,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   bool newton_next = false;
   Vec3<T> newton_dir = Vec3<T>::Zero();
   T newton_step2 = T(0);  // |delta|^2 of the step that chose newton_dir
-  const bool flat_pair = feature_pair_type(D.A->type, D.B->type);  // feature_direction()
+  const bool flat_pair = flat_newton_side(D.A->type, D.B->type) != 0;  // feature_direction()
   T newton_gap = T(0);    // flat pairs: the certified gap when the last Newton choice was made
 
   for (int k = 0; k < params.max_iterations; ++k) {
