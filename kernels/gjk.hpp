@@ -75,17 +75,19 @@ template <class T> struct GjkResult {
 /// Momentum steps allowed in a row without closing a tenth of the certified gap before plain GJK takes over.
 constexpr int kMaxStaleMomentumSteps = 4;
 
-/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment, box; triangle
+/// Cores whose support map is piecewise constant with more than one piece (hull, capsule segment; box and triangle
 /// too, but see flat_newton_side()): near the optimum their witness lies inside a face or an edge (a feature)
 /// spanned by support vertices.
-constexpr bool polytope_core(ShapeType t) {
-  return t == ShapeType::convex || t == ShapeType::capsule || t == ShapeType::box;
-}
+constexpr bool polytope_core(ShapeType t) { return t == ShapeType::convex || t == ShapeType::capsule; }
 /// Pairs of a polytope and an ellipsoid take feature Newton directions (wide_gjk.inl's feature_direction()):
 /// 1 when A is the polytope, 2 when B is, 0 for the other pair types.
-/// Boxes joined once pair_hessian() formed the ellipsoid's Hessian from its support point (no R H R^T): box-ellipsoid
-/// 18.7 -> 12.2 mean iterations and 8743 -> 8232 instructions per pair (callgrind, AVX2, close witness double);
-/// before, the step's arithmetic ate the saving (9669 -> 9317 ... +7%).
+/// Not boxes: with the Hessians formed from the support points, box-ellipsoid went from 18.7 to 12.2 mean iterations
+/// and, on AVX2 (4 double lanes), from 8743 to 8085 instructions per pair (callgrind, close witness double) and -8%
+/// wall (farm-bench, bench ns/pair medians 2918 -> 2688 on the loaded 2-core Xeon VM); but with 8 lanes per
+/// register it lost: AVX-512 double +4% and +7% ns/pair in two A/B runs (2052 -> 2137, 2036 -> 2188), AVX2 float
+/// 4035 -> 4530 instructions (14.6 -> 11.6 iterations); distance double 7734 -> 7943 (AVX2). More lanes mix more
+/// feature kinds (vertex, edge, face) per call, so feature_direction() runs more of its branches; results must not
+/// depend on the instruction set, so the gate is by pair type (branch `flat`: commit 0dff0ff has boxes on in double).
 /// Not against cylinders and cones, although their side lines and caps were tried as features as well (a side
 /// line as an edge along the axis or the generator, a cap as a face; branch `flat`, commit 58e3fc2): the iterations
 /// fell (box-cylinder 13.6 -> 11.5, capsule-cylinder 9.6 -> 7.2, cylinder-cylinder 18.8 -> 15.4, cylinder-convex8
@@ -95,13 +97,8 @@ constexpr bool polytope_core(ShapeType t) {
 /// cylinder-ellipsoid / cone-ellipsoid took more iterations than with newton_direction() (15.0 -> 17.1,
 /// 15.4 -> 19.3). (A cone's generator has its rim's curvature scaled by the distance from the apex, which the rim
 /// Hessian does not model: likely why cone rows gained least.) Triangles are left out, unmeasured.
-/// Boxes in double precision only: in float lanes (twice as many per register, so more lanes wait on the slowest)
-/// box-ellipsoid went from 14.6 to 11.6 mean iterations but from 4035 to 4530 instructions per pair (witness).
-/// Distance queries run the same lanes (and must: the results do not depend on the points being kept) and pay for
-/// tracking the box's points: box-ellipsoid distance double 7734 -> 7943 (+2.7%), against witness -7.5%.
-template <class T> constexpr int flat_newton_side(ShapeType a, ShapeType b) {
-  const auto flat = [](ShapeType t) { return polytope_core(t) && (t != ShapeType::box || sizeof(T) == sizeof(double)); };
-  return flat(a) && b == ShapeType::ellipsoid ? 1 : flat(b) && a == ShapeType::ellipsoid ? 2 : 0;
+constexpr int flat_newton_side(ShapeType a, ShapeType b) {
+  return polytope_core(a) && b == ShapeType::ellipsoid ? 1 : polytope_core(b) && a == ShapeType::ellipsoid ? 2 : 0;
 }
 
 /// Pair types whose distance / witness lanes take Newton search directions (wide_gjk.inl): an ellipsoid (curved in
@@ -113,12 +110,12 @@ template <class T> constexpr int flat_newton_side(ShapeType a, ShapeType b) {
 /// cylinder-cylinder 9765 -> 11042, box-cylinder 7357 -> 8751 with every curved pair type enabled.
 /// A polytope against a curved core (flat_newton_side()) takes them too, with the residual taken from the feature of
 /// the polytope that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
-template <class T> constexpr bool newton_pair_type(ShapeType a, ShapeType b) {
+constexpr bool newton_pair_type(ShapeType a, ShapeType b) {
   const auto round = [](ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::sphere || t == ShapeType::cylinder || t == ShapeType::cone;
   };
   return (a == ShapeType::ellipsoid && round(b)) || (b == ShapeType::ellipsoid && round(a)) ||
-         flat_newton_side<T>(a, b) != 0;
+         flat_newton_side(a, b) != 0;
 }
 
 /// Newton search directions (distance / witness queries on curved cores, wide_gjk.inl): a Newton step is taken

@@ -643,7 +643,7 @@ template <class T> struct WideGjk {
     L.stale[l] = 0;
     // Newton directions: every lane of a newton_pair_type() run may take them (boolean lanes are left out where
     // the steps are chosen, by L.boolean_only, which the batch-array refill sets per run).
-    L.newton[l] = newton_pair_type<T>(L.A.type, L.B.type) ? -1 : 0;
+    L.newton[l] = newton_pair_type(L.A.type, L.B.type) ? -1 : 0;
     L.newton_next[l] = 0;
     L.newton_steps[l] = 0;
   }
@@ -788,7 +788,7 @@ template <class T> struct WideGjk {
   __attribute__((noinline)) static V3 feature_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
                                                         mask use, real& step2) {
     const real zero = splat(T(0));
-    const bool fa = flat_newton_side<T>(L.A.type, L.B.type) == 1;
+    const bool fa = flat_newton_side(L.A.type, L.B.type) == 1;
     V3 p[3];
     for (int m = 0; m < 3; ++m) {
       const V3* v = fa ? L.a : L.b;
@@ -887,8 +887,8 @@ template <class T> struct WideGjk {
     const real zero = splat(T(0)), one = splat(T(1));
     const bool points = !Boolean && points_;
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
-    const bool newton_run = !Boolean && newton_pair_type<T>(L.A.type, L.B.type);
-    const bool flat_run = !Boolean && flat_newton_side<T>(L.A.type, L.B.type) != 0;  // feature_direction()
+    const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
+    const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);

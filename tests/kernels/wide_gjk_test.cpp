@@ -96,7 +96,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
         want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
         newton_steps += want.back().newton_steps;
         newton_pairs += want.back().newton_steps > 0 ? 1 : 0;
-        feature_pairs += want.back().newton_steps > 0 && kernels::flat_newton_side<T>(ta, tb) != 0 ? 1 : 0;
+        feature_pairs += want.back().newton_steps > 0 && kernels::flat_newton_side(ta, tb) != 0 ? 1 : 0;
         lo = std::min(lo, want.back().iterations);
         hi = std::max(hi, want.back().iterations);
       }

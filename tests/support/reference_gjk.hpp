@@ -159,7 +159,7 @@ Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, cons
 template <class T>
 Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, const Vec3<T>& n,
                           const SupportPoint<T>& s, T& step2) {
-  const bool fa = flat_newton_side<T>(D.A->type, D.B->type) == 1;
+  const bool fa = flat_newton_side(D.A->type, D.B->type) == 1;
   const auto flat = [&](int m) { return fa ? S.v[m].a : S.v[m].b; };
   const Vec3<T> p0 = flat(0);
   const Vec3<T> y = fa ? wsub(p0, s.b) : wsub(s.a, p0);
@@ -213,11 +213,11 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound
   // Newton directions (witness / distance queries of newton_pair_type()s) until one fails to progress.
-  bool newton = !params.boolean_only && newton_pair_type<T>(D.A->type, D.B->type);
+  bool newton = !params.boolean_only && newton_pair_type(D.A->type, D.B->type);
   bool newton_next = false;
   Vec3<T> newton_dir = Vec3<T>::Zero();
   T newton_step2 = T(0);  // |delta|^2 of the step that chose newton_dir
-  const bool flat_pair = flat_newton_side<T>(D.A->type, D.B->type) != 0;  // feature_direction()
+  const bool flat_pair = flat_newton_side(D.A->type, D.B->type) != 0;  // feature_direction()
   T newton_gap = T(0);    // flat pairs: the certified gap when the last Newton choice was made
 
   for (int k = 0; k < params.max_iterations; ++k) {
