@@ -80,13 +80,23 @@ constexpr int kMaxStaleMomentumSteps = 4;
 /// spanned by support vertices.
 constexpr bool polytope_core(ShapeType t) { return t == ShapeType::convex || t == ShapeType::capsule; }
 /// Pairs of a polytope and an ellipsoid take feature Newton directions (wide_gjk.inl's feature_direction()):
-/// 1 when A is the polytope, 2 when B is, 0 for the other pair types. Not against cylinders and cones: their caps
-/// and side lines are flat features of the curved side too, which feature_direction() does not model; there the
-/// iterations fell by only 7-13% and the instructions per pair rose (callgrind, AVX2, close witness, 4000 pairs:
-/// box-cylinder 7220 -> 8851, capsule-cylinder 5926 -> 6702, cylinder-convex8 8304 -> 9608, box-cone 5897 -> 7296).
-/// Not boxes either: box-ellipsoid went from 18.7 to 12.2 mean iterations, but the feature direction's arithmetic
-/// ate the saving (witness double 9669 -> 9317, distance 8640 -> 9214, witness float 5011 -> 5663 instructions).
-/// Triangles (like a box face) are left out with them, unmeasured.
+/// 1 when A is the polytope, 2 when B is, 0 for the other pair types.
+/// Not boxes: with the Hessians formed from the support points, box-ellipsoid went from 18.7 to 12.2 mean iterations
+/// and, on AVX2 (4 double lanes), from 8743 to 8085 instructions per pair (callgrind, close witness double) and -8%
+/// wall (farm-bench, bench ns/pair medians 2918 -> 2688 on the loaded 2-core Xeon VM); but with 8 lanes per
+/// register it lost: AVX-512 double +4% and +7% ns/pair in two A/B runs (2052 -> 2137, 2036 -> 2188), AVX2 float
+/// 4035 -> 4530 instructions (14.6 -> 11.6 iterations); distance double 7734 -> 7943 (AVX2). More lanes mix more
+/// feature kinds (vertex, edge, face) per call, so feature_direction() runs more of its branches; results must not
+/// depend on the instruction set, so the gate is by pair type (branch `flat`: commit 0dff0ff has boxes on in double).
+/// Not against cylinders and cones, although their side lines and caps were tried as features as well (a side
+/// line as an edge along the axis or the generator, a cap as a face; branch `flat`, commit 58e3fc2): the iterations
+/// fell (box-cylinder 13.6 -> 11.5, capsule-cylinder 9.6 -> 7.2, cylinder-cylinder 18.8 -> 15.4, cylinder-convex8
+/// 14.6 -> 11.9, box-cone 10.8 -> 10.4, cone-cone 15.8 -> 15.8), but not enough to pay for the step (instructions
+/// per pair: box-cylinder 6437 -> 7776, capsule-cylinder 4899 -> 5062, cylinder-cylinder 8709 -> 10434,
+/// cylinder-cone 8203 -> 10792, box-cone 5179 -> 7026, cone-cone 7392 -> 10833, capsule-cone 3739 -> 4718), and
+/// cylinder-ellipsoid / cone-ellipsoid took more iterations than with newton_direction() (15.0 -> 17.1,
+/// 15.4 -> 19.3). (A cone's generator has its rim's curvature scaled by the distance from the apex, which the rim
+/// Hessian does not model: likely why cone rows gained least.) Triangles are left out, unmeasured.
 constexpr int flat_newton_side(ShapeType a, ShapeType b) {
   return polytope_core(a) && b == ShapeType::ellipsoid ? 1 : polytope_core(b) && a == ShapeType::ellipsoid ? 2 : 0;
 }

@@ -169,46 +169,65 @@ template <class T> struct WideGjk {
   static constexpr bool curved(ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
   }
-  /// Hessian of the support function h(u) = max <p, u> of a curved core at the unit direction u (its own frame):
-  /// the Jacobian of the support map, which moves the support point along the boundary as u turns. It has u in
-  /// its null space (h is 1-homogeneous).
-  ///   ellipsoid, radii r, q = diag(r) u, g = diag(r) q / |q| (the support point): (diag(r^2) - g g^T) / |q|;
-  ///   cylinder / cone rim, radius r, rho = |u_xy|: (r / rho^3) [uy^2, -ux uy; -ux uy, ux^2] in the xy block
-  ///   (r times the projector orthogonal to the axis and to the radial direction, over rho); zero on a cone's apex
-  ///   and where rho = 0 (the support map jumps there).
+  /// Hessian of the support function h(u) = max <p, u> of a cylinder or cone at the unit direction u (its own
+  /// frame): the Jacobian of the support map, which moves the support point along the boundary as u turns. It has u
+  /// in its null space (h is 1-homogeneous). Rim of radius r, rho = |u_xy|: (r / rho^3) [uy^2, -ux uy; -ux uy, ux^2]
+  /// in the xy block (r times the projector orthogonal to the axis and to the radial direction, over rho); zero on
+  /// a cone's apex and where rho = 0 (the support map jumps there). A's side only: B's is rim_hessian(), and an
+  /// ellipsoid's is ellipsoid_hessian().
   static Sym support_hessian(const Side& s, const V3& u) {
     const real zero = splat(T(0));
     Sym h{zero, zero, zero, zero, zero, zero};
-    if (s.type == ShapeType::ellipsoid) {
-      const V3 q = {s.s0 * u.x, s.s1 * u.y, s.s2 * u.z};
-      const real m = norm(q);
-      const V3 g = {(s.s0 * q.x) / m, (s.s1 * q.y) / m, (s.s2 * q.z) / m};
-      const mask ok = m > zero;
-      h.xx = select(ok, (s.s0 * s.s0 - g.x * g.x) / m, zero);
-      h.yy = select(ok, (s.s1 * s.s1 - g.y * g.y) / m, zero);
-      h.zz = select(ok, (s.s2 * s.s2 - g.z * g.z) / m, zero);
-      h.xy = select(ok, -(g.x * g.y) / m, zero);
-      h.xz = select(ok, -(g.x * g.z) / m, zero);
-      h.yz = select(ok, -(g.y * g.z) / m, zero);
-    } else if (s.type == ShapeType::cylinder || s.type == ShapeType::cone) {
-      const real rho2 = u.x * u.x + u.y * u.y;
-      const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
-      mask ok = rho2 > zero;
-      if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
-      h.xx = select(ok, (k * u.y) * u.y, zero);
-      h.yy = select(ok, (k * u.x) * u.x, zero);
-      h.xy = select(ok, -((k * u.x) * u.y), zero);
-    }
+    const real rho2 = u.x * u.x + u.y * u.y;
+    const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
+    mask ok = rho2 > zero;
+    if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
+    h.xx = select(ok, (k * u.y) * u.y, zero);
+    h.yy = select(ok, (k * u.x) * u.x, zero);
+    h.xy = select(ok, -((k * u.x) * u.y), zero);
     return h;
   }
-  /// R h R^T (R row-major): B's Hessian in A's frame.
-  static Sym rotate(const real* R, const Sym& h) {
-    const real H[9] = {h.xx, h.xy, h.xz, h.xy, h.yy, h.yz, h.xz, h.yz, h.zz};
-    real M[9];
+  /// An ellipsoid's support Hessian in A's frame from its support point: g = the support point's offset from the
+  /// centre (A's frame), u the unit direction, M = R diag(r^2) R^T (R the ellipsoid's rotation in A's frame):
+  /// (M - g g^T) / m, m = <g, u> = |diag(r) R^T u|. The same matrix as R (diag(r^2) - g_B g_B^T) R^T / m in exact
+  /// arithmetic (g = R g_B, g_B the support point in the ellipsoid's frame), without the two 3x3 products and the
+  /// ellipsoid's own norm and divisions: the support point is already there.
+  AI static Sym ellipsoid_hessian(const Sym& M, const V3& g, const V3& u) {
+    const real zero = splat(T(0));
+    const real m = dot(g, u);
+    const mask ok = m > zero;
+    const real im = splat(T(1)) / m;
+    return {select(ok, (M.xx - g.x * g.x) * im, zero), select(ok, (M.yy - g.y * g.y) * im, zero),
+            select(ok, (M.zz - g.z * g.z) * im, zero), select(ok, (M.xy - g.x * g.y) * im, zero),
+            select(ok, (M.xz - g.x * g.z) * im, zero), select(ok, (M.yz - g.y * g.z) * im, zero)};
+  }
+  /// R diag(r^2) R^T (R row-major): an ellipsoid's metric in A's frame.
+  AI static Sym ellipsoid_metric(const Side& s, const real* R) {
+    const real q[3] = {s.s0 * s.s0, s.s1 * s.s1, s.s2 * s.s2};
+    real P[9];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) M[3 * i + j] = (R[3 * i] * H[j] + R[3 * i + 1] * H[3 + j]) + R[3 * i + 2] * H[6 + j];
-    const auto e = [&](int i, int j) { return (M[3 * i] * R[3 * j] + M[3 * i + 1] * R[3 * j + 1]) + M[3 * i + 2] * R[3 * j + 2]; };
+      for (int k = 0; k < 3; ++k) P[3 * i + k] = R[3 * i + k] * q[k];
+    const auto e = [&](int i, int j) { return (P[3 * i] * R[3 * j] + P[3 * i + 1] * R[3 * j + 1]) + P[3 * i + 2] * R[3 * j + 2]; };
     return {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
+  }
+  /// A cylinder's or cone's rim Hessian in A's frame at the unit direction n (B's side, rotation R): with the axis
+  /// a = R e_z and c = a x n (= R (e_z x R^T n), |c| = rho), support_hessian()'s (r / rho^3) [uy^2, -ux uy; ..]
+  /// rotated is (r / rho^3) c c^T: a cross product and an outer product instead of R H R^T's two 3x3 products.
+  AI static Sym rim_hessian(const Side& s, const real* R, const V3& n) {
+    const real zero = splat(T(0));
+    const V3 axis = {R[2], R[5], R[8]};
+    const V3 c = cross(axis, n);
+    const real rho2 = norm2(c);
+    const real rho = wsqrt<T>(rho2);
+    mask ok = rho2 > zero;
+    if (s.type == ShapeType::cone) {
+      const real uz = dot(axis, n);
+      ok &= ~(s.s1 * uz >= (-s.s1) * uz + s.s0 * rho);  // support()'s apex test
+    }
+    const real k = s.s0 / (rho2 * rho);
+    const V3 kc = scale(k, c);
+    return {select(ok, kc.x * c.x, zero), select(ok, kc.y * c.y, zero), select(ok, kc.z * c.z, zero),
+            select(ok, kc.x * c.y, zero), select(ok, kc.x * c.z, zero), select(ok, kc.y * c.z, zero)};
   }
 
   /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
@@ -711,21 +730,32 @@ template <class T> struct WideGjk {
   /// second-order step on the dual variable n, with the support functions' Hessians as curvature.
   /// Out of line: taken in a few iterations of some pairs; inlined, it grew drive() enough for GCC to outline
   /// support() (measured: +3% instructions on boolean ellipsoid pairs, which never take Newton steps).
-  __attribute__((noinline)) static V3 newton_direction(const Lanes& L, const V3& n, const V3& r, real lb, real& step2) {
-    const V3 delta = solve(pair_hessian(L, n), lb, r);
+  __attribute__((noinline)) static V3 newton_direction(const Lanes& L, const V3& n, const V3& sa, const V3& sb,
+                                                       const V3& r, real lb, real& step2) {
+    const V3 delta = solve(pair_hessian(L, n, sa, sb), lb, r);
     step2 = norm2(delta);
     return add(n, delta);
   }
-  /// H = H_A(-n) + R H_B(R^T n) R^T, the curved sides' support Hessians at the unit direction n (A's frame).
-  AI static Sym pair_hessian(const Lanes& L, const V3& n) {
+  /// H = H_A(-n) + R H_B(R^T n) R^T, the curved sides' support Hessians at the unit direction n (A's frame), from
+  /// the support points sa = s_A(-n), sb = s_B(n) (A's frame). An ellipsoid's and a B rim's are formed in A's
+  /// frame directly (ellipsoid_hessian(), rim_hessian()); A's rim is support_hessian()'s (no rotation).
+  AI static Sym pair_hessian(const Lanes& L, const V3& n, const V3& sa, const V3& sb) {
     Sym h{};
     const bool ca = curved(L.A.type), cb = curved(L.B.type);
-    if (ca) h = support_hessian(L.A, neg(n));
+    if (ca) {
+      if (L.A.type == ShapeType::ellipsoid) {
+        const real zero = splat(T(0));
+        const Sym M{L.A.s0 * L.A.s0, L.A.s1 * L.A.s1, L.A.s2 * L.A.s2, zero, zero, zero};
+        h = ellipsoid_hessian(M, sa, neg(n));
+      } else {
+        h = support_hessian(L.A, neg(n));
+      }
+    }
     if (cb) {
       const real* R = L.R;
-      const V3 n_in_b = {(R[0] * n.x + R[3] * n.y) + R[6] * n.z, (R[1] * n.x + R[4] * n.y) + R[7] * n.z,
-                         (R[2] * n.x + R[5] * n.y) + R[8] * n.z};
-      const Sym hb = rotate(R, support_hessian(L.B, n_in_b));
+      const Sym hb = L.B.type == ShapeType::ellipsoid
+                         ? ellipsoid_hessian(ellipsoid_metric(L.B, R), sub(sb, V3{L.t[0], L.t[1], L.t[2]}), n)
+                         : rim_hessian(L.B, R, n);
       if (ca) h = {h.xx + hb.xx, h.yy + hb.yy, h.zz + hb.zz, h.xy + hb.xy, h.xz + hb.xz, h.yz + hb.yz};
       else h = hb;
     }
@@ -779,7 +809,7 @@ template <class T> struct WideGjk {
     if (any(use & ~is_face)) {
       const V3 y = fa ? sub(p[0], sb) : sub(sa, p[0]);
       const real lb = dot(y, n);
-      const Sym h = pair_hessian(L, n);
+      const Sym h = pair_hessian(L, n, sa, sb);
       if (any(use & ~is_face & ~is_edge)) delta = solve(h, lb, sub(y, scale(lb, n)));  // vertex
       if (any(use & is_edge)) {
         const V3 e = pick(has1, e1, e2);
@@ -1034,7 +1064,7 @@ template <class T> struct WideGjk {
             shrunk = T(0.25) * L.newton_step2 + T(4) * (eps * eps);  // the tilt is no step of Newton's
           } else {
             const V3 r = sub(sw, scale(lb, n));
-            nd = newton_direction(L, n, r, lb, step2);
+            nd = newton_direction(L, n, sa, sb, r, lb, step2);
             shrunk = T(0.25) * L.newton_step2;
           }
           const mask valid = lb > zero;

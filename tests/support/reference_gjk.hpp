@@ -40,52 +40,92 @@ template <class T> Vec3<T> face_direction(const Simplex<T>& S, const Vec3<T>& x)
   return (dot3(n, x) < T(0) ? -n : n) * (xn / nn);
 }
 
+// The wide kernel's V3 arithmetic, in its association order (with kernels/math.hpp's dot3 and cross3).
+template <class T> Vec3<T> wscale(T s, const Vec3<T>& a) { return Vec3<T>(s * a.x(), s * a.y(), s * a.z()); }
+template <class T> Vec3<T> wdivide(const Vec3<T>& a, T s) { return Vec3<T>(a.x() / s, a.y() / s, a.z() / s); }
+template <class T> Vec3<T> wsub(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.x() - b.x(), a.y() - b.y(), a.z() - b.z());
+}
+template <class T> Vec3<T> wadd(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(a.x() + b.x(), a.y() + b.y(), a.z() + b.z());
+}
+
 /// Whether a core's support function has a curved part (wide_gjk.inl's curved()).
 inline bool curved_core(ShapeType t) {
   return t == ShapeType::ellipsoid || t == ShapeType::cylinder || t == ShapeType::cone;
 }
 
-/// Hessian xx, yy, zz, xy, xz, yz of a curved core's support function at the unit direction u (its frame): the
-/// formulas and operations of wide_gjk.inl's support_hessian().
+/// Hessian xx, yy, zz, xy, xz, yz of a cylinder's or cone's support function at the unit direction u (its frame):
+/// the formulas and operations of wide_gjk.inl's support_hessian().
 template <class T> std::array<T, 6> support_hessian(const ShapeCore<T>& core, const Vec3<T>& u) {
   std::array<T, 6> h{};
-  const T s0 = core.size.x(), s1 = core.size.y(), s2 = core.size.z();
-  if (core.type == ShapeType::ellipsoid) {
-    const Vec3<T> q(s0 * u.x(), s1 * u.y(), s2 * u.z());
-    const T m = norm3(q);
-    if (!(m > T(0))) return h;
-    const Vec3<T> g((s0 * q.x()) / m, (s1 * q.y()) / m, (s2 * q.z()) / m);
-    h = {(s0 * s0 - g.x() * g.x()) / m, (s1 * s1 - g.y() * g.y()) / m, (s2 * s2 - g.z() * g.z()) / m,
-         -(g.x() * g.y()) / m, -(g.x() * g.z()) / m, -(g.y() * g.z()) / m};
-  } else if (core.type == ShapeType::cylinder || core.type == ShapeType::cone) {
-    const T rho2 = u.x() * u.x() + u.y() * u.y();
-    if (!(rho2 > T(0))) return h;
-    if (core.type == ShapeType::cone && s1 * u.z() >= (-s1) * u.z() + s0 * std::sqrt(rho2)) return h;  // apex
-    const T k = s0 / (rho2 * std::sqrt(rho2));
-    h[0] = (k * u.y()) * u.y();
-    h[1] = (k * u.x()) * u.x();
-    h[3] = -((k * u.x()) * u.y());
-  }
+  const T s0 = core.size.x(), s1 = core.size.y();
+  const T rho2 = u.x() * u.x() + u.y() * u.y();
+  if (!(rho2 > T(0))) return h;
+  if (core.type == ShapeType::cone && s1 * u.z() >= (-s1) * u.z() + s0 * std::sqrt(rho2)) return h;  // apex
+  const T k = s0 / (rho2 * std::sqrt(rho2));
+  h[0] = (k * u.y()) * u.y();
+  h[1] = (k * u.x()) * u.x();
+  h[3] = -((k * u.x()) * u.y());
   return h;
 }
 
-/// H = H_A(-n) + R H_B(R^T n) R^T as xx, yy, zz, xy, xz, yz: wide_gjk.inl's pair_hessian().
-template <class T> std::array<T, 6> pair_hessian(const MinkowskiDifference<T>& D, const Vec3<T>& n) {
+/// An ellipsoid's support Hessian in A's frame from its support point: (M - g g^T) / <g, u>, M = R diag(r^2) R^T
+/// (wide_gjk.inl's ellipsoid_hessian(), which says why).
+template <class T>
+std::array<T, 6> ellipsoid_hessian(const std::array<T, 6>& M, const Vec3<T>& g, const Vec3<T>& u) {
+  const T m = dot3(g, u);
+  if (!(m > T(0))) return {};
+  const T im = T(1) / m;
+  return {(M[0] - g.x() * g.x()) * im, (M[1] - g.y() * g.y()) * im, (M[2] - g.z() * g.z()) * im,
+          (M[3] - g.x() * g.y()) * im, (M[4] - g.x() * g.z()) * im, (M[5] - g.y() * g.z()) * im};
+}
+
+/// R diag(r^2) R^T of an ellipsoid with radii r (wide_gjk.inl's ellipsoid_metric()).
+template <class T> std::array<T, 6> ellipsoid_metric(const ShapeCore<T>& core, const Mat3<T>& R) {
+  const T q[3] = {core.size.x() * core.size.x(), core.size.y() * core.size.y(), core.size.z() * core.size.z()};
+  T P[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) P[i][k] = R(i, k) * q[k];
+  const auto e = [&](int i, int j) { return (P[i][0] * R(j, 0) + P[i][1] * R(j, 1)) + P[i][2] * R(j, 2); };
+  return {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
+}
+
+/// A cylinder's or cone's rim Hessian in A's frame, B's pose R (wide_gjk.inl's rim_hessian()).
+template <class T> std::array<T, 6> rim_hessian(const ShapeCore<T>& core, const Mat3<T>& R, const Vec3<T>& n) {
+  const Vec3<T> axis(R(0, 2), R(1, 2), R(2, 2));
+  const Vec3<T> c = cross3(axis, n);
+  const T rho2 = dot3(c, c);
+  if (!(rho2 > T(0))) return {};
+  const T s0 = core.size.x(), s1 = core.size.y(), rho = std::sqrt(rho2);
+  if (core.type == ShapeType::cone) {
+    const T uz = dot3(axis, n);
+    if (s1 * uz >= (-s1) * uz + s0 * rho) return {};  // apex
+  }
+  const T k = s0 / (rho2 * rho);
+  const Vec3<T> kc(k * c.x(), k * c.y(), k * c.z());
+  return {kc.x() * c.x(), kc.y() * c.y(), kc.z() * c.z(), kc.x() * c.y(), kc.x() * c.z(), kc.y() * c.z()};
+}
+
+/// H = H_A(-n) + R H_B(R^T n) R^T as xx, yy, zz, xy, xz, yz from the support point s in direction -n:
+/// wide_gjk.inl's pair_hessian().
+template <class T>
+std::array<T, 6> pair_hessian(const MinkowskiDifference<T>& D, const Vec3<T>& n, const SupportPoint<T>& s) {
   std::array<T, 6> h{};
   const bool ca = curved_core(D.A->type), cb = curved_core(D.B->type);
-  if (ca) h = support_hessian(*D.A, Vec3<T>(-n));
+  if (ca) {
+    if (D.A->type == ShapeType::ellipsoid) {
+      const T s0 = D.A->size.x(), s1 = D.A->size.y(), s2 = D.A->size.z();
+      h = ellipsoid_hessian<T>({s0 * s0, s1 * s1, s2 * s2, T(0), T(0), T(0)}, s.a, Vec3<T>(-n));
+    } else {
+      h = support_hessian(*D.A, Vec3<T>(-n));
+    }
+  }
   if (cb) {
     const auto& R = D.b_in_a.R;
-    const Vec3<T> n_in_b((R(0, 0) * n.x() + R(1, 0) * n.y()) + R(2, 0) * n.z(),
-                         (R(0, 1) * n.x() + R(1, 1) * n.y()) + R(2, 1) * n.z(),
-                         (R(0, 2) * n.x() + R(1, 2) * n.y()) + R(2, 2) * n.z());
-    const std::array<T, 6> b = support_hessian(*D.B, n_in_b);
-    const T H[3][3] = {{b[0], b[3], b[4]}, {b[3], b[1], b[5]}, {b[4], b[5], b[2]}};
-    T M[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) M[i][j] = (R(i, 0) * H[0][j] + R(i, 1) * H[1][j]) + R(i, 2) * H[2][j];
-    const auto e = [&](int i, int j) { return (M[i][0] * R(j, 0) + M[i][1] * R(j, 1)) + M[i][2] * R(j, 2); };
-    const std::array<T, 6> hb = {e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)};
+    const std::array<T, 6> hb = D.B->type == ShapeType::ellipsoid
+                                    ? ellipsoid_hessian(ellipsoid_metric(*D.B, R), wsub(s.b, D.b_in_a.t), n)
+                                    : rim_hessian(*D.B, R, n);
     if (ca) for (int i = 0; i < 6; ++i) h[i] = h[i] + hb[i];
     else h = hb;
   }
@@ -106,20 +146,11 @@ template <class T> Vec3<T> newton_solve(const std::array<T, 6>& h, T lb, const V
 /// wide_gjk.inl's newton_direction(), where the derivation is: n + delta with (H + lb I) delta = r; step2 =
 /// |delta|^2.
 template <class T>
-Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, const Vec3<T>& r, T lb, T& step2) {
-  const Vec3<T> delta = newton_solve(pair_hessian(D, n), lb, r);
+Vec3<T> newton_direction(const MinkowskiDifference<T>& D, const Vec3<T>& n, const SupportPoint<T>& s,
+                         const Vec3<T>& r, T lb, T& step2) {
+  const Vec3<T> delta = newton_solve(pair_hessian(D, n, s), lb, r);
   step2 = norm2(delta);
   return Vec3<T>(n.x() + delta.x(), n.y() + delta.y(), n.z() + delta.z());
-}
-
-// The wide kernel's V3 arithmetic, in its association order (with kernels/math.hpp's dot3 and cross3).
-template <class T> Vec3<T> wscale(T s, const Vec3<T>& a) { return Vec3<T>(s * a.x(), s * a.y(), s * a.z()); }
-template <class T> Vec3<T> wdivide(const Vec3<T>& a, T s) { return Vec3<T>(a.x() / s, a.y() / s, a.z() / s); }
-template <class T> Vec3<T> wsub(const Vec3<T>& a, const Vec3<T>& b) {
-  return Vec3<T>(a.x() - b.x(), a.y() - b.y(), a.z() - b.z());
-}
-template <class T> Vec3<T> wadd(const Vec3<T>& a, const Vec3<T>& b) {
-  return Vec3<T>(a.x() + b.x(), a.y() + b.y(), a.z() + b.z());
 }
 
 /// Newton's direction for a polytope against a curved core (flat_newton_side()): wide_gjk.inl's
@@ -134,7 +165,7 @@ Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, 
   const Vec3<T> y = fa ? wsub(p0, s.b) : wsub(s.a, p0);
   const T lb = dot3(y, n);
   const Vec3<T> r = wsub(y, wscale(lb, n));
-  const std::array<T, 6> h = pair_hessian(D, n);
+  const std::array<T, 6> h = pair_hessian(D, n, s);
   const bool has1 = S.count > 1 && !(flat(1) == p0);
   const bool has2 = S.count > 2 && !(flat(2) == p0) && !(flat(2) == flat(1));
   const Vec3<T> e1 = S.count > 1 ? wsub(flat(1), p0) : Vec3<T>::Zero();
@@ -286,7 +317,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
         shrunk = T(0.25) * newton_step2 + T(4) * (eps * eps);
       } else {
         const Vec3<T> res(s.w.x() - lb * n.x(), s.w.y() - lb * n.y(), s.w.z() - lb * n.z());
-        nd = newton_direction(D, n, res, lb, step2);
+        nd = newton_direction(D, n, s, res, lb, step2);
         shrunk = T(0.25) * newton_step2;
       }
       const bool valid = lb > T(0);
