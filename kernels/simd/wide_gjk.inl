@@ -173,6 +173,32 @@ template <class T> struct WideGjk {
     }
     return r;
   }
+  /// start_cell() (kernels/hull_support.inl) of every lane's direction, with its operations lane by lane, so each
+  /// lane gets the cell the reference's scalar call computes.
+  static void start_cells(const V3& d, std::uint32_t* cell) {
+    const real zero = splat(T(0)), one = splat(T(1));
+    const real ax = select(d.x < zero, -d.x, d.x), ay = select(d.y < zero, -d.y, d.y), az = select(d.z < zero, -d.z, d.z);
+    const mask yx = ay > ax;
+    real major = select(yx, ay, ax), u = select(yx, d.z, d.y), v = select(yx, d.x, d.z);
+    const mask zx = az > major;
+    major = select(zx, az, major);
+    u = select(zx, d.x, u);
+    v = select(zx, d.y, v);
+    const real along = select(zx, d.z, select(yx, d.y, d.x));
+    mask face = select(zx, splat_mask(4), select(yx, splat_mask(2), splat_mask(0)));
+    face += select(along < zero, splat_mask(1), splat_mask(0));
+    const real grid = splat(T(kHullStartGrid)), half = splat(T(0.5 * kHullStartGrid));
+    const real k = half / major;
+    const mask ok = (major > zero) & (k <= splat(std::numeric_limits<T>::max()));
+    // [0, grid) -> its integer part, [grid, inf) -> grid - 1, below 1 and NaN -> 0: in range before converting
+    const real fu = u * k + half, fv = v * k + half;
+    const real cu = select(fu >= one, select(fu < grid, fu, grid - one), zero);
+    const real cv = select(fv >= one, select(fv < grid, fv, grid - one), zero);
+    const mask iu = __builtin_convertvector(cu, mask), iv = __builtin_convertvector(cv, mask);
+    const Int g = Int(kHullStartGrid);
+    const mask c = (face * g + iu) * g + iv;
+    for (int l = 0; l < W; ++l) cell[l] = ok[l] ? std::uint32_t(c[l]) : kNoHullVertex;
+  }
 
   // ---- Newton search direction (see the drive() loop; tests/support/reference_gjk.hpp, same operations) ----
   /// Symmetric 3x3 matrix: the Hessian of a support function.
@@ -217,32 +243,6 @@ template <class T> struct WideGjk {
     return h;
   }
   /// R h R^T (R row-major): B's Hessian in A's frame.
-  /// start_cell() (kernels/hull_support.inl) of every lane's direction, with its operations lane by lane, so each
-  /// lane gets the cell the reference's scalar call computes.
-  static void start_cells(const V3& d, std::uint32_t* cell) {
-    const real zero = splat(T(0)), one = splat(T(1));
-    const real ax = select(d.x < zero, -d.x, d.x), ay = select(d.y < zero, -d.y, d.y), az = select(d.z < zero, -d.z, d.z);
-    const mask yx = ay > ax;
-    real major = select(yx, ay, ax), u = select(yx, d.z, d.y), v = select(yx, d.x, d.z);
-    const mask zx = az > major;
-    major = select(zx, az, major);
-    u = select(zx, d.x, u);
-    v = select(zx, d.y, v);
-    const real along = select(zx, d.z, select(yx, d.y, d.x));
-    mask face = select(zx, splat_mask(4), select(yx, splat_mask(2), splat_mask(0)));
-    face += select(along < zero, splat_mask(1), splat_mask(0));
-    const real grid = splat(T(kHullStartGrid)), half = splat(T(0.5 * kHullStartGrid));
-    const real k = half / major;
-    const mask ok = (major > zero) & (k <= splat(std::numeric_limits<T>::max()));
-    // [0, grid) -> its integer part, [grid, inf) -> grid - 1, below 1 and NaN -> 0: in range before converting
-    const real fu = u * k + half, fv = v * k + half;
-    const real cu = select(fu >= one, select(fu < grid, fu, grid - one), zero);
-    const real cv = select(fv >= one, select(fv < grid, fv, grid - one), zero);
-    const mask iu = __builtin_convertvector(cu, mask), iv = __builtin_convertvector(cv, mask);
-    const Int g = Int(kHullStartGrid);
-    const mask c = (face * g + iu) * g + iv;
-    for (int l = 0; l < W; ++l) cell[l] = ok[l] ? std::uint32_t(c[l]) : kNoHullVertex;
-  }
   static Sym rotate(const real* R, const Sym& h) {
     const real H[9] = {h.xx, h.xy, h.xz, h.xy, h.yy, h.yz, h.xz, h.yz, h.zz};
     real M[9];
