@@ -24,6 +24,9 @@ template <class T> inline std::uint32_t start_cell(const Vec3<T>& d) {
   if (!(major > T(0))) return kNoHullVertex;  // zero, or NaN (every comparison false)
   face += (face == 0u ? x : face == 2u ? y : z) < T(0) ? 1u : 0u;
   const T k = T(0.5 * kHullStartGrid) / major, half = T(0.5 * kHullStartGrid);
+  // A major component below ~8 / max overflows k: u * k would be NaN or infinite and name a cell d is not in (a
+  // kHullPureCell entry is trusted without a climb).
+  if (!(k <= std::numeric_limits<T>::max())) return kNoHullVertex;
   return (face * kHullStartGrid + start_cell_index(u, k, half)) * kHullStartGrid + start_cell_index(v, k, half);
 }
 
@@ -55,13 +58,38 @@ template <class T> inline Vec3<T> hull_point(const HullView& hull, std::uint32_t
   return Vec3<T>(T(p[0]), T(p[1]), T(p[2]));
 }
 
+/// Whether the hull is climbed (with the direction table's cells) rather than scanned.
+inline bool hull_climbs(const HullView& hull) {
+  return hull.vertex_count >= kHillClimbMinVertices && hull.neighbor_block_offsets != nullptr;
+}
+
+/// The support vertex straight from a pure cell of the direction table (kHullPureCell: inside one vertex's normal
+/// cone, with a margin above rounding), when `cell` (start_cell of d, or kNoHullVertex) is one: no dot product, no
+/// climb. Returns kNoHullVertex otherwise. Only for a climbed hull (hull_climbs()).
+inline std::uint32_t pure_cell_vertex(const HullView& hull, std::uint32_t cell) {
+  if (hull.start_vertices == nullptr || cell == kNoHullVertex) return kNoHullVertex;
+  const std::uint32_t e = hull.start_vertices[cell], v = e & ~kHullPureCell;
+  return (e & kHullPureCell) && v < hull.vertex_count ? v : kNoHullVertex;
+}
+
+template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3<T>& d, SupportHint& hint,
+                                                std::uint32_t cell);
+
 template <class T> Vec3<T> hull_support(const HullView& hull, const Vec3<T>& d, SupportHint& hint) {
+  const bool table = hull_climbs(hull) && hull.start_vertices != nullptr;
+  return hull_support_in_cell(hull, d, hint, table ? start_cell(d) : kNoHullVertex);
+}
+
+/// hull_support() with d's cell given (start_cell(d), or kNoHullVertex for a hull without a table; the wide GJK
+/// computes the cells of all its lanes at once).
+template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3<T>& d, SupportHint& hint,
+                                                std::uint32_t cell) {
   const std::uint32_t count = hull.vertex_count;
   std::uint32_t best = 0;
   constexpr std::uint32_t B = kHullNeighborBlock;
   static_assert(B == 4, "HullBlock computes four dot products at once");
   // Small hulls, and a hull without its blocks (Shape::convex builds them for every hull it accepts), are scanned.
-  if (count < kHillClimbMinVertices || hull.neighbor_block_offsets == nullptr) {
+  if (!hull_climbs(hull)) {
     T best_dot = hull_dot(hull, 0, d);
     for (std::uint32_t i = 1; i < count; ++i) {
       const T di = hull_dot(hull, i, d);
@@ -73,16 +101,23 @@ template <class T> Vec3<T> hull_support(const HullView& hull, const Vec3<T>& d, 
   // guarantees termination (the dot product increases at every move).
   // Start from the better of the previous support vertex and the direction table's vertex: GJK's directions
   // swing by up to 180 degrees in the first iterations, and a climb from the previous vertex then crosses the
-  // hull, while the table's vertex is within a cell (~7 degrees) of the answer.
+  // hull, while the table's vertex is within a cell (~3 degrees) of the answer. A pure cell is the answer itself
+  // (pure_cell_vertex()).
   best = hint.vertex < count ? hint.vertex : 0;
-  T best_dot = hull_dot(hull, best, d);
-  if (hull.start_vertices != nullptr) {  // kHullStartCells entries
-    const std::uint32_t c = start_cell(d);
-    if (c != kNoHullVertex && hull.start_vertices[c] < count) {
-      const std::uint32_t t = hull.start_vertices[c];
-      const T dt = hull_dot(hull, t, d);
-      if (hint.vertex >= count || dt > best_dot) best = t, best_dot = dt;
+  std::uint32_t t = kNoHullVertex;
+  if (hull.start_vertices != nullptr && cell != kNoHullVertex) {  // kHullStartCells entries
+    const std::uint32_t e = hull.start_vertices[cell];
+    t = e & ~kHullPureCell;
+    if (t >= count) t = kNoHullVertex;
+    else if (e & kHullPureCell) {
+      hint.vertex = t;
+      return hull_point<T>(hull, t);
     }
+  }
+  T best_dot = hull_dot(hull, best, d);
+  if (t != kNoHullVertex) {
+    const T dt = hull_dot(hull, t, d);
+    if (hint.vertex >= count || dt > best_dot) best = t, best_dot = dt;
   }
   // Steepest ascent a block of neighbours at a time: the first neighbour with the largest dot product, taken when
   // it beats the current vertex strictly. The block's four dot products are one vector expression; only a block

@@ -136,10 +136,25 @@ template <class T> struct WideGjk {
     V3 r{zero, zero, zero};
     if (live == 0) return r;
     if (live & ~s.small) {
+      // The direction table's cells of all lanes at once; a lane whose cell is pure takes its vertex without a
+      // call, the others climb (hull_support_in_cell, this set's build, not ADL's kernels:: one).
+      std::uint32_t cell[W];
+      start_cells(d, cell);
       for (int l = 0; l < W; ++l) {
         if (!(live >> l & 1u)) continue;
-        const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support(*s.hull[l],  // this set's build, not ADL's kernels::
-                                                       Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l]);
+        const HullView& h = *s.hull[l];
+        const bool climbs = hull_climbs(h);
+        const std::uint32_t v = climbs ? pure_cell_vertex(h, cell[l]) : kNoHullVertex;
+        if (v != kNoHullVertex) {
+          s.hint[l].vertex = v;
+          const double* p = h.vertices + 3 * std::size_t(v);
+          r.x[l] = T(p[0]);
+          r.y[l] = T(p[1]);
+          r.z[l] = T(p[2]);
+          continue;
+        }
+        const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l],
+                                                                 climbs ? cell[l] : kNoHullVertex);
         r.x[l] = p.x();
         r.y[l] = p.y();
         r.z[l] = p.z();
@@ -157,6 +172,32 @@ template <class T> struct WideGjk {
       r = pick(better, V3{x, y, z}, r);
     }
     return r;
+  }
+  /// start_cell() (kernels/hull_support.inl) of every lane's direction, with its operations lane by lane, so each
+  /// lane gets the cell the reference's scalar call computes.
+  static void start_cells(const V3& d, std::uint32_t* cell) {
+    const real zero = splat(T(0)), one = splat(T(1));
+    const real ax = select(d.x < zero, -d.x, d.x), ay = select(d.y < zero, -d.y, d.y), az = select(d.z < zero, -d.z, d.z);
+    const mask yx = ay > ax;
+    real major = select(yx, ay, ax), u = select(yx, d.z, d.y), v = select(yx, d.x, d.z);
+    const mask zx = az > major;
+    major = select(zx, az, major);
+    u = select(zx, d.x, u);
+    v = select(zx, d.y, v);
+    const real along = select(zx, d.z, select(yx, d.y, d.x));
+    mask face = select(zx, splat_mask(4), select(yx, splat_mask(2), splat_mask(0)));
+    face += select(along < zero, splat_mask(1), splat_mask(0));
+    const real grid = splat(T(kHullStartGrid)), half = splat(T(0.5 * kHullStartGrid));
+    const real k = half / major;
+    const mask ok = (major > zero) & (k <= splat(std::numeric_limits<T>::max()));
+    // [0, grid) -> its integer part, [grid, inf) -> grid - 1, below 1 and NaN -> 0: in range before converting
+    const real fu = u * k + half, fv = v * k + half;
+    const real cu = select(fu >= one, select(fu < grid, fu, grid - one), zero);
+    const real cv = select(fv >= one, select(fv < grid, fv, grid - one), zero);
+    const mask iu = __builtin_convertvector(cu, mask), iv = __builtin_convertvector(cv, mask);
+    const Int g = Int(kHullStartGrid);
+    const mask c = (face * g + iu) * g + iv;
+    for (int l = 0; l < W; ++l) cell[l] = ok[l] ? std::uint32_t(c[l]) : kNoHullVertex;
   }
 
   // ---- Newton search direction (see the drive() loop; tests/support/reference_gjk.hpp, same operations) ----

@@ -109,6 +109,61 @@ TEST(Support, HandBuiltHullsGetTheirSearchStructures) {
   EXPECT_THROW(Shape::convex(out_of_range), InputError);
 }
 
+TEST(Support, PureCellsGiveTheLinearScansVertexWithoutAClimb) {
+  // A cell flagged kHullPureCell returns its vertex without a climb: every direction in it, in double and in
+  // float, must get the linear scan's first maximiser (index and point), directions near the cell's edges
+  // included; and a flag the table's builder did not set is not trusted (the table is rebuilt).
+  batchcol::testing::Rng rng(36);
+  for (int n : {250, 940}) {
+    const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
+    const ConvexHull& h = *s.hull;
+    const OwnedShapeView view(s);
+    const ShapeCore<double> core = make_core<double>(view.view);
+    const ShapeCore<float> core_f = make_core<float>(view.view);
+    int pure = 0, checked = 0;
+    for (std::uint32_t e : h.start_vertices) pure += (e & kHullPureCell) != 0;
+    EXPECT_GT(pure, int(kHullStartCells) / 20) << n << " vertices";
+    for (int q = 0; q < 20000; ++q) {
+      const Eigen::Vector3d d = batchcol::testing::random_unit_vector(rng);
+      const std::uint32_t c = start_cell(d);
+      ASSERT_NE(c, kNoHullVertex);
+      if (!(h.start_vertices[c] & kHullPureCell)) continue;
+      ++checked;
+      std::uint32_t best = 0;
+      for (std::uint32_t i = 1; i < h.vertices.size(); ++i)
+        if (h.vertices[i].dot(d) > h.vertices[best].dot(d)) best = i;
+      SupportHint hint;
+      EXPECT_EQ(support(core, d, hint), h.vertices[best]) << n << " vertices, query " << q;
+      EXPECT_EQ(hint.vertex, best);
+      const Eigen::Vector3f df = d.cast<float>();
+      if (start_cell(df) != c) continue;
+      std::uint32_t best_f = 0;
+      for (std::uint32_t i = 1; i < h.vertices.size(); ++i)
+        if (h.vertices[i].cast<float>().dot(df) > h.vertices[best_f].cast<float>().dot(df)) best_f = i;
+      SupportHint hint_f;
+      EXPECT_EQ(support(core_f, df, hint_f), Eigen::Vector3f(h.vertices[best_f].cast<float>())) << n << " vertices, float query " << q;
+    }
+    EXPECT_GT(checked, 1000) << n << " vertices";
+    // A flag set on a cell that is not pure: the hull is not shared as complete, its table is rebuilt.
+    auto forged = std::make_shared<ConvexHull>(h);
+    std::uint32_t c = 0;
+    while (h.start_vertices[c] & kHullPureCell) ++c;
+    forged->start_vertices[c] |= kHullPureCell;
+    const Shape fixed = Shape::convex(forged);
+    EXPECT_NE(fixed.hull, forged);
+    EXPECT_EQ(fixed.hull->start_vertices, h.start_vertices);
+  }
+}
+
+TEST(Support, TinyDirectionsHaveNoCell) {
+  // Below ~8 / max the cell arithmetic overflows (u * k with k = inf) and would name a cell d is not in: no cell,
+  // so no pure cell is trusted (the climb starts from the hint or vertex 0).
+  EXPECT_EQ(start_cell(Eigen::Vector3d(1e-310, -0.7e-310, 0.2e-310)), kNoHullVertex);
+  EXPECT_EQ(start_cell(Eigen::Vector3f(1e-39f, 0.5e-39f, -0.9e-39f)), kNoHullVertex);
+  EXPECT_NE(start_cell(Eigen::Vector3d(1e-300, -0.7e-300, 0.2e-300)), kNoHullVertex);
+  EXPECT_NE(start_cell(Eigen::Vector3f(1e-37f, 0.5e-37f, -0.9e-37f)), kNoHullVertex);
+}
+
 TEST(Support, StartCellIsDefinedForEveryDirectionAndRefusesNone) {
   EXPECT_EQ(start_cell(Eigen::Vector3d(0, 0, 0)), kNoHullVertex);
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -41,9 +41,13 @@ enum class ShapeType : std::uint8_t { sphere, capsule, box, cylinder, cone, elli
 constexpr int kShapeTypeCount = 9;
 
 /// Cells per cube-face side of ConvexHull::start_vertices (kernels/hull_support.inl, start_cell).
-constexpr std::uint32_t kHullStartGrid = 16;
+constexpr std::uint32_t kHullStartGrid = 32;
 constexpr std::uint32_t kHullStartCells = 6 * kHullStartGrid * kHullStartGrid;
 constexpr std::uint32_t kNoHullVertex = 0xffffffffu;
+/// Flag of a ConvexHull::start_vertices entry: the cell is inside the vertex's normal cone (every direction of the
+/// cell, widened by a rounding margin, has that vertex as its only maximiser), so a support in a direction of the
+/// cell is the vertex itself, without a climb. The vertex index is the entry without the flag.
+constexpr std::uint32_t kHullPureCell = 0x80000000u;
 /// Neighbours per block of ConvexHull::neighbor_block_xyz (ConvexHull::kNeighborBlock).
 constexpr std::uint32_t kHullNeighborBlock = 4;
 
