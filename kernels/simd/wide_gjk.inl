@@ -135,32 +135,7 @@ template <class T> struct WideGjk {
     const real zero = splat(T(0));
     V3 r{zero, zero, zero};
     if (live == 0) return r;
-    if (live & ~s.small) {
-      // The direction table's cells of all lanes at once; a lane whose cell is pure takes its vertex without a
-      // call, the others climb (hull_support_in_cell, this set's build, not ADL's kernels:: one).
-      std::uint32_t cell[W];
-      start_cells(d, cell);
-      for (int l = 0; l < W; ++l) {
-        if (!(live >> l & 1u)) continue;
-        const HullView& h = *s.hull[l];
-        const bool climbs = hull_climbs(h);
-        const std::uint32_t v = climbs ? pure_cell_vertex(h, cell[l]) : kNoHullVertex;
-        if (v != kNoHullVertex) {
-          s.hint[l].vertex = v;
-          const double* p = h.vertices + 3 * std::size_t(v);
-          r.x[l] = T(p[0]);
-          r.y[l] = T(p[1]);
-          r.z[l] = T(p[2]);
-          continue;
-        }
-        const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l],
-                                                                 climbs ? cell[l] : kNoHullVertex);
-        r.x[l] = p.x();
-        r.y[l] = p.y();
-        r.z[l] = p.z();
-      }
-      return r;
-    }
+    if (live & ~s.small) return large_hull_lanes(s, d, live);
     const SmallHulls& t = *s.table;
     r = {t.vx[0], t.vy[0], t.vz[0]};
     real best = (r.x * d.x + r.y * d.y) + r.z * d.z;
@@ -170,6 +145,37 @@ template <class T> struct WideGjk {
       const mask better = di > best;
       best = select(better, di, best);
       r = pick(better, V3{x, y, z}, r);
+    }
+    return r;
+  }
+  /// The lanes of hull_support_lanes() with a large hull. Out of line: inlined, its cell computation and climb
+  /// calls made GCC stop inlining hull_support_lanes() into the loop, which cost the small hulls' scan a call
+  /// (convex8 witness double 3712 -> 3875 instructions per pair, callgrind AVX2).
+  __attribute__((noinline)) static V3 large_hull_lanes(Side& s, const V3& d, std::uint32_t live) {
+    const real zero = splat(T(0));
+    V3 r{zero, zero, zero};
+    // The direction table's cells of all lanes at once; a lane whose cell is pure takes its vertex without a
+    // call, the others climb (hull_support_in_cell, this set's build, not ADL's kernels:: one).
+    std::uint32_t cell[W];
+    start_cells(d, cell);
+    for (int l = 0; l < W; ++l) {
+      if (!(live >> l & 1u)) continue;
+      const HullView& h = *s.hull[l];
+      const bool climbs = hull_climbs(h);
+      const std::uint32_t v = climbs ? pure_cell_vertex(h, cell[l]) : kNoHullVertex;
+      if (v != kNoHullVertex) {
+        s.hint[l].vertex = v;
+        const double* p = h.vertices + 3 * std::size_t(v);
+        r.x[l] = T(p[0]);
+        r.y[l] = T(p[1]);
+        r.z[l] = T(p[2]);
+        continue;
+      }
+      const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l],
+                                                               climbs ? cell[l] : kNoHullVertex);
+      r.x[l] = p.x();
+      r.y[l] = p.y();
+      r.z[l] = p.z();
     }
     return r;
   }
