@@ -104,16 +104,14 @@ template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3
   // hull, while the table's vertex is within a cell (~3 degrees) of the answer. A pure cell is the answer itself
   // (pure_cell_vertex()).
   best = hint.vertex < count ? hint.vertex : 0;
-  std::uint32_t t = kNoHullVertex;
-  if (hull.start_vertices != nullptr && cell != kNoHullVertex) {  // kHullStartCells entries
-    const std::uint32_t e = hull.start_vertices[cell];
-    t = e & ~kHullPureCell;
-    if (t >= count) t = kNoHullVertex;
-    else if (e & kHullPureCell) {
-      hint.vertex = t;
-      return hull_point<T>(hull, t);
-    }
+  const std::uint32_t pure = pure_cell_vertex(hull, cell);
+  if (pure != kNoHullVertex) {
+    hint.vertex = pure;
+    return hull_point<T>(hull, pure);
   }
+  // Not pure: the entry is a plain vertex index (a flagged entry left here names no vertex of this hull).
+  std::uint32_t t = hull.start_vertices != nullptr && cell != kNoHullVertex ? hull.start_vertices[cell] : kNoHullVertex;
+  if (t >= count) t = kNoHullVertex;
   T best_dot = hull_dot(hull, best, d);
   if (t != kNoHullVertex) {
     const T dt = hull_dot(hull, t, d);
