@@ -127,17 +127,21 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
   sp.predict = p.predict;
 }
 
-/// One block's samples and answers, structure of arrays (the kernel's layout).
+/// One block's samples, structure of arrays (the kernel's layout), and their answers, one row of kRow per sample
+/// (distance, witness a, witness b, normal, two zeros: the reduction reads a sample's values as whole registers).
 struct Block {
-  enum Array { kR = 0, kT = 9, kDir = 12, kZ = 15, kDist = 21, kWa = 22, kWb = 25, kN = 28, kArrays = 31 };
+  enum Array { kR = 0, kT = 9, kDir = 12, kZ = 15, kArrays = 21 };
+  static constexpr std::size_t kRow = 12;
   std::size_t capacity = 0, count = 0;
-  std::vector<double> data;
+  std::vector<double> data, values;
   std::vector<std::uint32_t> shape_a, shape_b, fallback;
   std::vector<Status> status;
   double* at(int array) { return data.data() + static_cast<std::size_t>(array) * capacity; }
+  double* row(std::size_t k) { return values.data() + kRow * k; }
   void reserve(std::size_t n) {
     capacity = n;
     data.resize(kArrays * n);
+    values.assign(kRow * n, 0.0);  // the padding stays 0
     shape_a.resize(n);
     shape_b.resize(n);
     fallback.resize(n);
@@ -184,11 +188,12 @@ template <class T> void solve_sample(const Context& c, Block& b, std::size_t k) 
       kernels::solve_pair<T>(ShapeTableAccess::view(c.shapes, b.shape_a[k]), ShapeTableAccess::view(c.shapes, b.shape_b[k]),
                              X, warm, c.query);
   b.status[k] = r.status;
-  b.at(Block::kDist)[k] = double(r.distance);
+  double* v = b.row(k);
+  v[0] = double(r.distance);
   for (int e = 0; e < 3; ++e) {
-    b.at(Block::kWa + e)[k] = double(r.witness_a[e]);
-    b.at(Block::kWb + e)[k] = double(r.witness_b[e]);
-    b.at(Block::kN + e)[k] = double(r.normal[e]);
+    v[1 + e] = double(r.witness_a[e]);
+    v[4 + e] = double(r.witness_b[e]);
+    v[7 + e] = double(r.normal[e]);
   }
 }
 
@@ -210,69 +215,28 @@ template <class T> void solve_samples(const Context& c, Block& b, std::size_t fi
   }
   kernels::simd::SampleResults out;
   out.status = b.status.data() + first;
-  out.distance = b.at(Block::kDist) + first;
+  double* v = b.row(first);
+  out.stride = Block::kRow;
+  out.distance = v;
   for (int e = 0; e < 3; ++e) {
-    out.witness_a[e] = b.at(Block::kWa + e) + first;
-    out.witness_b[e] = b.at(Block::kWb + e) + first;
-    out.normal[e] = b.at(Block::kN + e) + first;
+    out.witness_a[e] = v + 1 + e;
+    out.witness_b[e] = v + 4 + e;
+    out.normal[e] = v + 7 + e;
   }
   const std::size_t left = kernels::simd::gjk_samples<T>(c.isa, c.view, ta, tb, in, c.query, out, b.fallback.data());
   for (std::size_t f = 0; f < left; ++f) solve_sample<T>(c, b, first + b.fallback[f]);
 }
 
-using Values = Eigen::Matrix<double, 10, 1>;  // signed distance, witness a, witness b, normal
+using Sums = kernels::simd::SampleSums;
 
-/// The running sums of one pair's estimator, sample by sample in sample order (so a pair split over blocks gives the
-/// same bits).
-struct Sums {
-  Values mean = Values::Zero();
-  Eigen::Matrix<double, 10, 6> G = Eigen::Matrix<double, 10, 6>::Zero();
-  int valid = 0;
-};
-
-/// Adds samples [first, first + count) of the block: each sample's values (distance, witness points, normal in A's
-/// frame) minus the unperturbed ones, times its noise z; a sample without a converged, finite answer adds nothing.
-void accumulate(const PairPlan& p, Block& b, std::size_t first, std::size_t count, Sums& sums) {
-  // Sample order: the first sample of antithetic pair e at first + e, its copy at first + evens + e (build()).
-  const std::size_t evens = (count + 1) / 2;
-  const double* v0[10];
-  const double* z0[6];
-  for (int e = 0; e < 10; ++e) v0[e] = b.at(Block::kDist + e) + first;  // kDist, kWa, kWb, kN: consecutive
-  for (int f = 0; f < 6; ++f) z0[f] = b.at(Block::kZ + f) + first;
-  // Local sums (column-major, as Eigen's): the compiler keeps them out of the reference's aliasing and vectorises
-  // each column's 10 entries; every entry still adds its samples in sample order.
-  double mean[10], G[6][10], g0[10];
-  for (int e = 0; e < 10; ++e) {
-    mean[e] = sums.mean[e];
-    g0[e] = p.g0[e];
-    for (int f = 0; f < 6; ++f) G[f][e] = sums.G(e, f);
-  }
-  int valid = sums.valid;
-  const Status* status = b.status.data() + first;
-  for (std::size_t n = 0; n < count; ++n) {
-    const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
-    if (status[k] != Status::converged) continue;
-    double v[10], d[10], z[6];
-    bool finite = true;
-    for (int e = 0; e < 10; ++e) {
-      v[e] = v0[e][k];
-      finite = finite && std::isfinite(v[e]);
-    }
-    if (!finite) continue;
-    for (int f = 0; f < 6; ++f) z[f] = z0[f][k];
-    for (int e = 0; e < 10; ++e) {
-      mean[e] += v[e];
-      d[e] = v[e] - g0[e];
-    }
-    for (int f = 0; f < 6; ++f)
-      for (int e = 0; e < 10; ++e) G[f][e] += d[e] * z[f];
-    ++valid;
-  }
-  for (int e = 0; e < 10; ++e) {
-    sums.mean[e] = mean[e];
-    for (int f = 0; f < 6; ++f) sums.G(e, f) = G[f][e];
-  }
-  sums.valid = valid;
+/// Adds samples [first, first + count) of the block (the first sample of antithetic pair e at first + e, its copy
+/// at first + evens + e: build()) to the pair's sums, in the kernels' lanes: each sample's values (distance, witness
+/// points, normal in A's frame) minus the unperturbed ones, times its noise z, and the values themselves; a sample
+/// without a converged, finite answer adds nothing.
+void accumulate(const Context& c, Block& b, std::size_t first, std::size_t count, Sums& sums) {
+  const double* z[6];
+  for (int f = 0; f < 6; ++f) z[f] = b.at(Block::kZ + f) + first;
+  kernels::simd::accumulate_samples(c.isa, b.row(first), b.status.data() + first, z, count, (count + 1) / 2, sums);
 }
 
 /// The estimator from the sums, mapped from A's frame and A-frame noise to the world.
@@ -280,8 +244,9 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
   const std::size_t i = p.i;
   if (sums.valid == 0) return store_nothing(out, i);
   DerivativeResults& d = out.d;
-  const Values mean_a = sums.mean / sums.valid;
-  Eigen::Matrix<double, 10, 6> G = sums.G / sums.valid;
+  const Eigen::Matrix<double, 10, 1> mean_a = Eigen::Map<const Eigen::Matrix<double, 10, 1>>(sums.mean) / sums.valid;
+  Eigen::Matrix<double, 10, 6> G =
+      Eigen::Map<const Eigen::Matrix<double, 10, 6>, 0, Eigen::OuterStride<12>>(sums.G[0]) / sums.valid;
   // The score of the Gaussian over the noise scale: S^-1 z.
   G.leftCols<3>() /= p.s.translation;
   G.rightCols<3>() /= p.s.rotation;
@@ -317,8 +282,10 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
   const std::size_t M = static_cast<std::size_t>(c.o.samples);
   thread_local Block block;  // reused by every task of this thread (a task never waits on TBB)
   if (block.capacity != kBlockSamples) block.reserve(kBlockSamples);
-  std::vector<PairPlan> plans;
-  std::vector<Span> spans;
+  // Reused like the block: grown per call, a block's up to kBlockSamples / 2 plans were reallocated and copied
+  // ~8 times per call at M = 4.
+  thread_local std::vector<PairPlan> plans;
+  thread_local std::vector<Span> spans;
   StoreBlock out(d);
   Sums sums;
   std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
@@ -365,8 +332,11 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
     // Reduce: a span that ends its pair finishes it; the last span may continue in the next block.
     for (const Span& sp : spans) {
       const PairPlan& p = plans[sp.plan];
-      if (sp.j0 == 0) sums = Sums();
-      accumulate(p, block, sp.first, sp.count, sums);
+      if (sp.j0 == 0) {
+        sums = Sums();
+        for (int e = 0; e < 10; ++e) sums.g0[e] = p.g0[e];
+      }
+      accumulate(c, block, sp.first, sp.count, sums);
       if (sp.j0 + sp.count == M) finish_pair(c, p, sums, out);
     }
   }

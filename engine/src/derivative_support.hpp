@@ -4,6 +4,7 @@
 #pragma once
 
 #include "batchcol/shapes.hpp"
+#include "batchcol/types.hpp"
 
 #include <Eigen/Core>
 
@@ -72,8 +73,10 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
 /// z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k} (the baseline S(u) cancels within a pair),
 /// symmetrised and projected onto the positive semidefinite cone (the Hessian of the smoothed convex support
 /// function is symmetric PSD; the projection removes sampling noise that could make the implicit-function matrix
-/// singular, a bias that vanishes as M grows). Noise keyed by (seed, pair, sample, stream).
+/// singular, a bias that vanishes as M grows). Noise keyed by (seed, pair, sample, stream), drawn by `isa`'s
+/// kernels (resolved; every set gives the same bits).
 Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
-                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream);
+                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
+                                          InstructionSet isa);
 
 }  // namespace batchcol::detail

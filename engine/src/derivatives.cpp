@@ -175,7 +175,7 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
 
 // One pair, analytic or smoothed1. The support directions are n for a and -n for b, taken to each local frame.
 void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                        const DerivativeOptions& o, std::size_t i, StoreBlock& out) {
+                        const DerivativeOptions& o, InstructionSet isa, std::size_t i, StoreBlock& out) {
   if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out)) return;
   DerivativeResults& d = out.d;
   PairGeometry g;
@@ -245,8 +245,10 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     const auto direction_noise = [&](const Shape& s) {
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
-    g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1) * R_a.transpose();
-    g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2) * R_b.transpose();
+    g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1, isa) *
+            R_a.transpose();
+    g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2, isa) *
+            R_b.transpose();
   }
   double* slot = nullptr;
   if (o.method == DerivativeMethod::analytic && polytope_pair(g)) {
@@ -272,11 +274,11 @@ void check_sizes(const PairBatch& batch, const PairResults& results) {
                      " pairs; run collide() at QueryLevel::witness or penetration)");
 }
 
-}  // namespace
-}  // namespace detail
-
-void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                           const DerivativeOptions& options, int threads, DerivativeResults& derivatives) {
+/// differentiate_results() with the smoothed1 noise drawn by `isa`'s kernels (the same bits on every set: the
+/// choice only follows QueryOptions::isa when differentiate() calls it).
+void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
+                              const DerivativeOptions& options, int threads, InstructionSet isa,
+                              DerivativeResults& derivatives) {
   validate(options);
   if (options.method == DerivativeMethod::smoothed0)
     throw InputError("method: smoothed0 runs new queries; call differentiate() instead of differentiate_results()");
@@ -285,8 +287,16 @@ void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, con
   detail::size_for(derivatives, batch.size(), false);  // every pair writes all its entries
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
     detail::StoreBlock out(derivatives);
-    for (std::size_t i = begin; i < end; ++i) detail::differentiate_pair(shapes, batch, results, options, i, out);
+    for (std::size_t i = begin; i < end; ++i) differentiate_pair(shapes, batch, results, options, isa, i, out);
   });
+}
+
+}  // namespace
+}  // namespace detail
+
+void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
+                           const DerivativeOptions& options, int threads, DerivativeResults& derivatives) {
+  detail::differentiate_results_on(shapes, batch, results, options, threads, resolve_instruction_set(), derivatives);
 }
 
 void differentiate(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,
@@ -300,7 +310,8 @@ void differentiate(const ShapeTable& shapes, const PairBatch& batch, const Query
   if (options.method == DerivativeMethod::smoothed0) {
     detail::smoothed0(shapes, batch, query, options, results, derivatives);
   } else {
-    differentiate_results(shapes, batch, results, options, query.threads, derivatives);
+    detail::differentiate_results_on(shapes, batch, results, options, query.threads,
+                                     resolve_instruction_set(query.isa), derivatives);
   }
 }
 

@@ -45,6 +45,13 @@ void build_samples(const SamplePlan& p, std::uint64_t a0, std::size_t count, std
                    const SampleArrays& even, const SampleArrays& odd) {
   WideSamples::run(p, a0, count, odd_count, even, odd);
 }
+void accumulate_samples(const double* values, const Status* status, const double* const* z, std::size_t count,
+                        std::size_t evens, SampleSums& sums) {
+  WideSamples::accumulate(values, status, z, count, evens, sums);
+}
+void draw_gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count, double* const* z) {
+  WideSamples::gaussians4(key, stream, k0, count, z);
+}
 
 std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, const std::uint32_t* pairs,
                           std::size_t n, const ClosedFormQuery& query, const ResultView& out,

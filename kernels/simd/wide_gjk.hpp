@@ -68,6 +68,9 @@ struct SampleResults {
   double* witness_a[3] = {};
   double* witness_b[3] = {};
   double* normal[3] = {};
+  /// Sample s's entries are at [s * stride]: 1 for arrays, more for one record per sample (smoothed0's reduction
+  /// reads a sample's 10 values as one contiguous row).
+  std::size_t stride = 1;
 };
 
 /// GJK on every sample of `in` (kernels/simd/wide_gjk_samples.inl): the answer setup_pair_into(), the SIMD GJK and
@@ -109,5 +112,24 @@ struct SampleArrays {
 /// at index k - a0 of `odd` for the first odd_count pairs. The same bits on every instruction set.
 void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
                    std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd);
+/// One pair's running sums of the smoothed0 estimator (engine/src/derivative_smoothed0.cpp), in A's frame: over the
+/// samples that entered (`valid` of them), the sum of their 10 values v (distance, witness a, witness b, normal) and
+/// the sums of (v - g0) z_f for the 6 noise coordinates f. Rows of 12 (two padding entries) for whole registers.
+struct SampleSums {
+  double mean[12] = {};
+  double G[6][12] = {};
+  double g0[12] = {};  // the unperturbed answer; padding 0
+  int valid = 0;
+};
+/// Adds `count` samples to `sums` in sample order (sample 2e at index e, 2e+1 at evens + e; each entry adds its
+/// samples one after the other, so a pair split over calls gives the same bits): sample k's values are
+/// values[12 k .. 12 k + 9] (padding 0), its noise z[f][k]; a sample whose status is not converged or with a
+/// non-finite value adds nothing. The same bits on every set (elementwise IEEE operations, no contraction).
+void accumulate_samples(InstructionSet isa, const double* values, const Status* status, const double* const* z,
+                        std::size_t count, std::size_t evens, SampleSums& sums);
+/// engine/src/counter_rng.hpp's gaussian_vector<4>(seed, pair, k, stream) for k = k0 .. k0 + count - 1 into
+/// z[0..3][k - k0], W draws per register (key = splitmix64(splitmix64(seed) ^ pair)). The same bits on every set.
+void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream, std::uint64_t k0,
+                     std::size_t count, double* const* z);
 
 }  // namespace batchcol::kernels::simd

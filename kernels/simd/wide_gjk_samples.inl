@@ -112,11 +112,12 @@ template <class T> struct WideGjkSamples {
         return;
       }
       out.status[s] = r.status;
-      out.distance[s] = double(r.distance);
+      const std::size_t k = s * out.stride;
+      out.distance[k] = double(r.distance);
       for (int c = 0; c < 3; ++c) {
-        out.witness_a[c][s] = double(r.witness_a[c]);
-        out.witness_b[c][s] = double(r.witness_b[c]);
-        out.normal[c][s] = double(r.normal[c]);
+        out.witness_a[c][k] = double(r.witness_a[c]);
+        out.witness_b[c][k] = double(r.witness_b[c]);
+        out.normal[c][k] = double(r.normal[c]);
       }
     }
   };

@@ -22,11 +22,30 @@ struct WideSamples {
   }
   static real splat(double v) { return real{} + v; }
 
+  /// x (at most 2^53) as a double, exactly. AVX-512DQ converts 64-bit lanes natively; AVX2 has no such instruction
+  /// and GCC converted lane by lane through scalar registers (a fifth of this file's instructions): there the 32-bit
+  /// halves go through the 2^52 exponent trick and hi 2^32 + lo is exact (at most 53 significant bits).
+  static real exact_u53(u64 x) {
+#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
+    return __builtin_convertvector(x, real);
+#else
+    const u64 hi = (x >> 32) | 0x4330000000000000ull, lo = (x & 0xFFFFFFFFull) | 0x4330000000000000ull;
+    return ((real)hi - 0x1.0p52) * 0x1.0p32 + ((real)lo - 0x1.0p52);
+#endif
+  }
+  /// A small signed lane integer (|k| < 2^51) as a double, exactly (the same trick).
+  static real exact_small(mask k) {
+#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
+    return __builtin_convertvector(k, real);
+#else
+    return (real)(k + 0x4338000000000000ll) - 0x1.8p52;
+#endif
+  }
   /// CounterRng::uniform(): (next >> 11) + 1 times 2^-53, exact.
   static real uniform(u64& state) {
     state += 0x9E3779B97F4A7C15ull;
     const u64 x = (splitmix(state) >> 11) + 1;
-    return __builtin_convertvector(x, real) * 0x1.0p-53;
+    return exact_u53(x) * 0x1.0p-53;
   }
   /// counter_rng.hpp's log_unit, lane by lane.
   static real log_unit(real u) {
@@ -41,7 +60,7 @@ struct WideSamples {
     const real p = (((((((((((1.0 / 23.0) * z + 1.0 / 21.0) * z + 1.0 / 19.0) * z + 1.0 / 17.0) * z + 1.0 / 15.0) *
                             z + 1.0 / 13.0) * z + 1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) *
                       z + 1.0 / 3.0) * z + 1.0;
-    return __builtin_convertvector(k, real) * 0.6931471805599453 + 2.0 * s * p;
+    return exact_small(k) * 0.6931471805599453 + 2.0 * s * p;
   }
   /// counter_rng.hpp's sinc_cos_small.
   static void sinc_cos_small(real x, real& sinc, real& cos) {
@@ -54,8 +73,18 @@ struct WideSamples {
   }
   /// counter_rng.hpp's sincos_turn: the quarter turn q = int(4u + 0.5) removed exactly, then the series.
   static void sincos_turn(real u, real& sin, real& cos) {
+    // q = int(4u + 0.5) (u in (0, 1]: 0 .. 4), as the scalar code's truncation. Without AVX-512DQ: rounded through
+    // the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's low mantissa bits.
+#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
     const mask q = __builtin_convertvector(4.0 * u + 0.5, mask);
-    const real x = 6.283185307179586 * (u - 0.25 * __builtin_convertvector(q, real));
+    const real qd = __builtin_convertvector(q, real);
+#else
+    const real v = 4.0 * u + 0.5;
+    real qd = (v + 0x1.8p52) - 0x1.8p52;
+    qd = select(qd > v, qd - 1.0, qd);
+    const mask q = (mask)(qd + 0x1.8p52);
+#endif
+    const real x = 6.283185307179586 * (u - 0.25 * qd);
     real sx, cx;
     sinc_cos_small(x, sx, cx);
     sx *= x;
@@ -65,6 +94,100 @@ struct WideSamples {
     cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
   }
 
+  /// gaussian_vector<N>(seed, pair, k, stream) for k = k0 .. k0 + W - 1, lane by lane (key: splitmix(splitmix(seed)
+  /// ^ pair), as SamplePlan::key).
+  template <int N> static void gaussians(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, real* z) {
+    u64 index{};
+    for (int l = 0; l < W; ++l) index[l] = k0 + std::uint64_t(l);
+    u64 state = splitmix(splitmix((u64{} + key) ^ index) ^ stream);
+    for (int g = 0; g < N; g += 2) {
+      const real radius = wsqrt<double>(-2.0 * log_unit(uniform(state)));
+      real s, c;
+      sincos_turn(uniform(state), s, c);
+      z[g] = radius * c;
+      z[g + 1] = radius * s;
+    }
+  }
+
+  /// gaussian_vector<4>(seed, pair, k, stream) for k = k0 .. k0 + count - 1 into z[c][k - k0] (the smoothed1
+  /// support samples, engine/src/derivative_support.cpp: drawn W at a time instead of one libm-free scalar draw each).
+  static void gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count,
+                         double* const* z) {
+    for (std::size_t e0 = 0; e0 < count; e0 += W) {
+      real v[4];
+      gaussians<4>(key, stream, k0 + e0, v);
+      const std::size_t lanes = std::min<std::size_t>(W, count - e0);
+      for (int c = 0; c < 4; ++c) {
+        if (lanes == std::size_t(W)) std::memcpy(z[c] + e0, &v[c], sizeof v[c]);
+        else for (std::size_t l = 0; l < lanes; ++l) z[c][e0 + l] = v[c][l];
+      }
+    }
+  }
+
+  typedef double v4 __attribute__((vector_size(32)));
+  typedef double v4u __attribute__((vector_size(32), aligned(8)));  // an unaligned load of 4 doubles
+
+  /// One pass of accumulate() over the valid samples idx[0 .. m): the sums of noise columns fa and fa + 1, and with
+  /// kMean the values' sums. 3 + 3 (+ 3) accumulators, g0, d and the broadcast fit AVX2's 16 registers: with all
+  /// 21 accumulators in one loop GCC kept them on the stack (~130 instructions per sample, ~75 in three passes).
+  template <bool kMean>
+  static void pass(const double* values, const std::uint32_t* idx, int m, const double* const* z, int fa,
+                   double* mean_sums, double (*G_sums)[12], const v4* g0) {
+    // Named vectors, not arrays: GCC kept memcpy-initialised arrays on the stack.
+    v4 a0, a1, a2, b0, b1, b2, m0 = {}, m1 = {}, m2 = {};
+    std::memcpy(&a0, G_sums[fa], 32), std::memcpy(&a1, G_sums[fa] + 4, 32), std::memcpy(&a2, G_sums[fa] + 8, 32);
+    std::memcpy(&b0, G_sums[fa + 1], 32), std::memcpy(&b1, G_sums[fa + 1] + 4, 32);
+    std::memcpy(&b2, G_sums[fa + 1] + 8, 32);
+    if constexpr (kMean)
+      std::memcpy(&m0, mean_sums, 32), std::memcpy(&m1, mean_sums + 4, 32), std::memcpy(&m2, mean_sums + 8, 32);
+    const double *za = z[fa], *zb = z[fa + 1];
+    const v4 g00 = g0[0], g01 = g0[1], g02 = g0[2];
+    for (int i = 0; i < m; ++i) {
+      const std::uint32_t k = idx[i];
+      const v4u* row = reinterpret_cast<const v4u*>(values + 12 * std::size_t(k));
+      const v4 v0 = row[0], v1 = row[1], v2 = row[2];
+      if constexpr (kMean) m0 += v0, m1 += v1, m2 += v2;
+      const v4 d0 = v0 - g00, d1 = v1 - g01, d2 = v2 - g02;
+      const double a = za[k], b = zb[k];
+      a0 += d0 * a, a1 += d1 * a, a2 += d2 * a;
+      b0 += d0 * b, b1 += d1 * b, b2 += d2 * b;
+    }
+    std::memcpy(G_sums[fa], &a0, 32), std::memcpy(G_sums[fa] + 4, &a1, 32), std::memcpy(G_sums[fa] + 8, &a2, 32);
+    std::memcpy(G_sums[fa + 1], &b0, 32), std::memcpy(G_sums[fa + 1] + 4, &b1, 32);
+    std::memcpy(G_sums[fa + 1] + 8, &b2, 32);
+    if constexpr (kMean)
+      std::memcpy(mean_sums, &m0, 32), std::memcpy(mean_sums + 4, &m1, 32), std::memcpy(mean_sums + 8, &m2, 32);
+  }
+
+  /// accumulate_samples() (wide_gjk.hpp): a row of 12 is three 4-lane vectors on every set; each entry's sums take
+  /// the valid samples in sample order, so the order of the passes over the columns does not change a bit.
+  static void accumulate(const double* values, const Status* status, const double* const* z, std::size_t count,
+                         std::size_t evens, SampleSums& sums) {
+    v4 g0[3];
+    std::memcpy(g0, sums.g0, sizeof g0);
+    constexpr std::size_t kChunk = 256;
+    std::uint32_t idx[kChunk];
+    for (std::size_t n0 = 0; n0 < count; n0 += kChunk) {
+      const std::size_t n1 = std::min(count, n0 + kChunk);
+      int m = 0;
+      for (std::size_t n = n0; n < n1; ++n) {
+        const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
+        if (status[k] != Status::converged) continue;
+        const v4u* row = reinterpret_cast<const v4u*>(values + 12 * k);
+        const v4 v0 = row[0], v1 = row[1], v2 = row[2];
+        // x - x is 0 exactly when x is finite (NaN for inf and NaN), and a sum of zeros and NaNs is 0 only
+        // without a NaN.
+        const v4 t = (v0 - v0) + (v1 - v1) + (v2 - v2);
+        if (!((t[0] + t[1]) + (t[2] + t[3]) == 0.0)) continue;
+        idx[m++] = std::uint32_t(k);
+      }
+      pass<true>(values, idx, m, z, 0, sums.mean, sums.G, g0);
+      pass<false>(values, idx, m, z, 2, sums.mean, sums.G, g0);
+      pass<false>(values, idx, m, z, 4, sums.mean, sums.G, g0);
+      sums.valid += m;
+    }
+  }
+
   /// Samples of antithetic pairs a0 .. a0 + count - 1 of plan p: pair e's first sample goes to index e of `even`,
   /// its antithetic copy to index e of `odd` (odd's arrays may be null when count == 1 and the copy is not wanted:
   /// `odd_count` copies are written, count or count - 1).
@@ -72,18 +195,9 @@ struct WideSamples {
                   const SampleArrays& even, const SampleArrays& odd) {
     for (std::size_t e0 = 0; e0 < count; e0 += W) {
       const int lanes = int(std::min<std::size_t>(W, count - e0));
-      u64 index{};
-      for (int l = 0; l < W; ++l) index[l] = a0 + e0 + std::uint64_t(l);
       // CounterRng(seed, pair, k, 0): p.key holds splitmix(splitmix(seed) ^ pair).
-      u64 state = splitmix(splitmix((u64{} + p.key) ^ index) ^ std::uint64_t(0));
       real z[6];
-      for (int g = 0; g < 6; g += 2) {
-        const real radius = wsqrt<double>(-2.0 * log_unit(uniform(state)));
-        real s, c;
-        sincos_turn(uniform(state), s, c);
-        z[g] = radius * c;
-        z[g + 1] = radius * s;
-      }
+      gaussians<6>(p.key, 0, a0 + e0, z);
       // exp([w]x) through the unit quaternion (cos h, sin(h) w / (2h)), h = |w| / 2 (the engine's rotation_exp).
       const real w0 = p.rotation * z[3], w1 = p.rotation * z[4], w2 = p.rotation * z[5];
       const real angle2 = (w0 * w0 + w1 * w1) + w2 * w2;

@@ -1,7 +1,8 @@
 // The smoothed0 sample builder (kernels::simd::build_samples): its noise is engine/src/counter_rng.hpp's
 // gaussian_vector<6> bit for bit on every instruction set, antithetic copies are exact negations with the
 // transposed rotation, the poses are E R0 and t0 + s_t z with E the rotation exponential of s_w z_w, and the first
-// directions follow the plan.
+// directions follow the plan. The smoothed1 draws (draw_gaussians4) are gaussian_vector<4> bit for bit, and the
+// smoothed0 reduction (accumulate_samples) is the scalar sample-order sums bit for bit, on every instruction set.
 #include "batchcol/batch.hpp"  // to_string(InstructionSet)
 #include "counter_rng.hpp"  // engine/src
 #include "kernels/simd/wide_gjk.hpp"
@@ -10,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -91,6 +93,109 @@ TEST(WideSamples, NoiseIsTheCounterGeneratorsAndPosesFollowThePlan) {
         all.insert(all.end(), odd.data.begin(), odd.data.end());
         if (reference.empty()) reference = all;
         else EXPECT_EQ(std::memcmp(all.data(), reference.data(), all.size() * sizeof(double)), 0);
+      }
+    }
+  }
+}
+
+TEST(WideSamples, SmoothedFirstOrderDrawsAreTheCounterGenerators) {
+  // Many keys and counts (partial registers), so that the uniforms' conversions and the quarter-turn rounding meet
+  // many values (AVX2 converts 64-bit lanes without a conversion instruction).
+  for (std::uint64_t pair : {0ull, 3ull, 1000003ull}) {
+    for (std::uint64_t stream : {1ull, 2ull}) {
+      const std::size_t count = 1000 + pair % 7;
+      const std::uint64_t key = detail::splitmix64(detail::splitmix64(77) ^ pair);
+      for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
+        if (!kernels::simd::cpu_has(isa)) continue;
+        SCOPED_TRACE(to_string(isa));
+        std::vector<double> buffer(4 * count, -7.0);
+        double* const z[4] = {buffer.data(), buffer.data() + count, buffer.data() + 2 * count,
+                              buffer.data() + 3 * count};
+        kernels::simd::draw_gaussians4(isa, key, stream, 11, count, z);
+        for (std::size_t k = 0; k < count; ++k) {
+          double r[4];
+          detail::gaussian_vector<4>(77, pair, 11 + k, stream, r);
+          for (int c = 0; c < 4; ++c) ASSERT_TRUE(same(z[c][k], r[c])) << pair << " " << k << " " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
+  // 23 samples (an odd count: 12 firsts, 11 copies), values of all magnitudes, one non-converged sample and one
+  // with an infinite entry; the sums are taken in two calls (a pair split over blocks) and in one.
+  const std::size_t count = 23, evens = 12;
+  std::vector<double> values(12 * count, 0.0), zdata(6 * count);
+  std::vector<Status> status(count, Status::converged);
+  std::uint64_t state = 5;
+  const auto next = [&] {
+    state = detail::splitmix64(state);
+    return std::ldexp(double(state >> 11) * 0x1.0p-53 - 0.5, int(state % 40) - 20);
+  };
+  for (std::size_t k = 0; k < count; ++k) {
+    for (int e = 0; e < 10; ++e) values[12 * k + e] = next();
+    for (int f = 0; f < 6; ++f) zdata[f * count + k] = next();
+  }
+  status[4] = Status::max_iterations;
+  values[12 * 7 + 5] = INFINITY;
+  const double* z[6];
+  for (int f = 0; f < 6; ++f) z[f] = zdata.data() + f * count;
+  double g0[10];
+  for (double& g : g0) g = next();
+  // The reference: the scalar loop of the sums, sample by sample.
+  double mean[10] = {}, G[6][10] = {};
+  int valid = 0;
+  for (std::size_t n = 0; n < count; ++n) {
+    const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
+    bool finite = status[k] == Status::converged;
+    for (int e = 0; e < 10; ++e) finite = finite && std::isfinite(values[12 * k + e]);
+    if (!finite) continue;
+    for (int e = 0; e < 10; ++e) {
+      mean[e] += values[12 * k + e];
+      for (int f = 0; f < 6; ++f) G[f][e] += (values[12 * k + e] - g0[e]) * z[f][k];
+    }
+    ++valid;
+  }
+  EXPECT_EQ(valid, 21);
+  for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
+    if (!kernels::simd::cpu_has(isa)) continue;
+    SCOPED_TRACE(to_string(isa));
+    kernels::simd::SampleSums whole, split;
+    for (int e = 0; e < 10; ++e) whole.g0[e] = split.g0[e] = g0[e];
+    kernels::simd::accumulate_samples(isa, values.data(), status.data(), z, count, evens, whole);
+    // The first 10 samples (5 pairs) of a block holding only them, then the rest as the next block would.
+    {
+      const std::size_t part = 10, part_evens = 5;
+      std::vector<double> v(12 * part), zd(6 * part);
+      std::vector<Status> st(part);
+      for (std::size_t n = 0; n < part; ++n) {
+        const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2, kk = n % 2 == 0 ? n / 2 : part_evens + n / 2;
+        std::copy_n(values.data() + 12 * k, 12, v.data() + 12 * kk);
+        for (int f = 0; f < 6; ++f) zd[f * part + kk] = z[f][k];
+        st[kk] = status[k];
+      }
+      const double* zp[6];
+      for (int f = 0; f < 6; ++f) zp[f] = zd.data() + f * part;
+      kernels::simd::accumulate_samples(isa, v.data(), st.data(), zp, part, part_evens, split);
+      const std::size_t rest = count - part, rest_evens = (rest + 1) / 2;
+      std::vector<double> v2(12 * rest), zd2(6 * rest);
+      std::vector<Status> st2(rest);
+      for (std::size_t n = 0; n < rest; ++n) {
+        const std::size_t m = part + n, k = m % 2 == 0 ? m / 2 : evens + m / 2;
+        const std::size_t kk = n % 2 == 0 ? n / 2 : rest_evens + n / 2;
+        std::copy_n(values.data() + 12 * k, 12, v2.data() + 12 * kk);
+        for (int f = 0; f < 6; ++f) zd2[f * rest + kk] = z[f][k];
+        st2[kk] = status[k];
+      }
+      for (int f = 0; f < 6; ++f) zp[f] = zd2.data() + f * rest;
+      kernels::simd::accumulate_samples(isa, v2.data(), st2.data(), zp, rest, rest_evens, split);
+    }
+    for (const kernels::simd::SampleSums* s : {&whole, &split}) {
+      EXPECT_EQ(s->valid, valid);
+      for (int e = 0; e < 10; ++e) {
+        EXPECT_TRUE(same(s->mean[e], mean[e])) << e;
+        for (int f = 0; f < 6; ++f) EXPECT_TRUE(same(s->G[f][e], G[f][e])) << e << " " << f;
       }
     }
   }
