@@ -64,15 +64,21 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   const V onx = splat(r.o_near[0]), ony = splat(r.o_near[1]), onz = splat(r.o_near[2]);
   const V ofx = splat(r.o_far[0]), ofy = splat(r.o_far[1]), ofz = splat(r.o_far[2]);
   const V nix = splat(-r.inv[0]), niy = splat(-r.inv[1]), niz = splat(-r.inv[2]);
-  const V zero = splat(0.0f), scale = splat(kFarScale), slack = splat(kFarSlack);
+  const V scale = splat(kFarScale), slack = splat(kFarSlack);
+  // The compiler is not told that `zero` is 0: knowing it, it turns the first max_into() into a compare and a mask
+  // (two instructions) instead of one ordered max, the same value.
+  float zero_scalar = 0.0f;
+  __asm__("" : "+x"(zero_scalar));
+  const V zero = splat(zero_scalar);
   // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
   // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
   Entry e{0u, 0.0f};  // the root
-  // `limit` lives in memory (visit() may lower it through its address); `lim` is its copy for the loop, refreshed
-  // after every visit, so the node test does not reload it.
+  // `limit` lives in memory (visit() may lower it through its address); `lim` and `lim_v` are its copies for the
+  // loop, refreshed after every visit, so the node test neither reloads nor broadcasts it.
   float lim = limit;
+  V lim_v = splat(lim);
   // The next entry still within reach (a closer hit may have been found since it was pushed); false when none.
   const auto pop = [&] {
     do {
@@ -90,6 +96,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       }
       const bool go_on = visit(context, leaf, limit);
       lim = limit;
+      lim_v = splat(lim);
       if (!go_on || !pop()) return;
       continue;
     }
@@ -98,7 +105,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     tn = max_into((onx - load_at(n, near_x)) * nix, tn);
     tn = max_into((ony - load_at(n, near_y)) * niy, tn);
     tn = max_into((onz - load_at(n, near_z)) * niz, tn);
-    V tf = splat(lim);
+    V tf = lim_v;
     tf = min_into((ofx - load_at(n, far_x)) * nix, tf);
     tf = min_into((ofy - load_at(n, far_y)) * niy, tf);
     tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
