@@ -48,8 +48,9 @@ struct Entry {
 // included, as in make_wide_ray()): which of a node's lo / hi arrays is the near and which the far plane is then a
 // constant offset, so each plane is one subtraction with a memory operand, and the ray's offsets stay out of the
 // registers the loop needs. The parameter is computed as (o - plane) * (-inv): round-to-nearest is symmetric, so
-// fl(o - p) = -fl(p - o) and fl(-a * -b) = fl(a * b): bitwise the (plane - o) * inv of the header's analysis, the same
-// visiting order as before and on every instruction set.
+// fl(o - p) = -fl(p - o) and fl(-a * -b) = fl(a * b): the value of the header's (plane - o) * inv (only a zero may
+// come out with the other sign, which no comparison below sees), so the visiting order is the one before and the
+// same on every instruction set.
 namespace {
 
 template <int kOctant>
