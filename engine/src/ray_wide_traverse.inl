@@ -8,7 +8,7 @@ typedef int M __attribute__((vector_size(32)));
 
 inline V splat(float x) { return V{x, x, x, x, x, x, x, x}; }
 
-inline V load_at(const WideNode* node, std::uint32_t byte_offset) {
+inline V load_at(const WideNode* node, std::size_t byte_offset) {
   V v;
   __builtin_memcpy(&v, reinterpret_cast<const char*>(node) + byte_offset, sizeof v);
   return v;
@@ -44,22 +44,48 @@ struct Entry {
 
 }  // namespace
 
-void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+// The loop for one octant of ray directions (bit k of kOctant: the direction's component k is negative, -0
+// included, as in make_wide_ray()): which of a node's lo / hi arrays is the near and which the far plane is then a
+// constant offset, so each plane is one subtraction with a memory operand, and the ray's offsets stay out of the
+// registers the loop needs. The parameter is computed as (o - plane) * (-inv): round-to-nearest is symmetric, so
+// fl(o - p) = -fl(p - o) and fl(-a * -b) = fl(a * b): the value of the header's (plane - o) * inv (only a zero may
+// come out with the other sign, which no comparison below sees), so the visiting order is the one before and the
+// same on every instruction set.
+namespace {
+
+template <int kOctant>
+void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+  constexpr bool neg_x = (kOctant & 1) != 0, neg_y = (kOctant & 2) != 0, neg_z = (kOctant & 4) != 0;
+  constexpr std::size_t near_x = neg_x ? offsetof(WideNode, hi_x) : offsetof(WideNode, lo_x);
+  constexpr std::size_t near_y = neg_y ? offsetof(WideNode, hi_y) : offsetof(WideNode, lo_y);
+  constexpr std::size_t near_z = neg_z ? offsetof(WideNode, hi_z) : offsetof(WideNode, lo_z);
+  constexpr std::size_t far_x = neg_x ? offsetof(WideNode, lo_x) : offsetof(WideNode, hi_x);
+  constexpr std::size_t far_y = neg_y ? offsetof(WideNode, lo_y) : offsetof(WideNode, hi_y);
+  constexpr std::size_t far_z = neg_z ? offsetof(WideNode, lo_z) : offsetof(WideNode, hi_z);
   const V onx = splat(r.o_near[0]), ony = splat(r.o_near[1]), onz = splat(r.o_near[2]);
   const V ofx = splat(r.o_far[0]), ofy = splat(r.o_far[1]), ofz = splat(r.o_far[2]);
-  const V ix = splat(r.inv[0]), iy = splat(r.inv[1]), iz = splat(r.inv[2]);
-  const V zero = splat(0.0f), scale = splat(kFarScale), slack = splat(kFarSlack);
+  const V nix = splat(-r.inv[0]), niy = splat(-r.inv[1]), niz = splat(-r.inv[2]);
+  const V scale = splat(kFarScale), slack = splat(kFarSlack);
+  // The compiler is not told that `zero` is 0: knowing it, it turns the first max_into() into a compare and a mask
+  // (two instructions) instead of one ordered max, the same value.
+  float zero_scalar = 0.0f;
+  __asm__("" : "+x"(zero_scalar));
+  const V zero = splat(zero_scalar);
   // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
   // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
   Entry e{0u, 0.0f};  // the root
+  // `limit` lives in memory (visit() may lower it through its address); `lim` and `lim_v` are its copies for the
+  // loop, refreshed after every visit, so the node test neither reloads nor broadcasts it.
+  float lim = limit;
+  V lim_v = splat(lim);
   // The next entry still within reach (a closer hit may have been found since it was pushed); false when none.
   const auto pop = [&] {
     do {
       if (top == 0) return false;
       e = stack[--top];
-    } while (e.t > limit);
+    } while (e.t > lim);
     return true;
   };
   for (;;) {
@@ -69,18 +95,21 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
         if (!pop()) return;
         continue;
       }
-      if (!visit(context, leaf, limit) || !pop()) return;
+      const bool go_on = visit(context, leaf, limit);
+      lim = limit;
+      lim_v = splat(lim);
+      if (!go_on || !pop()) return;
       continue;
     }
     const WideNode* n = nodes + e.ref;
     V tn = zero;
-    tn = max_into((load_at(n, r.near_offset[0]) - onx) * ix, tn);
-    tn = max_into((load_at(n, r.near_offset[1]) - ony) * iy, tn);
-    tn = max_into((load_at(n, r.near_offset[2]) - onz) * iz, tn);
-    V tf = splat(limit);
-    tf = min_into((load_at(n, r.far_offset[0]) - ofx) * ix, tf);
-    tf = min_into((load_at(n, r.far_offset[1]) - ofy) * iy, tf);
-    tf = min_into((load_at(n, r.far_offset[2]) - ofz) * iz, tf);
+    tn = max_into((onx - load_at(n, near_x)) * nix, tn);
+    tn = max_into((ony - load_at(n, near_y)) * niy, tn);
+    tn = max_into((onz - load_at(n, near_z)) * niz, tn);
+    V tf = lim_v;
+    tf = min_into((ofx - load_at(n, far_x)) * nix, tf);
+    tf = min_into((ofy - load_at(n, far_y)) * niy, tf);
+    tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
     tf = tf * scale + slack;
     std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
     if (bits == 0) {
@@ -108,20 +137,40 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
       e = Entry{n->child[near], entry[near]};
       continue;
     }
-    Entry hit[kWideArity];
-    int count = 0;
-    while (bits != 0) {
-      const int k = __builtin_ctz(bits);
-      bits &= bits - 1;
-      Entry x{n->child[k], entry[k]};
-      int j = count++;
-      for (; j > 0 && hit[j - 1].t > x.t; --j) hit[j] = hit[j - 1];
-      hit[j] = x;
+    // Three or more: each hit child's rank in that order, counted without branches on the data: the hit children
+    // strictly nearer, plus the equally near ones in lower slots (entries are never NaN: tn starts at 0 and the
+    // ordered max drops NaN). Rank 0 is next; rank j >= 1 goes j places below the new top, so the stack pops them
+    // nearest first, exactly as the stable sort this replaces (and the same on every instruction set).
+    const int count = __builtin_popcount(bits);
+    Entry* const base = stack + top + count - 1;
+    for (std::uint32_t b = bits; b != 0; b &= b - 1) {
+      const int k = __builtin_ctz(b);
+      const float t = entry[k];
+      const V tk = splat(t);
+      const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
+      const int rank = __builtin_popcount(bits & (nearer | (same & ((1u << k) - 1u))));
+      base[-rank] = Entry{n->child[k], t};
+      if (r.prefetch && rank != 0) prefetch_node(nodes, n->child[k]);
     }
-    for (int j = count - 1; j >= 1; --j) {
-      stack[top++] = hit[j];
-      if (r.prefetch) prefetch_node(nodes, hit[j].ref);
-    }
-    e = hit[0];  // the nearest child next, without a trip through the stack
+    top += count - 1;
+    e = stack[top];  // rank 0: the nearest child next, without a trip through the stack
+  }
+}
+}  // namespace
+
+void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+  // The octant is read back from the near planes make_wide_ray() chose (hi: a negative component).
+  const int octant = (r.near_offset[0] == offsetof(WideNode, hi_x) ? 1 : 0) |
+                     (r.near_offset[1] == offsetof(WideNode, hi_y) ? 2 : 0) |
+                     (r.near_offset[2] == offsetof(WideNode, hi_z) ? 4 : 0);
+  switch (octant) {
+    case 0: return traverse_octant<0>(nodes, r, limit, visit, context);
+    case 1: return traverse_octant<1>(nodes, r, limit, visit, context);
+    case 2: return traverse_octant<2>(nodes, r, limit, visit, context);
+    case 3: return traverse_octant<3>(nodes, r, limit, visit, context);
+    case 4: return traverse_octant<4>(nodes, r, limit, visit, context);
+    case 5: return traverse_octant<5>(nodes, r, limit, visit, context);
+    case 6: return traverse_octant<6>(nodes, r, limit, visit, context);
+    default: return traverse_octant<7>(nodes, r, limit, visit, context);
   }
 }

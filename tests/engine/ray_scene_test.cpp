@@ -145,6 +145,53 @@ TEST(RayScene, MatchesBruteForceForEveryQuery) {
   expect_matches_brute_force(index, w, random_rays(rng, 1500));
 }
 
+TEST(RayScene, RaysGrazingTheExtremePointsOfTurnedHullsMatchBruteForce) {
+  // The ray index clips a hull's world box (its turned local box) to the box of its bounding ball about the local
+  // origin. Hulls here are off-centre (the origin is not their centre) and turned at random; rays pass 1e-7 inside
+  // each hull's extreme vertex along every world axis, parallel to another axis, where a box clipped too far would
+  // drop the hull. Every answer must be brute force's.
+  Rng rng(31);
+  auto table = std::make_shared<ShapeTable>();
+  for (int s = 0; s < 4; ++s) {
+    std::vector<Eigen::Vector3d> points;
+    const Eigen::Vector3d offset(uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4));
+    for (int k = 0; k < 40; ++k) points.push_back(offset + 0.5 * testing::random_unit_vector(rng));
+    table->add(Shape::convex(points));
+  }
+  World w(table);
+  for (int i = 0; i < 60; ++i) {
+    const Eigen::Vector3d t(uniform(rng, -4, 4), uniform(rng, -4, 4), uniform(rng, -4, 4));
+    w.handles.push_back(w.scene.add(static_cast<std::uint32_t>(i % 4), {t, testing::random_rotation(rng)}));
+  }
+  RaySceneIndex index;
+  index.update(w.scene);
+  RayBatch rays;
+  for (ObjectHandle h : w.handles) {
+    const Pose p = w.scene.pose(h);
+    const std::vector<Eigen::Vector3d>& local = (*w.table)[w.scene.shape(h)].hull->vertices;
+    for (int a = 0; a < 3; ++a) {
+      for (double sign : {-1.0, 1.0}) {
+        Eigen::Vector3d best = p.rotation * local[0] + p.translation;
+        for (const Eigen::Vector3d& v : local) {
+          const Eigen::Vector3d x = p.rotation * v + p.translation;
+          if (sign * x[a] > sign * best[a]) best = x;
+        }
+        const int b = (a + 1) % 3;
+        Eigen::Vector3d o = best, d = Eigen::Vector3d::Zero();
+        o[a] -= sign * 1e-7;
+        o[b] -= 20.0;
+        d[b] = 1.0;
+        rays.add(o, d, INFINITY);
+      }
+    }
+  }
+  expect_matches_brute_force(index, w, rays);
+  RayResults r;
+  index.cast(rays, RayOptions{}, r);
+  const long hits = std::count(r.hit.begin(), r.hit.end(), 1);
+  EXPECT_GT(hits, long(rays.size()) / 4);  // rays that reach their hull (and usually others) are common, not rare
+}
+
 TEST(RayScene, SmallScenes) {
   Rng rng(12);
   for (int n : {1, 2, 3, 17}) {

@@ -199,6 +199,48 @@ TEST(RayWideBvh, FloatTestNeverMissesABoxTheSegmentTouches) {
   EXPECT_GT(grazing, 1000);
 }
 
+TEST(RayWideBvh, ChildrenAreVisitedNearestFirstTiesInSlotOrderInEveryOctant) {
+  // Seven boxes in one wide node (three of them identical, so their entries tie), crossed by a ray along +-x in each
+  // of the 8 direction octants: the traversal runs one loop per octant and ranks 3+ hit children without a sort, and
+  // must visit them by entry (the near plane: x_lo going +x, x_hi going -x), equal entries in slot order.
+  const float x_lo[7] = {0.0f, 3.0f, 1.0f, 3.0f, 5.0f, 2.0f, 3.0f};
+  broadphase::AabbSoa b;
+  b.resize(7);
+  for (std::size_t i = 0; i < 7; ++i) {
+    b.min_x[i] = x_lo[i], b.max_x[i] = x_lo[i] + 0.5f;
+    b.min_y[i] = b.min_z[i] = -1.0f, b.max_y[i] = b.max_z[i] = 1.0f;
+  }
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b);
+  ASSERT_EQ(wide.nodes().size(), 1u);  // the premise: every leaf is a child of the root
+  const WideNode& root = wide.nodes()[0];
+  for (int octant = 0; octant < 8; ++octant) {
+    const double sx = octant & 1 ? -1.0 : 1.0, sy = octant & 2 ? -1.0 : 1.0, sz = octant & 4 ? -1.0 : 1.0;
+    const double o[3] = {-50.0 * sx + 2.75, 0.0, 0.0}, d[3] = {sx, 1e-3 * sy, 1e-3 * sz};
+    std::vector<int> slots;
+    for (int s = 0; s < kWideArity; ++s)
+      if (root.child[s] != kWideEmpty) slots.push_back(s);
+    ASSERT_EQ(slots.size(), 7u);
+    const auto entry = [&](int s) {
+      const std::uint32_t i = bvh.leaf_object()[root.child[s] & ~kLeafBit];
+      return sx > 0 ? double(b.min_x[i]) : -double(b.max_x[i]);
+    };
+    std::stable_sort(slots.begin(), slots.end(), [&](int a, int c) { return entry(a) < entry(c); });
+    std::vector<std::uint32_t> expected;
+    for (int s : slots) expected.push_back(root.child[s] & ~kLeafBit);
+    const WideRay ray = make_wide_ray(o, d);
+    for (int isa = 0; isa < 3; ++isa) {
+      if (const WideTraverse traverse = wide_traverse_for(isa)) {
+        Leaves seen;
+        traverse(wide.nodes().data(), ray, wide_limit(INFINITY), record, &seen);
+        EXPECT_EQ(seen.seen, expected) << "octant " << octant << " isa " << isa;
+      }
+    }
+  }
+}
+
 TEST(RayWideBvh, FloatTestIsTightAndTheSameOnEveryInstructionSet) {
   // Random rays: every leaf the float test visits is hit by the exact test on the box widened by 1e-5 of its scale,
   // and every leaf the exact test hits on the box narrowed by 1e-5 is visited (no test this bounds can pass by
