@@ -152,31 +152,35 @@ template <class T> struct WideGjk {
   /// calls made GCC stop inlining hull_support_lanes() into the loop, which cost the small hulls' scan a call
   /// (convex8 witness double 3712 -> 3875 instructions per pair, callgrind AVX2).
   __attribute__((noinline)) static V3 large_hull_lanes(Side& s, const V3& d, std::uint32_t live) {
-    const real zero = splat(T(0));
-    V3 r{zero, zero, zero};
-    // The direction table's cells of all lanes at once; a lane whose cell is pure takes its vertex without a
-    // call, the others climb (hull_support_in_cell, this set's build, not ADL's kernels:: one).
+    // The direction table's cells of all lanes at once; a lane whose cell has an entry in the candidate table
+    // (pure: the vertex; else a short list) takes its vertex from it (cell_vertex()), the others climb
+    // (hull_support_in_cell, this set's build, not ADL's kernels:: one). The lanes go through arrays: element
+    // access on the vector types cost a store and reload per lane and coordinate.
     std::uint32_t cell[W];
     start_cells(d, cell);
-    for (int l = 0; l < W; ++l) {
-      if (!(live >> l & 1u)) continue;
+    alignas(sizeof(real)) T dx[W], dy[W], dz[W], rx[W] = {}, ry[W] = {}, rz[W] = {};
+    std::memcpy(dx, &d.x, sizeof dx);
+    std::memcpy(dy, &d.y, sizeof dy);
+    std::memcpy(dz, &d.z, sizeof dz);
+    for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
+      const int l = __builtin_ctz(bits);
       const HullView& h = *s.hull[l];
       const bool climbs = hull_climbs(h);
-      const std::uint32_t v = climbs ? pure_cell_vertex(h, cell[l]) : kNoHullVertex;
+      const Vec3<T> dl(dx[l], dy[l], dz[l]);
+      const std::uint32_t v = climbs ? cell_vertex(h, cell[l], dl) : kNoHullVertex;
       if (v != kNoHullVertex) {
         s.hint[l].vertex = v;
         const double* p = h.vertices + 3 * std::size_t(v);
-        r.x[l] = T(p[0]);
-        r.y[l] = T(p[1]);
-        r.z[l] = T(p[2]);
+        rx[l] = T(p[0]), ry[l] = T(p[1]), rz[l] = T(p[2]);
         continue;
       }
-      const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l],
-                                                               climbs ? cell[l] : kNoHullVertex);
-      r.x[l] = p.x();
-      r.y[l] = p.y();
-      r.z[l] = p.z();
+      const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, dl, s.hint[l], climbs ? cell[l] : kNoHullVertex);
+      rx[l] = p.x(), ry[l] = p.y(), rz[l] = p.z();
     }
+    V3 r;
+    std::memcpy(&r.x, rx, sizeof rx);
+    std::memcpy(&r.y, ry, sizeof ry);
+    std::memcpy(&r.z, rz, sizeof rz);
     return r;
   }
   /// start_cell() (kernels/hull_support.inl) of every lane's direction, with its operations lane by lane, so each
