@@ -72,6 +72,25 @@ inline std::uint32_t pure_cell_vertex(const HullView& hull, std::uint32_t cell) 
   return (e & kHullPureCell) && v < hull.vertex_count ? v : kNoHullVertex;
 }
 
+/// The support vertex of d from its cell's entry of HullView::cell_candidates (`cell` = start_cell(d)): a pure
+/// cell's vertex as it is, else the first maximum of hull_dot over the cell's list, whose indices ascend: the
+/// linear scan's vertex (engine/src/convex_hull.cpp, build_cell_candidates(), has the argument). A few dot
+/// products where a climb takes a few dozen. Returns kNoHullVertex when the cell has no entry (its supports climb).
+/// Only for a climbed hull (hull_climbs()).
+template <class T> inline std::uint32_t cell_vertex(const HullView& hull, std::uint32_t cell, const Vec3<T>& d) {
+  if (hull.cell_candidates == nullptr || cell == kNoHullVertex) return kNoHullVertex;
+  const std::uint32_t e = hull.cell_candidates[cell], n = e & 15u;
+  if (n <= 1) return n == 1 ? e >> 4 : kNoHullVertex;
+  const std::uint32_t* list = hull.cell_candidates + (e >> 4);
+  std::uint32_t best = list[0];
+  T best_dot = hull_dot(hull, best, d);
+  for (std::uint32_t i = 1; i < n; ++i) {
+    const T di = hull_dot(hull, list[i], d);
+    if (di > best_dot) best_dot = di, best = list[i];
+  }
+  return best;
+}
+
 template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3<T>& d, SupportHint& hint,
                                                 std::uint32_t cell);
 
@@ -102,12 +121,13 @@ template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3
   // Start from the better of the previous support vertex and the direction table's vertex: GJK's directions
   // swing by up to 180 degrees in the first iterations, and a climb from the previous vertex then crosses the
   // hull, while the table's vertex is within a cell (~3 degrees) of the answer. A pure cell is the answer itself
-  // (pure_cell_vertex()).
+  // (pure_cell_vertex()); most other cells list the few vertices the answer is among (cell_vertex()).
   best = hint.vertex < count ? hint.vertex : 0;
-  const std::uint32_t pure = pure_cell_vertex(hull, cell);
-  if (pure != kNoHullVertex) {
-    hint.vertex = pure;
-    return hull_point<T>(hull, pure);
+  std::uint32_t known = cell_vertex(hull, cell, d);
+  if (known == kNoHullVertex) known = pure_cell_vertex(hull, cell);  // (a hull without lists: only pure cells)
+  if (known != kNoHullVertex) {
+    hint.vertex = known;
+    return hull_point<T>(hull, known);
   }
   // Not pure: the entry is a plain vertex index (a flagged entry left here names no vertex of this hull).
   std::uint32_t t = hull.start_vertices != nullptr && cell != kNoHullVertex ? hull.start_vertices[cell] : kNoHullVertex;

@@ -4,12 +4,14 @@
 #include "convex_hull_search.hpp"
 
 #include "batchcol/errors.hpp"
+#include "kernels/support.hpp"  // kHillClimbMinVertices
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -99,6 +101,154 @@ void build_start_vertices(ConvexHull& hull) {
       }
     }
     hull.start_vertices[c] = pure_cell(hull, v, c) ? v | kHullPureCell : v;
+  }
+}
+
+/// Whether vertex u can be a support vertex of some direction of cube-map cell c widened by 1/1000 of a cell on
+/// each side (pure_cell()'s widening), with margin `margin` (per unit |d|): whether some d of the widened cell
+/// has <u - n, d> >= -margin |d| for every neighbour n of u. Conservative (true when unsure): |d| is bounded by
+/// its largest value on the widened cell, `dmax`, which makes every constraint linear in the cell coordinates
+/// (a, b) of d = d0 + a da + b db (cell_direction(c, a, b)); the widened square is clipped by the half-planes,
+/// and u passes if something is left (points within 1e-12 of a line kept: the margin is far above that).
+/// Neighbours n with first[n] == c are taken first (the vertices already found for cell c: the likeliest to beat u
+/// over the whole cell, which rejects u at once); `first` may be null.
+bool near_support_in_cell(const ConvexHull& hull, std::uint32_t u, const Eigen::Vector3d& d0, const Eigen::Vector3d& da,
+                          const Eigen::Vector3d& db, double margin, double dmax, const std::uint32_t* first,
+                          std::uint32_t c) {
+  if (hull.neighbor_offsets[u] == hull.neighbor_offsets[u + 1]) return false;  // on no face: no support vertex
+  if (first != nullptr) {  // the quick rejection: a found neighbour beats u at the widened cell's four corners
+    const double lo = -1e-3, hi = 1.0 + 1e-3;
+    for (std::uint32_t k = hull.neighbor_offsets[u]; k < hull.neighbor_offsets[u + 1]; ++k) {
+      if (first[hull.neighbors[k]] != c) continue;
+      const Eigen::Vector3d e = hull.vertices[u] - hull.vertices[hull.neighbors[k]];
+      const double g0 = e.dot(d0) + margin * dmax, ga = e.dot(da), gb = e.dot(db);
+      const double tol = 1e-12 * (std::abs(g0) + std::abs(ga) + std::abs(gb));
+      if (g0 + ga * lo + gb * lo < -tol && g0 + ga * hi + gb * lo < -tol && g0 + ga * hi + gb * hi < -tol &&
+          g0 + ga * lo + gb * hi < -tol)
+        return false;
+    }
+  }
+  constexpr int kMax = 32;  // a convex polygon clipped by lines: 4 + one vertex per line at most (the valence)
+  double poly[kMax][2], next[kMax][2];
+  int count = 4;
+  const double lo = -1e-3, hi = 1.0 + 1e-3;
+  const double square[4][2] = {{lo, lo}, {hi, lo}, {hi, hi}, {lo, hi}};
+  for (int i = 0; i < 4; ++i) poly[i][0] = square[i][0], poly[i][1] = square[i][1];
+  const Eigen::Vector3d& p = hull.vertices[u];
+  for (std::uint32_t k = hull.neighbor_offsets[u]; k < hull.neighbor_offsets[u + 1] && count > 0; ++k) {
+    const Eigen::Vector3d e = p - hull.vertices[hull.neighbors[k]];
+    // g(a, b) = <e, d0 + a da + b db> + margin dmax >= 0
+    const double g0 = e.dot(d0) + margin * dmax, ga = e.dot(da), gb = e.dot(db);
+    const double tol = 1e-12 * (std::abs(g0) + std::abs(ga) + std::abs(gb));
+    double g[kMax];
+    int inside = 0;
+    for (int i = 0; i < count; ++i) inside += (g[i] = g0 + ga * poly[i][0] + gb * poly[i][1]) >= -tol;
+    if (inside == count) continue;  // the line misses the polygon: nothing clipped (the common case)
+    if (inside == 0) return false;
+    if (count + 1 >= kMax) return true;  // (cannot happen; unsure = true)
+    int out = 0;
+    for (int i = 0; i < count; ++i) {
+      const int j = (i + 1) % count;
+      if (g[i] >= -tol) next[out][0] = poly[i][0], next[out][1] = poly[i][1], ++out;
+      if ((g[i] >= -tol) != (g[j] >= -tol)) {  // the edge crosses the line: its crossing point
+        const double t = g[i] / (g[i] - g[j]);
+        next[out][0] = poly[i][0] + t * (poly[j][0] - poly[i][0]);
+        next[out][1] = poly[i][1] + t * (poly[j][1] - poly[i][1]);
+        ++out;
+      }
+    }
+    count = out;
+    for (int i = 0; i < count; ++i) poly[i][0] = next[i][0], poly[i][1] = next[i][1];
+  }
+  return count > 0;
+}
+
+/// ConvexHull::cell_candidates (needs start_vertices and the adjacency; none for hulls the kernels scan). A pure
+/// cell's entry is its vertex. For a cell that is not pure, the vertices that pass near_support_in_cell() with
+/// margin 2e-5 R (R the largest vertex norm), found by a search over the adjacency from the cell centre's
+/// maximiser that expands from every passing vertex: one is the entry, 2 to kHullCellCandidatesMax are a list in
+/// ascending index order, more leave the cell without an entry (its supports climb).
+///
+/// Why the first maximum over the list is the linear scan's vertex, bit for bit, in double and in float: let d be
+/// a direction whose start_cell() is c (so d is inside c widened by 1/1000 of a cell: the cell arithmetic's
+/// rounding is ~1e-5 cell), and w a vertex whose rounded dot product (hull_dot, in T) equals the largest rounded
+/// one. Then for every vertex v, exactly, <w, d> >= <v, d> - 2 err with err <= ~5 2^-24 R |d| (coordinates rounded
+/// to T, three products and two sums in T): w is within 1e-6 R |d| of the largest exact dot product, so below
+/// every neighbour by at most the margin: w passes the test. The set G of vertices within the margin of the
+/// maximum for some d of the cell is connected through hull edges (from any vertex an increasing edge path leads
+/// to the maximiser of d, and every vertex on it is in G; the maximisers of the cell's directions are themselves
+/// adjacent), it contains the centre's maximiser, and every vertex of G passes the test: the search finds all of G.
+/// So every vertex with the largest rounded dot product is on the list, and the list's first maximum in
+/// ascending index order is the scan's first maximum. (Vertices on no face are skipped, as the climb skips them.)
+///
+/// For directions so small that hull_dot's products are subnormal (|d| near the smallest cell-bearing direction,
+/// ~1e-37 in float) the rounding bound above does not hold; the same is true of the pure cells. The wide GJK and
+/// the reference compute the same vertex there all the same (one text).
+///
+/// Measured on the bench's hulls (points on ellipsoids, 20 hulls each): convex250 3580 pure cells, 2564 lists of
+/// 2.29 vertices on average (at most 8), none left to climb; convex940 2019 pure, 4122 lists of 2.67 (14 longer
+/// than 10), 4 cells climb. kHullCellCandidatesMax = 15 (what 4 bits hold) therefore leaves almost nothing to the
+/// climb. The table is 47 KB (convex250) / 67 KB (convex940) per hull, next to ~24 KB for start_vertices; it
+/// costs 13 M / 25 M instructions per hull to build (+68% / +73% of Shape::convex from points, callgrind).
+void build_cell_candidates(ConvexHull& hull) {
+  const std::size_t nv = hull.vertices.size();
+  double radius = 0.0;
+  for (const auto& v : hull.vertices) radius = std::max(radius, v.norm());
+  const double margin = 2e-5 * radius;
+  // Small hulls are scanned (kernels::kHillClimbMinVertices), and an entry holds a vertex index in 28 bits.
+  hull.cell_candidates.clear();
+  if (nv < kernels::kHillClimbMinVertices || nv >= (std::size_t(1) << 28)) return;
+  hull.cell_candidates.assign(kHullStartCells, 0);
+  std::vector<std::uint32_t> mark(nv, kNoHullVertex), passed(nv, kNoHullVertex), stack, found;
+  for (std::uint32_t c = 0; c < kHullStartCells; ++c) {
+    if (hull.start_vertices[c] & kHullPureCell) {  // the vertex itself, no list
+      hull.cell_candidates[c] = (hull.start_vertices[c] & ~kHullPureCell) << 4 | 1u;
+      continue;
+    }
+    const Eigen::Vector3d d0 = cell_direction(c, 0.0, 0.0), da = cell_direction(c, 1.0, 0.0) - d0,
+                          db = cell_direction(c, 0.0, 1.0) - d0;
+    double dmax = 0.0;
+    for (const double a : {-1e-3, 1.0 + 1e-3})
+      for (const double b : {-1e-3, 1.0 + 1e-3}) dmax = std::max(dmax, cell_direction(c, a, b).norm());
+    // The seed: the centre direction's maximiser, climbed to from the table's vertex (a table given with the hull
+    // may name any vertex in a cell that is not pure; the argument below needs the seed in G).
+    const Eigen::Vector3d centre = cell_direction(c, 0.5, 0.5);
+    std::uint32_t seed = hull.start_vertices[c];
+    if (seed >= nv) continue;
+    double best = hull.vertices[seed].dot(centre);
+    for (std::uint32_t from = kNoHullVertex; from != seed;) {
+      from = seed;
+      for (std::uint32_t k = hull.neighbor_offsets[from]; k < hull.neighbor_offsets[from + 1]; ++k) {
+        const double dk = hull.vertices[hull.neighbors[k]].dot(centre);
+        if (dk > best) best = dk, seed = hull.neighbors[k];
+      }
+    }
+    stack.assign(1, seed);
+    mark[seed] = c;
+    found.clear();
+    bool too_many = false;
+    while (!stack.empty() && !too_many) {
+      const std::uint32_t u = stack.back();
+      stack.pop_back();
+      // The seed is expanded even if it failed (it cannot, up to rounding: it is the centre's maximiser).
+      const bool pass = near_support_in_cell(hull, u, d0, da, db, margin, dmax, passed.data(), c);
+      if (pass) found.push_back(u), passed[u] = c;
+      if (!pass && u != seed) continue;
+      too_many = found.size() > kHullCellCandidatesMax;
+      for (std::uint32_t k = hull.neighbor_offsets[u]; k < hull.neighbor_offsets[u + 1]; ++k) {
+        const std::uint32_t n = hull.neighbors[k];
+        if (mark[n] != c) mark[n] = c, stack.push_back(n);
+      }
+    }
+    if (too_many || found.empty()) continue;
+    if (found.size() == 1) {  // a cell pure_cell() did not flag, but the search finds one vertex: no list either
+      hull.cell_candidates[c] = found[0] << 4 | 1u;
+      continue;
+    }
+    std::sort(found.begin(), found.end());
+    const std::uint32_t start = static_cast<std::uint32_t>(hull.cell_candidates.size());
+    hull.cell_candidates[c] = start << 4 | static_cast<std::uint32_t>(found.size());
+    hull.cell_candidates.insert(hull.cell_candidates.end(), found.begin(), found.end());
   }
 }
 
@@ -194,12 +344,26 @@ std::shared_ptr<const ConvexHull> with_search_structures(std::shared_ptr<const C
                blocks.neighbor_block_index == hull->neighbor_block_index &&
                blocks.neighbor_block_xyz == hull->neighbor_block_xyz;
   }
-  if (complete) return hull;
+  if (complete) {
+    // The candidate lists must be the ones built here (a missing vertex would give a wrong support): built once,
+    // the hull is shared when it has them, else a copy gets them (compute_convex_hull() leaves them to this step).
+    ConvexHull lists;
+    lists.vertices = hull->vertices;
+    lists.neighbor_offsets = hull->neighbor_offsets;
+    lists.neighbors = hull->neighbors;
+    lists.start_vertices = hull->start_vertices;
+    build_cell_candidates(lists);
+    if (lists.cell_candidates == hull->cell_candidates) return hull;
+    auto with_lists = std::make_shared<ConvexHull>(*hull);
+    with_lists->cell_candidates = std::move(lists.cell_candidates);
+    return with_lists;
+  }
   auto full = std::make_shared<ConvexHull>(*hull);
   full->neighbor_offsets = std::move(derived.neighbor_offsets);
   full->neighbors = std::move(derived.neighbors);
   build_neighbor_blocks(*full);
   build_start_vertices(*full);
+  build_cell_candidates(*full);
   return full;
 }
 
@@ -266,7 +430,7 @@ std::shared_ptr<const ConvexHull> compute_convex_hull(const std::vector<Eigen::V
   build_adjacency(*hull);
   build_neighbor_blocks(*hull);
   build_start_vertices(*hull);
-  return hull;
+  return hull;  // (the candidate lists: with_search_structures(), which Shape::convex calls, builds them once)
 }
 
 }  // namespace batchcol

@@ -233,6 +233,8 @@ HullView hull_view(const ConvexHull& hull) {
   // The kernels check the optional structures by presence: a table of another size, or blocks that do not cover
   // every vertex, are as good as none (a linear scan, a climb from vertex 0).
   h.start_vertices = hull.start_vertices.size() == kHullStartCells ? hull.start_vertices.data() : nullptr;
+  h.cell_candidates = h.start_vertices != nullptr && hull.cell_candidates.size() >= kHullStartCells
+                          ? hull.cell_candidates.data() : nullptr;
   if (hull.neighbor_block_offsets.size() == hull.vertices.size() + 1) {
     h.neighbor_block_offsets = hull.neighbor_block_offsets.data();
     h.neighbor_block_index = data(hull.neighbor_block_index);

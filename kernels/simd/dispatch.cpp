@@ -35,6 +35,8 @@ namespace batchcol::kernels::simd {
   void draw_gaussians4(std::uint64_t, std::uint64_t, std::uint64_t, std::size_t, double* const*);                  \
   void accumulate_samples(const double*, const Status*, const double* const*, std::size_t, std::size_t,            \
                           SampleSums&);                                                                            \
+  void start_cells_double(const double*, std::size_t, std::uint32_t*);                                             \
+  void start_cells_float(const float*, std::size_t, std::uint32_t*);                                               \
   }
 BATCHCOL_DECLARE_ISA(scalar)
 BATCHCOL_DECLARE_ISA(avx2)
@@ -81,11 +83,14 @@ struct IsaKernels {
   decltype(&scalar::build_samples) build_samples;
   decltype(&scalar::draw_gaussians4) draw_gaussians4;
   decltype(&scalar::accumulate_samples) accumulate_samples;
+  decltype(&scalar::start_cells_double) start_cells_double;
+  decltype(&scalar::start_cells_float) start_cells_float;
 };
 #define BATCHCOL_ISA_TABLE(ns)                                                                               \
   IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
                &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float, &ns::gjk_samples_double,   \
-               &ns::gjk_samples_float, &ns::build_samples, &ns::draw_gaussians4, &ns::accumulate_samples }
+               &ns::gjk_samples_float, &ns::build_samples, &ns::draw_gaussians4, &ns::accumulate_samples,      \
+               &ns::start_cells_double, &ns::start_cells_float }
 // Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
 // same bits), scalar, avx2, avx512.
 constexpr IsaKernels kIsaKernels[] = {BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(avx2),
@@ -107,6 +112,13 @@ void gjk_lanes<double>(InstructionSet isa, const PairSetup<double>* s, std::size
                        Solver solver, bool points) {
   require_resolved(solver);
   kernels_of(isa).gjk_lanes_double(s, n, out, solver, points);
+}
+
+template <> void start_cells_lanes<double>(InstructionSet isa, const double* xyz, std::size_t n, std::uint32_t* cell) {
+  kernels_of(isa).start_cells_double(xyz, n, cell);
+}
+template <> void start_cells_lanes<float>(InstructionSet isa, const float* xyz, std::size_t n, std::uint32_t* cell) {
+  kernels_of(isa).start_cells_float(xyz, n, cell);
 }
 
 template <>

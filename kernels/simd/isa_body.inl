@@ -41,6 +41,11 @@ std::size_t gjk_samples_float(const PairView& shapes, ShapeType a, ShapeType b, 
   return WideGjkSamples<float>::run(shapes, a, b, in, options, out, fallback);
 }
 
+void start_cells_double(const double* xyz, std::size_t n, std::uint32_t* cell) {
+  WideGjk<double>::start_cells_of(xyz, n, cell);
+}
+void start_cells_float(const float* xyz, std::size_t n, std::uint32_t* cell) { WideGjk<float>::start_cells_of(xyz, n, cell); }
+
 void build_samples(const SamplePlan& p, std::uint64_t a0, std::size_t count, std::size_t odd_count,
                    const SampleArrays& even, const SampleArrays& odd) {
   WideSamples::run(p, a0, count, odd_count, even, odd);

@@ -31,6 +31,12 @@ void gjk_lanes<double>(InstructionSet, const PairSetup<double>*, std::size_t, Gj
 template <>
 void gjk_lanes<float>(InstructionSet, const PairSetup<float>*, std::size_t, GjkResult<float>*, Solver, bool);
 
+/// The large-hull supports' direction-table cells (WideGjk::start_cells) of directions xyz[3 i .. 3 i + 3),
+/// i < n, computed W at a time as the GJK loop does: for the tests, which check them against start_cell().
+template <class T> void start_cells_lanes(InstructionSet isa, const T* xyz, std::size_t n, std::uint32_t* cell);
+template <> void start_cells_lanes<double>(InstructionSet, const double*, std::size_t, std::uint32_t*);
+template <> void start_cells_lanes<float>(InstructionSet, const float*, std::size_t, std::uint32_t*);
+
 /// GJK pairs of one shape-pair type (A of type_a, B of type_b) straight from the batch arrays into the result
 /// arrays: pose validation, B's pose in A's frame, setup, GJK, completion and the world-frame output, with the
 /// executor's scalar path's bits. Preconditions: neither type is triangle or halfspace, no closed form applies to

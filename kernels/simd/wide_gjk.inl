@@ -152,36 +152,44 @@ template <class T> struct WideGjk {
   /// calls made GCC stop inlining hull_support_lanes() into the loop, which cost the small hulls' scan a call
   /// (convex8 witness double 3712 -> 3875 instructions per pair, callgrind AVX2).
   __attribute__((noinline)) static V3 large_hull_lanes(Side& s, const V3& d, std::uint32_t live) {
-    const real zero = splat(T(0));
-    V3 r{zero, zero, zero};
-    // The direction table's cells of all lanes at once; a lane whose cell is pure takes its vertex without a
-    // call, the others climb (hull_support_in_cell, this set's build, not ADL's kernels:: one).
+    // The direction table's cells of all lanes at once; a lane whose cell has an entry in the candidate table
+    // (pure: the vertex; else a short list) takes its vertex from it (cell_vertex()), the others climb
+    // (hull_support_in_cell, this set's build, not ADL's kernels:: one). The lanes go through arrays: element
+    // access on the vector types cost a store and reload per lane and coordinate.
     std::uint32_t cell[W];
     start_cells(d, cell);
-    for (int l = 0; l < W; ++l) {
-      if (!(live >> l & 1u)) continue;
+    alignas(sizeof(real)) T dx[W], dy[W], dz[W], rx[W] = {}, ry[W] = {}, rz[W] = {};
+    std::memcpy(dx, &d.x, sizeof dx);
+    std::memcpy(dy, &d.y, sizeof dy);
+    std::memcpy(dz, &d.z, sizeof dz);
+    for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
+      const int l = __builtin_ctz(bits);
       const HullView& h = *s.hull[l];
       const bool climbs = hull_climbs(h);
-      const std::uint32_t v = climbs ? pure_cell_vertex(h, cell[l]) : kNoHullVertex;
+      const Vec3<T> dl(dx[l], dy[l], dz[l]);
+      const std::uint32_t v = climbs ? cell_vertex(h, cell[l], dl) : kNoHullVertex;
       if (v != kNoHullVertex) {
         s.hint[l].vertex = v;
         const double* p = h.vertices + 3 * std::size_t(v);
-        r.x[l] = T(p[0]);
-        r.y[l] = T(p[1]);
-        r.z[l] = T(p[2]);
+        rx[l] = T(p[0]), ry[l] = T(p[1]), rz[l] = T(p[2]);
         continue;
       }
-      const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, Vec3<T>(d.x[l], d.y[l], d.z[l]), s.hint[l],
-                                                               climbs ? cell[l] : kNoHullVertex);
-      r.x[l] = p.x();
-      r.y[l] = p.y();
-      r.z[l] = p.z();
+      const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, dl, s.hint[l], climbs ? cell[l] : kNoHullVertex);
+      rx[l] = p.x(), ry[l] = p.y(), rz[l] = p.z();
     }
+    V3 r;
+    std::memcpy(&r.x, rx, sizeof rx);
+    std::memcpy(&r.y, ry, sizeof ry);
+    std::memcpy(&r.z, rz, sizeof rz);
     return r;
   }
   /// start_cell() (kernels/hull_support.inl) of every lane's direction, with its operations lane by lane, so each
   /// lane gets the cell the reference's scalar call computes.
   static void start_cells(const V3& d, std::uint32_t* cell) {
+    // The cell's arithmetic in T and 32-bit lanes: the indices are integers below 2^13, exact in either, and every
+    // conversion here is one instruction on AVX2 (64-bit integer lanes had no conversion or multiply there and
+    // were done lane by lane).
+    typedef std::int32_t I32 __attribute__((vector_size(4 * W)));
     const real zero = splat(T(0)), one = splat(T(1));
     const real ax = select(d.x < zero, -d.x, d.x), ay = select(d.y < zero, -d.y, d.y), az = select(d.z < zero, -d.z, d.z);
     const mask yx = ay > ax;
@@ -191,8 +199,7 @@ template <class T> struct WideGjk {
     u = select(zx, d.x, u);
     v = select(zx, d.y, v);
     const real along = select(zx, d.z, select(yx, d.y, d.x));
-    mask face = select(zx, splat_mask(4), select(yx, splat_mask(2), splat_mask(0)));
-    face += select(along < zero, splat_mask(1), splat_mask(0));
+    const real face = select(zx, splat(T(4)), select(yx, splat(T(2)), zero)) + select(along < zero, one, zero);
     const real grid = splat(T(kHullStartGrid)), half = splat(T(0.5 * kHullStartGrid));
     const real k = half / major;
     const mask ok = (major > zero) & (k <= splat(std::numeric_limits<T>::max()));
@@ -200,10 +207,21 @@ template <class T> struct WideGjk {
     const real fu = u * k + half, fv = v * k + half;
     const real cu = select(fu >= one, select(fu < grid, fu, grid - one), zero);
     const real cv = select(fv >= one, select(fv < grid, fv, grid - one), zero);
-    const mask iu = __builtin_convertvector(cu, mask), iv = __builtin_convertvector(cv, mask);
-    const Int g = Int(kHullStartGrid);
-    const mask c = (face * g + iu) * g + iv;
-    for (int l = 0; l < W; ++l) cell[l] = ok[l] ? std::uint32_t(c[l]) : kNoHullVertex;
+    const real iu = __builtin_convertvector(__builtin_convertvector(cu, I32), real);  // truncated, as uint32_t(f)
+    const real iv = __builtin_convertvector(__builtin_convertvector(cv, I32), real);
+    const real c = select(ok, (face * grid + iu) * grid + iv, splat(T(-1)));  // -1: kNoHullVertex as uint32_t
+    const I32 ci = __builtin_convertvector(c, I32);
+    std::memcpy(cell, &ci, sizeof ci);
+  }
+  /// start_cells() on directions xyz[3 i ..], W at a time (the last register padded with zero directions).
+  static void start_cells_of(const T* xyz, std::size_t n, std::uint32_t* out) {
+    for (std::size_t i = 0; i < n; i += W) {
+      V3 d{splat(T(0)), splat(T(0)), splat(T(0))};
+      for (int l = 0; l < W && i + l < n; ++l) d.x[l] = xyz[3 * (i + l)], d.y[l] = xyz[3 * (i + l) + 1], d.z[l] = xyz[3 * (i + l) + 2];
+      std::uint32_t cell[W];
+      start_cells(d, cell);
+      for (int l = 0; l < W && i + l < n; ++l) out[i + l] = cell[l];
+    }
   }
 
   // ---- Newton search direction (see the drive() loop; tests/support/reference_gjk.hpp, same operations) ----

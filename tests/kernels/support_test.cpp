@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace batchcol::kernels {
 namespace {
@@ -152,6 +154,97 @@ TEST(Support, PureCellsGiveTheLinearScansVertexWithoutAClimb) {
     const Shape fixed = Shape::convex(forged);
     EXPECT_NE(fixed.hull, forged);
     EXPECT_EQ(fixed.hull->start_vertices, h.start_vertices);
+  }
+}
+
+/// The linear scan's first maximiser of hull_dot (the support's own dot product, in T) over every vertex.
+template <class T> std::uint32_t scan_vertex(const HullView& h, const Vec3<T>& d) {
+  std::uint32_t best = 0;
+  for (std::uint32_t i = 1; i < h.vertex_count; ++i)
+    if (hull_dot(h, i, d) > hull_dot(h, best, d)) best = i;
+  return best;
+}
+
+TEST(Support, CandidateListsGiveTheLinearScansVertex) {
+  // A cell's entry in the candidate table answers with its vertex (pure cells) or the first maximum over its
+  // list: it must be the linear scan's first maximiser, index for index, in double and in float, for random directions, for
+  // directions on and just across cell edges and corners, and for the hull's face normals and edge bisectors
+  // (two or three vertices tie there in exact arithmetic, so the first-maximum rule decides).
+  batchcol::testing::Rng rng(37);
+  for (int n : {40, 250, 940}) {
+    const Shape s = Shape::convex(batchcol::testing::random_hull_points(rng, n, 0.05, 0.4));
+    const ConvexHull& h = *s.hull;
+    const OwnedShapeView view(s);
+    const HullView& hv = *view.view.hull;
+    ASSERT_NE(hv.cell_candidates, nullptr);
+    int listed = 0;
+    for (std::uint32_t c = 0; c < kHullStartCells; ++c) {
+      const std::uint32_t e = h.cell_candidates[c], count = e & 15u;
+      if (h.start_vertices[c] & kHullPureCell) {
+        EXPECT_EQ(e, (h.start_vertices[c] & ~kHullPureCell) << 4 | 1u);
+      }
+      if (count == 1) {
+        EXPECT_LT(e >> 4, h.vertices.size());
+      }
+      listed += count > 1;
+      if (count <= 1) continue;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        EXPECT_LT(h.cell_candidates[(e >> 4) + i], h.vertices.size());
+        if (i > 0) {
+          EXPECT_LT(h.cell_candidates[(e >> 4) + i - 1], h.cell_candidates[(e >> 4) + i]) << "ascending";
+        }
+      }
+    }
+    EXPECT_GT(listed, n >= 250 ? int(kHullStartCells) / 5 : 20) << n << " vertices";
+    std::vector<Eigen::Vector3d> dirs;
+    for (int q = 0; q < 20000; ++q) dirs.push_back(batchcol::testing::random_unit_vector(rng));
+    for (std::size_t f = 0; f < h.faces.size(); ++f) {
+      dirs.push_back(h.face_normals[f]);
+      const std::uint32_t* v = h.faces[f].data();
+      for (int e = 0; e < 3; ++e) {  // the bisector of the edge's two faces is roughly this: ties of two vertices
+        const Eigen::Vector3d m = 0.5 * (h.vertices[v[e]] + h.vertices[v[(e + 1) % 3]]) - h.centroid;
+        const Eigen::Vector3d edge = h.vertices[v[(e + 1) % 3]] - h.vertices[v[e]];
+        dirs.push_back(m - edge * (m.dot(edge) / edge.squaredNorm()));
+      }
+    }
+    for (int q = 0; q < 4000; ++q) {  // on a cell's edge or corner in the cube map, or 1e-7 of a cell beside it
+      const Eigen::Vector3d r = batchcol::testing::random_unit_vector(rng);
+      const int axis = q % 3;
+      Eigen::Vector3d d = r / std::abs(r[axis]);
+      for (int k : {1, 2}) {
+        const double t = std::round((d[(axis + k) % 3] + 1.0) * kHullStartGrid / 2) * 2 / kHullStartGrid - 1.0;
+        if (q % 2 == 0 || k == 1) d[(axis + k) % 3] = t + (q % 4 == 3 ? 1e-7 / kHullStartGrid : 0.0);
+      }
+      dirs.push_back(d);
+    }
+    int checked = 0, checked_f = 0;
+    for (const Eigen::Vector3d& d : dirs) {
+      const std::uint32_t c = start_cell(d);
+      if (c == kNoHullVertex) continue;
+      const std::uint32_t got = cell_vertex(hv, c, d);
+      if (got != kNoHullVertex) {
+        ++checked;
+        EXPECT_EQ(got, scan_vertex(hv, d)) << n << " vertices, d " << d.transpose();
+        SupportHint hint;
+        hull_support(hv, d, hint);
+        EXPECT_EQ(hint.vertex, got);
+      }
+      const Eigen::Vector3f df = d.cast<float>();
+      const std::uint32_t cf = start_cell(df), got_f = cell_vertex(hv, cf, df);
+      if (got_f == kNoHullVertex) continue;
+      ++checked_f;
+      EXPECT_EQ(got_f, scan_vertex(hv, df)) << n << " vertices, float d " << df.transpose();
+    }
+    EXPECT_GT(checked, 2000) << n << " vertices";
+    EXPECT_GT(checked_f, 2000) << n << " vertices";
+    // A list short of one vertex is not trusted: the hull is not shared as complete, its lists are rebuilt.
+    auto forged = std::make_shared<ConvexHull>(h);
+    std::uint32_t c = 0;
+    while ((h.cell_candidates[c] & 15u) < 2) ++c;
+    forged->cell_candidates[c] -= 1;
+    const Shape fixed = Shape::convex(forged);
+    EXPECT_NE(fixed.hull, forged);
+    EXPECT_EQ(fixed.hull->cell_candidates, h.cell_candidates);
   }
 }
 

@@ -10,11 +10,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace batchcol {
 namespace {
@@ -142,6 +145,60 @@ TEST(WideGjk, EqualsReferenceBitwiseFloat) {
 }
 
 // The lanes take the solver the setups were made with; `automatic` must have been resolved before.
+template <class T> void expect_start_cells_match(const std::vector<Eigen::Matrix<T, 3, 1>>& dirs) {
+  std::vector<T> xyz;
+  for (const auto& d : dirs) xyz.insert(xyz.end(), {d.x(), d.y(), d.z()});
+  for (const InstructionSet isa : runnable_sets()) {
+    std::vector<std::uint32_t> cells(dirs.size(), 0u);
+    kernels::simd::start_cells_lanes<T>(isa, xyz.data(), dirs.size(), cells.data());
+    int mismatches = 0;
+    for (std::size_t i = 0; i < dirs.size() && mismatches < 10; ++i) {
+      const std::uint32_t want = kernels::start_cell(dirs[i]);
+      if (cells[i] != want) ++mismatches;
+      EXPECT_EQ(cells[i], want) << to_string(isa) << " " << sizeof(T) << "-byte d " << dirs[i].transpose();
+    }
+  }
+}
+
+TEST(WideGjk, StartCellsOfTheLanesAreTheScalarStartCell) {
+  // The large-hull supports look up the direction table with the cells start_cells() computes W lanes at a time;
+  // the reference computes start_cell() per call. They must name the same cell (or none) for every direction:
+  // random, of every magnitude, on cube edges and corners (face ties), on cell boundaries, tiny (no cell, or
+  // just one), zero and NaN.
+  Rng rng(52);
+  std::vector<Eigen::Vector3d> dirs;
+  for (int q = 0; q < 4000; ++q)
+    dirs.push_back(testing::random_unit_vector(rng) * std::pow(10.0, double(q % 60) - 30.0));
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        for (const double scale : {1.0, 3e-7, 1e-300, 1e-310, 1e-39, 1e-37, 1e30})
+          dirs.push_back(Eigen::Vector3d(x, y, z) * scale);
+  for (int q = 0; q < 2000; ++q) {  // exactly on a cell boundary of one face, and the neighbouring doubles
+    Eigen::Vector3d d(1.0, double(q % (kHullStartGrid + 1)) * 2 / kHullStartGrid - 1.0,
+                      double(q / 7 % (kHullStartGrid + 1)) * 2 / kHullStartGrid - 1.0);
+    if (q % 3 == 1) d.y() = std::nextafter(d.y(), 2.0);
+    if (q % 3 == 2) d.z() = std::nextafter(d.z(), -2.0);
+    const int axis = q % 3;
+    std::swap(d[0], d[axis]);
+    dirs.push_back(q % 2 ? -d : d);
+    dirs.push_back(dirs.back() * 1e-20);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  dirs.push_back(Eigen::Vector3d(nan, 1.0, 0.5));
+  dirs.push_back(Eigen::Vector3d(1.0, nan, 0.5));
+  dirs.push_back(Eigen::Vector3d(nan, nan, nan));
+  dirs.push_back(Eigen::Vector3d(inf, 1.0, -2.0));
+  expect_start_cells_match<double>(dirs);
+  std::vector<Eigen::Vector3f> dirs_f;
+  for (const auto& d : dirs) dirs_f.push_back(d.cast<float>());
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        for (const float scale : {1e-38f, 1e-40f, 2e-45f, 1e-37f, 3e38f}) dirs_f.push_back(Eigen::Vector3f(x, y, z) * scale);
+  expect_start_cells_match<float>(dirs_f);
+}
+
 TEST(WideGjk, AutomaticSolverIsRejectedByTheLanes) {
   Rng rng(77);
   QueryOptions options;  // solver automatic: setup_pair resolves it into the parameters

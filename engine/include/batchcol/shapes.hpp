@@ -41,6 +41,13 @@ struct ConvexHull {
   /// Where a support query without a previous vertex starts climbing: per cube-map cell of directions, the support
   /// vertex of the cell's centre direction (kHullStartCells entries; empty: start at vertex 0).
   std::vector<std::uint32_t> start_vertices;
+  /// Per cube-map cell, the support vertex of every direction of the cell or the few vertices it is among, so such a
+  /// support is a lookup or a first maximum over 2-15 vertices instead of a climb: kHullStartCells entries
+  /// (e & 15 = 1: vertex e >> 4; 2 to kHullCellCandidatesMax: a list of that many ascending vertex indices at
+  /// index e >> 4 of this same array; 0: none, the support climbs), then the lists. Built with the direction table
+  /// (engine/src/convex_hull.cpp, build_cell_candidates(), which has the argument for its exactness) for hulls
+  /// that are climbed; empty for small hulls (scanned) and when absent (pure cells and climbs only).
+  std::vector<std::uint32_t> cell_candidates;
   /// The adjacency again, in blocks of kNeighborBlock neighbours with their coordinates in structure-of-arrays
   /// order, so that one climbing step computes a block's dot products together (kernels/support.hpp). Vertex v's
   /// blocks are [neighbor_block_offsets[v], neighbor_block_offsets[v + 1]); block b's indices are

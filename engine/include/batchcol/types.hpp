@@ -48,6 +48,9 @@ constexpr std::uint32_t kNoHullVertex = 0xffffffffu;
 /// cell, widened by a rounding margin, has that vertex as its only maximiser), so a support in a direction of the
 /// cell is the vertex itself, without a climb. The vertex index is the entry without the flag.
 constexpr std::uint32_t kHullPureCell = 0x80000000u;
+/// Most candidates a cell of ConvexHull::cell_candidates lists (more: the cell has no list, its supports climb).
+/// 15 is what the entry's 4-bit count holds; see build_cell_candidates() for the numbers behind the choice.
+constexpr std::uint32_t kHullCellCandidatesMax = 15;
 /// Neighbours per block of ConvexHull::neighbor_block_xyz (ConvexHull::kNeighborBlock).
 constexpr std::uint32_t kHullNeighborBlock = 4;
 
@@ -62,6 +65,7 @@ struct HullView {
   const std::uint32_t* faces = nullptr;     // 3 face_count, counter-clockwise seen from outside
   const double* face_normals = nullptr;     // 3 face_count, unit, outward
   const std::uint32_t* start_vertices = nullptr;  // kHullStartCells entries, or null
+  const std::uint32_t* cell_candidates = nullptr;  // ConvexHull::cell_candidates, or null
   /// Adjacency in blocks of kHullNeighborBlock (null when the hull has none): vertex_count + 1 offsets, then the
   /// blocks' vertex indices and their coordinates (x of the block's vertices, then y, then z).
   const std::uint32_t* neighbor_block_offsets = nullptr;
