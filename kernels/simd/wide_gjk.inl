@@ -750,16 +750,6 @@ template <class T> struct WideGjk {
     w = sub(a, b);
   }
 
-  /// Slot m of the compacted simplex: v[q] where the projection kept old slot q (from_q[q], q > lo), else v[lo],
-  /// for a lo <= index[m]. A kept vertex never moves up (index[m] >= m: the indices of a support set are
-  /// increasing), so lo = m reads only slots m..3 (6 picks and compares per iteration fewer than lo = 0); slots
-  /// past the new count then keep their own stale value instead of slot 0's, which nothing reads.
-  static V3 from_slot(const mask* from_q, const V3* v, int lo) {
-    V3 r = v[lo];
-    for (int q = lo + 1; q < 4; ++q) r = pick(from_q[q], v[q], r);
-    return r;
-  }
-
   static V3 face_direction(const Lanes& L, const V3& x) {
     const V3 n = cross(sub(L.w[1], L.w[0]), sub(L.w[2], L.w[0]));
     const real w = wmax(wmax(norm(L.w[0]), norm(L.w[1])), norm(L.w[2]));
@@ -1038,8 +1028,6 @@ template <class T> struct WideGjk {
         // Project the origin on the simplex plus s, keep the support set. The projection reads the old vertices
         // L.w[0 .. count) and s, and names s by index 3 whatever the lane's count, so s is never blended into slot
         // `count` first (a pick per slot per iteration); the compaction below reads it as vertex 3.
-        V3 src[4];  // the other loop's compaction reads a copy (the boolean one compacts L.w in place)
-        if (!Boolean) src[0] = L.w[0], src[1] = L.w[1], src[2] = L.w[2], src[3] = sw;
         mask pslot[4];
         // feature_direction() reads the flat side's points of the simplex: tracked for its lanes without `points`.
         const bool track = points || (flat_run && newton_live);
@@ -1074,29 +1062,20 @@ template <class T> struct WideGjk {
         const real next_xn = wsqrt<T>(next_xx);
         const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
         L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
+        // Compaction in place, slot by slot: slot m takes vertex q = index[m] >= m (the indices of a support set
+        // are increasing, so a kept vertex never moves up) and reads slots m .. 3 only, none written yet. Lanes
+        // that do not move select nothing (from_q false) and keep their vertex m (m < 3; slot 3 gets s, stale:
+        // their count is at most 3): a mask and instead of a pick of the whole vertex, and no copy of L.w.
         for (int m = 0; m < 4; ++m) {
           mask from_q[4];
-          if (Boolean) {
-            // In place, slot by slot: slot m reads slots m .. 3 only (from_slot()), none written yet. Lanes that
-            // do not move select nothing (from_q false) and keep their vertex m (m < 3; slot 3 gets s, stale:
-            // their count is at most 3): a mask and instead of a pick of the whole vertex. A copy of L.w for
-            // the reads cost ~25 instructions per pair (box-cylinder, AVX2).
-            for (int q = m + 1; q < 4; ++q) from_q[q] = moves & (proj.index[m] == splat_mask(q));
-            V3 r = m < 3 ? L.w[m] : sw;
-            for (int q = m + 1; q < 4; ++q) r = pick(from_q[q], q < 3 ? L.w[q] : sw, r);
-            L.w[m] = r;
-            continue;
-          }
-          // The other loop keeps the uniform form (lo = 0 and a pick by `moves`): lo = m there made GCC's code
-          // for the whole loop longer (measured, AVX2, box-cylinder witness double close: 6360 -> 6698
-          // instructions per pair, with the same results).
-          const int lo = 0;
-          for (int q = lo + 1; q < 4; ++q) from_q[q] = proj.index[m] == splat_mask(q);
-          L.w[m] = pick(moves, from_slot(from_q, src, lo), L.w[m]);
+          for (int q = m + 1; q < 4; ++q) from_q[q] = moves & (proj.index[m] == splat_mask(q));
+          V3 r = m < 3 ? L.w[m] : sw;
+          for (int q = m + 1; q < 4; ++q) r = pick(from_q[q], q < 3 ? L.w[q] : sw, r);
+          L.w[m] = r;
           if (track) {
-            mask q = pslot[lo];
-            for (int o = lo + 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
-            L.slot[m] = select(moves, q, L.slot[m]);
+            mask q = pslot[m];
+            for (int o = m + 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
+            L.slot[m] = q;
           }
           if (!Boolean) L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);  // a boolean output has no weights
         }
