@@ -443,12 +443,12 @@ template <class T> struct WideGjk {
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
-  /// Face m of tetrahedron p[0..3] that keeps vertex 3, per lane (m = 0: old vertices 1, 2; m = 1: 0, 2; m = 2: 0,
-  /// 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
-  AI static Face face_keeping_3(const V3* p, mask m0, mask m2, mask& i, mask& j) {
+  /// Face m of tetrahedron p[0..2], s that keeps s (vertex 3), per lane (m = 0: old vertices 1, 2; m = 1: 0, 2;
+  /// m = 2: 0, 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
+  AI static Face face_keeping_3(const V3* p, const V3& s, mask m0, mask m2, mask& i, mask& j) {
     i = select(m0, splat_mask(1), splat_mask(0));
     j = select(m2, splat_mask(1), splat_mask(2));
-    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), p[3]);
+    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), s);
   }
 
   /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
@@ -471,11 +471,15 @@ template <class T> struct WideGjk {
   /// whatever the lane's size (the segment lanes' segment, the triangle lanes' two edges, the tetrahedron lanes'
   /// three), computed once; the triangle lanes' face and the tetrahedron lanes' first face are one face() call; and
   /// one Proj (13 registers) is assembled at the end instead of one per size.
+  /// p[0 .. count) are the old vertices, s the new one; s has index 3 in the answer whatever the lane's size
+  /// (input index `count` in the reference's terms: the caller maps 3 to it), so no step writes s into slot
+  /// `count` first, and the caller's compaction reads it from a fixed place.
   AI static Proj project(const V3* p, const V3& s, mask count, mask live) {
     const real zero = splat(T(0));
     const mask three = live & (count == splat_mask(2)), four = live & (count == splat_mask(3));
+    const mask newest = splat_mask(3);  // s's index (see above)
     // Only segment lanes (the first iterations of a run, short pairs): the segment alone, as segment() did.
-    if (!any(three | four)) return to_proj(edge(p[0], s, splat_mask(0), count));
+    if (!any(three | four)) return to_proj(edge(p[0], s, splat_mask(0), newest));
     // Tetrahedron lanes (tetrahedron()): the origin inside, else the faces keeping vertex 3 that it sees (cand[m]:
     // face m omits vertex m), and the visible face whose plane is farthest from the origin (the reference's rule,
     // same arithmetic): where the origin's projection lies inside that face, it is the answer, in one face instead
@@ -510,15 +514,15 @@ template <class T> struct WideGjk {
     // Computed whatever the lanes (only segment lanes is rare): no branch, and no default value to write first.
     const Face f = face(pick(first_0, p[1], p[0]), pick(three, p[1], pick(first_2, p[1], p[2])), s);
     const mask first_ok = have_first & f.use;
-    // Edges to the new vertex (input indices k and count), where some lane's answer may be one.
+    // Edges to the new vertex (input indices k and 3), where some lane's answer may be one.
     const mask tri_edges = three & ~f.use, rest = four & ~inside & ~first_ok;
     // Edge 0 is computed whatever the lanes (segment lanes nearly always need it); edges 1 and 2 start as copies of
     // it where no lane needs them (registers, not zeroed memory).
     Edge E[3];
     real En[3];
-    E[0] = edge(p[0], s, splat_mask(0), count), En[0] = norm2(E[0].x);
+    E[0] = edge(p[0], s, splat_mask(0), newest), En[0] = norm2(E[0].x);
     E[1] = E[0], En[1] = En[0], E[2] = E[0], En[2] = En[0];
-    if (any(tri_edges | rest)) E[1] = edge(p[1], s, splat_mask(1), count), En[1] = norm2(E[1].x);
+    if (any(tri_edges | rest)) E[1] = edge(p[1], s, splat_mask(1), newest), En[1] = norm2(E[1].x);
     // The tetrahedron lanes whose first face was not the answer: the closest of every visible face's answer.
     real best_n2 = splat(std::numeric_limits<T>::infinity());
     Face bf;  // the best face's x and weights (use, via_i, via_j unused)
@@ -528,7 +532,7 @@ template <class T> struct WideGjk {
     mask bi = splat_mask(0), bj = splat_mask(0), best_edge = splat_mask(0), best_use = splat_mask(0);
     mask have = splat_mask(0);
     if (any(rest)) {
-      E[2] = edge(p[2], s, splat_mask(2), count), En[2] = norm2(E[2].x);
+      E[2] = edge(p[2], s, splat_mask(2), newest), En[2] = norm2(E[2].x);
       mask remaining[3], taken[3];
       for (int m = 0; m < 3; ++m) remaining[m] = cand[m] & ~first_ok;
       for (;;) {
@@ -536,7 +540,7 @@ template <class T> struct WideGjk {
         if (!any(round)) break;
         // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
         mask i, j;
-        const Face g = face_keeping_3(p, taken[0], taken[2], i, j);  // p[3] = s in these lanes
+        const Face g = face_keeping_3(p, s, taken[0], taken[2], i, j);
         const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
         const mask to_j = takes_j(g, ni, nj);
         const real n2 = select(g.use, norm2(g.x), select(to_j, nj, ni));
@@ -559,7 +563,7 @@ template <class T> struct WideGjk {
     Face a = f;
     a.x = pick(from_best, bf.x, f.x);
     for (int m = 0; m < 3; ++m) a.lambda[m] = select(from_best, bf.lambda[m], f.lambda[m]);
-    Proj r = pick(use_face, face_proj(a, select(from_best, bi, fi), select(from_best, bj, fj), count), to_proj(e));
+    Proj r = pick(use_face, face_proj(a, select(from_best, bi, fi), select(from_best, bj, fj), newest), to_proj(e));
     if (any(four)) {
       // No visible face: no candidate (x infinite, count 0); the origin inside: the whole tetrahedron.
       const mask none = from_best & ~have;
@@ -583,7 +587,7 @@ template <class T> struct WideGjk {
   struct Lanes {
     Side A, B;
     real R[9]{}, t[3]{};
-    V3 w[4];
+    V3 w[4]{};  // zeroed: slots past a lane's count are stale, and project() reads them in lanes that ignore them
     // The points of A and B behind the simplex (witness levels) stay in the fixed slot where they were written;
     // slot[m] says which slot holds those of simplex vertex m. Only w is compacted after each projection (the
     // projection reads it in order); a slot index per vertex is cheaper to move than six coordinates.
@@ -762,16 +766,6 @@ template <class T> struct WideGjk {
     b = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + L.t[0], ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + L.t[1],
          ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + L.t[2]};
     w = sub(a, b);
-  }
-
-  /// Slot m of the compacted simplex: v[q] where the projection kept old slot q (from_q[q], q > lo), else v[lo],
-  /// for a lo <= index[m]. A kept vertex never moves up (index[m] >= m: the indices of a support set are
-  /// increasing), so lo = m reads only slots m..3 (6 picks and compares per iteration fewer than lo = 0); slots
-  /// past the new count then keep their own stale value instead of slot 0's, which nothing reads.
-  static V3 from_slot(const mask* from_q, const V3* v, int lo) {
-    V3 r = v[lo];
-    for (int q = lo + 1; q < 4; ++q) r = pick(from_q[q], v[q], r);
-    return r;
   }
 
   static V3 face_direction(const Lanes& L, const V3& x) {
@@ -1049,15 +1043,10 @@ template <class T> struct WideGjk {
 
       mask ends_contains = splat_mask(0), ends_stall = splat_mask(0), ends_stall_overlap = splat_mask(0);
       if (any(live)) {
-        // Add s at slot `count`, project the origin on the simplex, keep the support set.
-        V3 pw[4];
+        // Project the origin on the simplex plus s, keep the support set. The projection reads the old vertices
+        // L.w[0 .. count) and s, and names s by index 3 whatever the lane's count, so s is never blended into slot
+        // `count` first (a pick per slot per iteration); the compaction below reads it as vertex 3.
         mask pslot[4];
-        // count >= 1 (a simplex never empties: a projection with no candidate does not decrease |x|), so s never
-        // goes to slot 0. The boolean loop only: in the other one the same saving (and from_slot()'s lo = m below)
-        // made GCC's code for the whole loop longer (measured, AVX2, box-cylinder witness double close: 6360 ->
-        // 6698 instructions per pair, with the same results), so it keeps the uniform form.
-        pw[0] = Boolean ? L.w[0] : pick(live & (L.count == splat_mask(0)), sw, L.w[0]);
-        for (int m = 1; m < 4; ++m) pw[m] = pick(live & (L.count == splat_mask(m)), sw, L.w[m]);
         // feature_direction() reads the flat side's points of the simplex: tracked for its lanes without `points`.
         const bool track = points || (flat_run && newton_live);
         if (track) {
@@ -1074,9 +1063,10 @@ template <class T> struct WideGjk {
             L.a[q] = pick(here, sa, L.a[q]);
             L.b[q] = pick(here, sb, L.b[q]);
           }
-          for (int m = 0; m < 4; ++m) pslot[m] = select(live & (L.count == splat_mask(m)), free, L.slot[m]);
+          for (int m = 0; m < 3; ++m) pslot[m] = L.slot[m];
+          pslot[3] = free;  // s's slot, at s's index
         }
-        const Proj proj = project(pw, sw, L.count, live);
+        const Proj proj = project(L.w, sw, L.count, live);
         const real next_xx = norm2(proj.x);
 
         ends_contains = live & proj.contains;
@@ -1090,15 +1080,20 @@ template <class T> struct WideGjk {
         const real next_xn = wsqrt<T>(next_xx);
         const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
         L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
+        // Compaction in place, slot by slot: slot m takes vertex q = index[m] >= m (the indices of a support set
+        // are increasing, so a kept vertex never moves up) and reads slots m .. 3 only, none written yet. Lanes
+        // that do not move select nothing (from_q false) and keep their vertex m (m < 3; slot 3 gets s, stale:
+        // their count is at most 3): a mask and instead of a pick of the whole vertex, and no copy of L.w.
         for (int m = 0; m < 4; ++m) {
           mask from_q[4];
-          const int lo = Boolean ? m : 0;
-          for (int q = lo + 1; q < 4; ++q) from_q[q] = proj.index[m] == splat_mask(q);
-          L.w[m] = pick(moves, from_slot(from_q, pw, lo), L.w[m]);
+          for (int q = m + 1; q < 4; ++q) from_q[q] = moves & (proj.index[m] == splat_mask(q));
+          V3 r = m < 3 ? L.w[m] : sw;
+          for (int q = m + 1; q < 4; ++q) r = pick(from_q[q], q < 3 ? L.w[q] : sw, r);
+          L.w[m] = r;
           if (track) {
-            mask q = pslot[lo];
-            for (int o = lo + 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
-            L.slot[m] = select(moves, q, L.slot[m]);
+            mask q = pslot[m];
+            for (int o = m + 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
+            L.slot[m] = q;
           }
           if (!Boolean) L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);  // a boolean output has no weights
         }
