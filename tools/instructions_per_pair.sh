@@ -14,7 +14,7 @@ for runs in 5 $high; do
   valgrind --tool=callgrind --callgrind-out-file="$work/cg$runs" "$bin" bench --case "$case_name" --regime close \
     --query "$query" --precision "$precision" --pairs $pairs --threads 1 --no-peers --isa "$isa" --runs $runs --min-run-ms 0 \
     >/dev/null 2>&1
-  callgrind_annotate --inclusive=no "$work/cg$runs" 2>/dev/null | grep -E "^ *[0-9,]+ \(" |
+  callgrind_annotate --inclusive=no --auto=no "$work/cg$runs" 2>/dev/null | grep -E "^ *[0-9,]+ \(" |
     sed -E 's/,//g; s/^ *([0-9]+) +\( *[0-9.]+%\) +/\1\t/' > "$work/f$runs"
 done
 python3 - "$work/f5" "$work/f$high" $(((high - 5) * pairs)) <<'PY'
