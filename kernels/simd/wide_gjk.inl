@@ -162,7 +162,10 @@ template <class T> struct WideGjk {
     std::memcpy(dx, &d.x, sizeof dx);
     std::memcpy(dy, &d.y, sizeof dy);
     std::memcpy(dz, &d.z, sizeof dz);
-    for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
+    // Only lanes 0..W-1 exist: a mask bit above them must not index s.hull (UBSan found index W here under the
+    // sanitizer build; the loop over l < W this replaced ignored such bits the same way).
+    static_assert(W < 32, "lane mask");
+    for (std::uint32_t bits = live & ((1u << W) - 1u); bits != 0; bits &= bits - 1) {
       const int l = __builtin_ctz(bits);
       const HullView& h = *s.hull[l];
       const bool climbs = hull_climbs(h);
