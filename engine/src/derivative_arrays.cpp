@@ -43,6 +43,11 @@ void validate(const DerivativeOptions& o) {
     throw InputError("method must be analytic, smoothed0 or smoothed1");
   if (o.noise_scale != NoiseScale::relative && o.noise_scale != NoiseScale::absolute)
     throw InputError("noise_scale must be relative or absolute");
+  // smoothed1's distance gradient is the analytic one (the envelope theorem does not involve the curvature), and
+  // smoothed0 estimates every output from the same samples: gradients alone are only a separate path for analytic.
+  if (!o.jacobians && o.method != DerivativeMethod::analytic)
+    throw InputError(std::string("jacobians: false (distance gradients only) needs method analytic, got ") +
+                     to_string(o.method));
 }
 
 Eigen::Matrix<double, 1, 6> Vec6Array::operator[](std::size_t i) const {

@@ -266,6 +266,61 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   d.status[i] = J.dependent ? DerivativeStatus::nonsmooth : J.singular ? DerivativeStatus::singular : status;
 }
 
+// The distance gradients alone (DerivativeOptions::jacobians false): distance_gradients()'s envelope formula from the
+// witness results of every pair nominal_geometry() accepts (the pairs the full derivative gives a gradient), without
+// rotations, features or the implicit-function solve. Pairs go through a 12 x 8 buffer and each array gets 8
+// consecutive entries per flush, for StoreBlock's reason: 12 arrays a power of two apart written pair by pair would
+// share one L1 set.
+void gradients_only(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, int threads,
+                    DerivativeResults& d) {
+  const std::size_t n = batch.size();
+  d.status.resize(n);
+  d.distance_gradient_a.data.resize(6 * n);
+  d.distance_gradient_b.data.resize(6 * n);
+  for (Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
+                        &d.normal_wrt_a, &d.normal_wrt_b})
+    m->data.clear();
+  d.smoothed_distance.clear();
+  for (Vec3Array* v : {&d.smoothed_witness_a, &d.smoothed_witness_b, &d.smoothed_normal}) v->resize(0);
+  const auto& types = ShapeTableAccess::types(shapes);
+  double* const ga = d.distance_gradient_a.data.data();
+  double* const gb = d.distance_gradient_b.data.data();
+  for_pairs(threads, n, [&](std::size_t begin, std::size_t end) {
+    constexpr std::size_t kBlock = 8;
+    double buf[12][kBlock];
+    PairGeometry g;
+    Row6 grad_a, grad_b;
+    for (std::size_t first = begin; first < end; first += kBlock) {
+      const std::size_t count = std::min(kBlock, end - first);
+      for (std::size_t j = 0; j < count; ++j) {
+        const std::size_t i = first + j;
+        const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
+        bool ok = results.status[i] == Status::converged && a < shapes.size() && b < shapes.size() &&
+                  types[a] != ShapeType::halfspace && types[b] != ShapeType::halfspace;
+        if (ok) {
+          g.witness_a = results.witness_a[i];
+          g.witness_b = results.witness_b[i];
+          g.normal = results.normal[i];
+          ok = g.witness_a.allFinite() && g.witness_b.allFinite() && g.normal.allFinite() &&
+               std::isfinite(results.distance[i]);
+        }
+        if (ok) {
+          distance_gradients(g, grad_a, grad_b);
+        } else {
+          grad_a.setConstant(std::numeric_limits<double>::quiet_NaN());
+          grad_b = grad_a;
+        }
+        for (int k = 0; k < 6; ++k) buf[k][j] = grad_a(k), buf[6 + k][j] = grad_b(k);
+        d.status[i] = ok ? DerivativeStatus::smooth : DerivativeStatus::no_witness;
+      }
+      for (int k = 0; k < 6; ++k) {
+        std::copy_n(buf[k], count, ga + k * n + first);
+        std::copy_n(buf[6 + k], count, gb + k * n + first);
+      }
+    }
+  });
+}
+
 void check_sizes(const PairBatch& batch, const PairResults& results) {
   const std::size_t n = batch.size();
   if (results.size() != n || results.distance.size() != n || results.witness_a.size() != n ||
@@ -284,6 +339,10 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
     throw InputError("method: smoothed0 runs new queries; call differentiate() instead of differentiate_results()");
   if (threads < 0) throw InputError("threads must be >= 0 (0 = all cores)");
   detail::check_sizes(batch, results);
+  if (!options.jacobians) {
+    detail::gradients_only(shapes, batch, results, threads, derivatives);
+    return;
+  }
   detail::size_for(derivatives, batch.size(), false);  // every pair writes all its entries
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
     detail::StoreBlock out(derivatives);

@@ -8,6 +8,7 @@
 #include <limits>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace batchcol {
@@ -77,14 +78,18 @@ void append_row_values(std::string& line, const PairResults& r, std::size_t i, b
 
 // Derivative columns (derivatives.hpp): d_status, the distance gradients g_a0..g_a5, g_b0..g_b5, then the 3x6
 // Jacobians row by row (dpa_da_RC: d witness_a / d xi_a, row R, column C; dpa_db, dpb_da, dpb_db, dn_da, dn_db),
-// then for smoothed0 the smoothed values s_distance, s_pa_*, s_pb_*, s_n_*.
+// then for smoothed0 the smoothed values s_distance, s_pa_*, s_pb_*, s_n_*. Without Jacobians (DerivativeOptions::
+// jacobians false: their arrays are empty) the columns stop after the gradients.
+bool has_jacobians(const DerivativeResults& d) { return d.witness_a_wrt_a.data.size() == 18 * d.size(); }
+
 std::vector<std::string> derivative_columns(const DerivativeResults& d) {
   std::vector<std::string> names = {"d_status"};
   for (const char* body : {"a", "b"})
     for (int k = 0; k < 6; ++k) names.push_back(std::string("g_") + body + std::to_string(k));
-  for (const char* m : {"dpa_da_", "dpa_db_", "dpb_da_", "dpb_db_", "dn_da_", "dn_db_"})
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 6; ++c) names.push_back(m + std::to_string(r) + std::to_string(c));
+  if (has_jacobians(d))
+    for (const char* m : {"dpa_da_", "dpa_db_", "dpb_da_", "dpb_db_", "dn_da_", "dn_db_"})
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 6; ++c) names.push_back(m + std::to_string(r) + std::to_string(c));
   if (!d.smoothed_distance.empty())
     for (const char* v :
          {"s_distance", "s_pa_x", "s_pa_y", "s_pa_z", "s_pb_x", "s_pb_y", "s_pb_z", "s_n_x", "s_n_y", "s_n_z"})
@@ -105,9 +110,10 @@ void append_derivatives(std::string& line, const DerivativeResults& d, std::size
   const char* missing = json ? "null" : "";
   for (const Vec6Array* g : {&d.distance_gradient_a, &d.distance_gradient_b})
     for (int k = 0; k < 6; ++k) key(), append_number(line, g->data[k * d.size() + i], missing, json);
-  for (const Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
-                              &d.normal_wrt_a, &d.normal_wrt_b})
-    for (int k = 0; k < 18; ++k) key(), append_number(line, m->data[k * d.size() + i], missing, json);
+  if (has_jacobians(d))
+    for (const Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
+                                &d.normal_wrt_a, &d.normal_wrt_b})
+      for (int k = 0; k < 18; ++k) key(), append_number(line, m->data[k * d.size() + i], missing, json);
   if (d.smoothed_distance.empty()) return;
   key(), append_number(line, d.smoothed_distance[i], missing, json);
   for (const Vec3Array* v : {&d.smoothed_witness_a, &d.smoothed_witness_b, &d.smoothed_normal})
@@ -115,9 +121,31 @@ void append_derivatives(std::string& line, const DerivativeResults& d, std::size
 }
 
 void check_derivative_sizes(const PairResults& r, const DerivativeResults* d) {
-  if (d && d->size() != r.size())
-    throw InputError("derivatives: " + std::to_string(d->size()) + " pairs, the results have " +
-                     std::to_string(r.size()));
+  if (!d) return;
+  const std::size_t n = d->size();
+  if (n != r.size())
+    throw InputError("derivatives: " + std::to_string(n) + " pairs, the results have " + std::to_string(r.size()));
+  // Every array read below must hold n pairs (Jacobians: all six or none; smoothed values: all or none).
+  const auto fail = [](const char* field) {
+    throw InputError(std::string("derivatives: ") + field + " does not hold one entry per pair");
+  };
+  if (d->distance_gradient_a.data.size() != 6 * n) fail("distance_gradient_a");
+  if (d->distance_gradient_b.data.size() != 6 * n) fail("distance_gradient_b");
+  if (has_jacobians(*d)) {
+    const std::pair<const Mat36Array*, const char*> matrices[] = {
+        {&d->witness_a_wrt_b, "witness_a_wrt_b"}, {&d->witness_b_wrt_a, "witness_b_wrt_a"},
+        {&d->witness_b_wrt_b, "witness_b_wrt_b"}, {&d->normal_wrt_a, "normal_wrt_a"},
+        {&d->normal_wrt_b, "normal_wrt_b"}};
+    for (const auto& [m, name] : matrices)
+      if (m->data.size() != 18 * n) fail(name);
+  }
+  if (!d->smoothed_distance.empty()) {
+    if (d->smoothed_distance.size() != n) fail("smoothed_distance");
+    for (const auto& [v, name] : {std::pair<const Vec3Array*, const char*>{&d->smoothed_witness_a, "smoothed_witness_a"},
+                                  {&d->smoothed_witness_b, "smoothed_witness_b"},
+                                  {&d->smoothed_normal, "smoothed_normal"}})
+      if (v->x.size() != n || v->y.size() != n || v->z.size() != n) fail(name);
+  }
 }
 
 }  // namespace

@@ -164,5 +164,60 @@ TEST(DerivativesOptions, BitwiseIdenticalForAnyThreadCount) {
   }
 }
 
+// DerivativeOptions::jacobians = false: the gradient of every pair is bitwise the full analytic derivative's (every
+// shape type, separated and overlapping pairs at the penetration level, pairs without witness), the Jacobian arrays
+// are empty, the status is smooth exactly where the full derivative gave a gradient, and a later full call on the
+// same DerivativeResults fills the Jacobians again.
+TEST(DerivativesOptions, GradientsOnlyAreTheFullDerivativesGradients) {
+  Rng rng(5);
+  ShapeTable shapes;
+  PairBatch batch = random_separated_pairs(rng, shapes, bounded_shape_types(), 1500);
+  const auto s = shapes.add(Shape::ellipsoid(0.5, 0.5, 0.5));
+  batch.add(s, Pose::identity(), s, Pose::from_translation({0.5, 0, 0}));  // overlapping
+  batch.add(s, Pose::identity(), 1u << 30, Pose::identity());              // invalid shape index
+  const auto h = shapes.add(Shape::halfspace({0, 0, 1}, 0));
+  batch.add(s, Pose::from_translation({0, 0, 2}), h, Pose::identity());  // halfspace
+  for (QueryLevel level : {QueryLevel::witness, QueryLevel::penetration}) {
+    QueryOptions q;
+    q.level = level;
+    DerivativeOptions full, gradients;
+    gradients.jacobians = false;
+    PairResults r;
+    DerivativeResults d_full, d;
+    differentiate(shapes, batch, q, full, r, d_full);
+    differentiate(shapes, batch, q, gradients, r, d);
+    ASSERT_EQ(d.size(), batch.size());
+    EXPECT_TRUE(d.witness_a_wrt_a.data.empty() && d.witness_b_wrt_b.data.empty() && d.normal_wrt_b.data.empty());
+    EXPECT_TRUE(d.smoothed_distance.empty());
+    std::size_t computed = 0;
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const bool given = d_full.status[i] != DerivativeStatus::no_witness;
+      EXPECT_EQ(d.status[i], given ? DerivativeStatus::smooth : DerivativeStatus::no_witness) << i;
+      computed += given;
+      for (int k = 0; k < 6; ++k) {
+        const double ga = d.distance_gradient_a[i](k), gb = d.distance_gradient_b[i](k);
+        const double fa = d_full.distance_gradient_a[i](k), fb = d_full.distance_gradient_b[i](k);
+        if (!given) {
+          EXPECT_TRUE(std::isnan(ga) && std::isnan(gb)) << i;
+          continue;
+        }
+        EXPECT_EQ(std::memcmp(&ga, &fa, sizeof ga), 0) << "pair " << i << " a" << k << ": " << ga << " vs " << fa;
+        EXPECT_EQ(std::memcmp(&gb, &fb, sizeof gb), 0) << "pair " << i << " b" << k << ": " << gb << " vs " << fb;
+      }
+    }
+    EXPECT_GE(computed, 1400u) << to_string(level);
+    differentiate(shapes, batch, q, full, r, d);  // the same object, Jacobians again
+    EXPECT_EQ(d.witness_a_wrt_a.data.size(), 18 * batch.size());
+    EXPECT_EQ(d.status, d_full.status);
+  }
+  // Only analytic has a gradients-only path.
+  DerivativeOptions o;
+  o.jacobians = false;
+  for (DerivativeMethod m : {DerivativeMethod::smoothed0, DerivativeMethod::smoothed1}) {
+    o.method = m;
+    expect_input_error(shapes, batch, QueryOptions{}, o, "jacobians");
+  }
+}
+
 }  // namespace
 }  // namespace batchcol::testing

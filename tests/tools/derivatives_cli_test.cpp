@@ -37,6 +37,28 @@ TEST_F(DerivativesCli, AnalyticAddsTheDerivativeColumns) {
   EXPECT_EQ(values[15], "-1");  // g_a0
 }
 
+TEST_F(DerivativesCli, GradientsOnlyStopAfterTheGradientColumns) {
+  const RunResult r = run("query " + file("b.json", kSpheres) + " --derivatives analytic --gradients-only");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::stringstream lines(r.out);
+  std::string header, row;
+  std::getline(lines, header);
+  std::getline(lines, row);
+  const auto names = split(header), values = split(row);
+  ASSERT_EQ(names.size(), 14u + 1 + 12);  // the results, d_status, 2 gradients
+  ASSERT_EQ(values.size(), names.size());
+  EXPECT_EQ(values[14], "smooth");
+  EXPECT_EQ(values[21], "1");   // g_b0
+  EXPECT_EQ(values[15], "-1");  // g_a0
+  for (const std::string flags : {"--derivatives smoothed1 --gradients-only", "--gradients-only"}) {
+    const RunResult bad = run("query " + file("b.json", kSpheres) + " " + flags);
+    EXPECT_EQ(bad.exit_code, 2) << flags;
+    EXPECT_NE(bad.err.find(flags == "--gradients-only" ? "--gradients-only" : "jacobians"), std::string::npos)
+        << flags << ": " << bad.err;
+    EXPECT_TRUE(bad.out.empty()) << flags;
+  }
+}
+
 TEST_F(DerivativesCli, SmoothedZeroAddsTheSmoothedValuesToJson) {
   const fs::path out = dir_ / "d.json";
   const RunResult r = run("query " + file("b.json", kSpheres) +

@@ -45,6 +45,7 @@ struct BenchSettings {
   bool json = false, no_peers = false;
   std::string derivatives;  // empty: time collide(); else differentiate() with this method (issue #18)
   DerivativeOptions derivative_options;
+  bool gradients_only = false;  // DerivativeOptions::jacobians = false
 };
 
 struct CaseResult {
@@ -106,6 +107,7 @@ CaseResult run_case(const BenchCase& bench_case, std::size_t case_index, const B
   DerivativeResults derivatives;
   DerivativeOptions d = s.derivative_options;
   if (!s.derivatives.empty()) d.method = parse_derivative_method(s.derivatives);
+  d.jacobians = !s.gradients_only;
   const auto call = [&] {
     if (s.derivatives.empty()) collide(p.shapes, p.pairs, options, results);
     else differentiate(p.shapes, p.pairs, options, d, results, derivatives);
@@ -158,7 +160,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
   if (!r.note.empty()) j["note"] = r.note;
   if (!s.derivatives.empty())
     j["derivatives"] = {{"method", s.derivatives}, {"samples", s.derivative_options.samples},
-                        {"noise", s.derivative_options.noise}};
+                        {"noise", s.derivative_options.noise}, {"jacobians", !s.gradients_only}};
   return j;
 }
 
@@ -172,8 +174,9 @@ void print_table(const std::vector<CaseResult>& results, const BenchSettings& s,
               to_string(regime), to_string(o.level), s.precision.c_str(), to_string(resolve_solver(o.solver, o.level)),
               o.solver == Solver::automatic ? " (automatic)" : "", threads, s.pairs, s.runs, s.min_run_ms);
   if (!s.derivatives.empty())
-    std::printf("timing differentiate() with derivatives %s (samples %d, noise %g), peers time plain queries\n",
-                s.derivatives.c_str(), s.derivative_options.samples, s.derivative_options.noise);
+    std::printf("timing differentiate() with derivatives %s%s (samples %d, noise %g), peers time plain queries\n",
+                s.derivatives.c_str(), s.gradients_only ? ", distance gradients only" : "",
+                s.derivative_options.samples, s.derivative_options.noise);
   std::printf("error: |distance - reference| (double, tol 1e-12, gjk, closed forms off); ratio = peer ns / batchcol ns\n");
   const bool boolean = o.level == QueryLevel::boolean;
   std::printf("%-22s %-11s %6s %10s %11s %10s %10s", "case", "kernel", "iters", "ns/pair", "pairs/s",
@@ -220,9 +223,11 @@ int run_bench(const BenchSettings& s) {
   }
   options.isa = resolve_instruction_set(options.isa);  // InputError when this CPU cannot run it
   validate(options);
+  if (s.gradients_only && s.derivatives.empty()) throw InputError("--gradients-only needs --derivatives analytic");
   if (!s.derivatives.empty()) {  // bad derivative options fail before any pair is generated
     DerivativeOptions d = s.derivative_options;
     d.method = parse_derivative_method(s.derivatives);
+    d.jacobians = !s.gradients_only;
     validate(d);
     if (options.level < QueryLevel::witness) throw InputError("--derivatives needs --query witness or penetration");
   }
@@ -276,6 +281,7 @@ Command add_bench_command(CLI::App& parent) {
   app->add_option("--derivatives", s->derivatives, "Time differentiate() instead: analytic, smoothed0 or smoothed1");
   app->add_option("--samples", s->derivative_options.samples, "Samples per pair of the smoothed derivatives");
   app->add_option("--noise", s->derivative_options.noise, "Relative noise of the smoothed derivatives");
+  app->add_flag("--gradients-only", s->gradients_only, "With --derivatives analytic: time the distance gradients only");
   app->add_flag("--json", s->json, "Print JSON (one object, an array for --case all)");
   return {app, [s] { return run_bench(*s); }};
 }

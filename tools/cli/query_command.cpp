@@ -23,6 +23,7 @@ struct QuerySettings {
   int max_iterations = 0, threads = 0;
   std::string derivatives;  // empty: none
   DerivativeOptions derivative_options;
+  bool gradients_only = false;  // DerivativeOptions::jacobians = false
   CLI::Option *query_flag = nullptr, *solver_flag = nullptr, *precision_flag = nullptr, *tolerance_flag = nullptr,
               *margin_flag = nullptr, *max_iterations_flag = nullptr;
 };
@@ -67,9 +68,11 @@ int run_query(const QuerySettings& s) {
   PairResults results;
   DerivativeResults derivatives;
   const bool differentiating = !s.derivatives.empty();
+  if (s.gradients_only && !differentiating) throw InputError("--gradients-only needs --derivatives analytic");
   if (differentiating) {
     DerivativeOptions d = s.derivative_options;
     d.method = parse_derivative_method(s.derivatives);
+    d.jacobians = !s.gradients_only;
     differentiate(batch.shapes, batch.pairs, options, d, results, derivatives);
   } else {
     collide(batch.shapes, batch.pairs, options, results);
@@ -120,6 +123,8 @@ Command add_query_command(CLI::App& parent) {
   app->add_option("--noise", s->derivative_options.noise,
                   "Noise of the smoothed derivatives, relative to the perturbed shape's bounding radius (> 0)");
   app->add_option("--seed", s->derivative_options.seed, "Seed of the smoothed derivatives' samples");
+  app->add_flag("--gradients-only", s->gradients_only,
+                "With --derivatives analytic: only the distance gradients (no Jacobian columns)");
   app->add_option("--out", s->out, "Output file (.csv or .json); standard output (CSV) when absent");
   return {app, [s] { return run_query(*s); }};
 }

@@ -65,10 +65,17 @@ struct DerivativeOptions {
   NoiseScale noise_scale = NoiseScale::relative;
   std::uint64_t seed = 0;  // samples come from a counter-based generator keyed by (seed, pair, sample): results
                            // depend on the seed only, never on the thread count or the batch split
+  /// false: the distance gradients only (method analytic only; InputError naming "jacobians" otherwise). The six
+  /// Jacobian arrays of DerivativeResults are left empty, the witness points' features are not examined, and the
+  /// status is smooth (gradient computed) or no_witness. The gradient is the envelope formula, bitwise the one the
+  /// full analytic derivative gives; where the witness points are not unique (face against face: the full
+  /// derivative says nonsmooth) it is one subgradient. It costs a pass over the witness results and 12 stores per
+  /// pair instead of the features, the implicit-function solve and 120 stores.
+  bool jacobians = true;
 };
 
 /// Throws InputError naming the option when `options` is invalid (samples < 1 or too many, noise <= 0 or not
-/// finite).
+/// finite, jacobians false with a smoothed method).
 BATCHCOL_API void validate(const DerivativeOptions& options);
 
 /// Per-pair derivative status. Values are NaN when the status says nothing was computed.
@@ -116,7 +123,7 @@ struct BATCHCOL_API DerivativeResults {
   Vec6Array distance_gradient_a, distance_gradient_b;  // d(signed distance) / d(xi)
   Mat36Array witness_a_wrt_a, witness_a_wrt_b;         // d(witness_a) / d(xi)
   Mat36Array witness_b_wrt_a, witness_b_wrt_b;         // d(witness_b) / d(xi)
-  Mat36Array normal_wrt_a, normal_wrt_b;               // d(normal) / d(xi)
+  Mat36Array normal_wrt_a, normal_wrt_b;               // d(normal) / d(xi); all six empty when jacobians is false
   /// smoothed0 only (empty otherwise): the smoothed values, means over the samples (the mean normal is not unit).
   std::vector<double> smoothed_distance;
   Vec3Array smoothed_witness_a, smoothed_witness_b, smoothed_normal;
