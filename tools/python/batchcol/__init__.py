@@ -26,12 +26,14 @@ distance negative when overlapping, results bitwise identical for any thread cou
 
 from ._batchcol import (  # noqa: F401
     XYZ,
+    Derivatives,
     Results,
     Scene,
     SceneResults,
     Shape,
     ShapeTable,
     collide,
+    differentiate,
     load_batch_file,
     load_mesh_points,
 )
@@ -40,7 +42,11 @@ from ._batchcol import (  # noqa: F401
 STATUS = ("converged", "max_iterations", "degenerate", "invalid_input")
 CONVERGED, MAX_ITERATIONS, DEGENERATE, INVALID_INPUT = range(4)
 
+#: Names of the codes in Derivatives.status (C++ DerivativeStatus).
+DERIVATIVE_STATUS = ("smooth", "zero_curvature", "nonsmooth", "singular", "partial_samples", "no_witness")
+
 __all__ = [
-    "XYZ", "Results", "Scene", "SceneResults", "Shape", "ShapeTable", "collide", "load_batch_file",
-    "load_mesh_points", "STATUS", "CONVERGED", "MAX_ITERATIONS", "DEGENERATE", "INVALID_INPUT",
+    "XYZ", "Derivatives", "Results", "Scene", "SceneResults", "Shape", "ShapeTable", "collide", "differentiate",
+    "load_batch_file", "load_mesh_points", "STATUS", "CONVERGED", "MAX_ITERATIONS", "DEGENERATE", "INVALID_INPUT",
+    "DERIVATIVE_STATUS",
 ]

@@ -46,19 +46,6 @@ std::string invalid_reason(const ShapeTable& shapes, const PairBatchView& b, std
   return "pair " + std::to_string(i) + " has invalid input";
 }
 
-void raise_invalid(const ShapeTable& shapes, const PairBatchView& b, const PairResults& r) {
-  // memchr: the common case (no invalid pair) costs one vectorised pass over one byte per pair.
-  static_assert(sizeof(Status) == 1, "statuses are bytes");
-  const auto* status = reinterpret_cast<const unsigned char*>(r.status.data());
-  const void* hit = r.size() == 0 ? nullptr : std::memchr(status, static_cast<int>(Status::invalid_input), r.size());
-  if (hit == nullptr) return;
-  const auto first = static_cast<std::size_t>(static_cast<const unsigned char*>(hit) - status);
-  std::size_t count = 0;
-  for (std::size_t i = first; i < r.size(); ++i) count += r.status[i] == Status::invalid_input;
-  throw ArgumentError(invalid_reason(shapes, b, first) + " (" + std::to_string(count) + " of " +
-                      std::to_string(r.size()) + " pairs have invalid input; invalid='status' reports them as "
-                      "per-pair statuses instead of this error)");
-}
 
 /// Raw timings of the C++ collide() on the same arrays, for bench/python/overhead.py (not public API): on the
 /// view of the caller's memory itself (same pages: the binding's overhead alone), or on a PairBatch copy.
@@ -88,6 +75,20 @@ std::vector<double> cpp_collide_seconds(const TableHolder& table, const PairBatc
 }
 
 }  // namespace
+
+void raise_invalid(const ShapeTable& shapes, const PairBatchView& b, const PairResults& r) {
+  // memchr: the common case (no invalid pair) costs one vectorised pass over one byte per pair.
+  static_assert(sizeof(Status) == 1, "statuses are bytes");
+  const auto* status = reinterpret_cast<const unsigned char*>(r.status.data());
+  const void* hit = r.size() == 0 ? nullptr : std::memchr(status, static_cast<int>(Status::invalid_input), r.size());
+  if (hit == nullptr) return;
+  const auto first = static_cast<std::size_t>(static_cast<const unsigned char*>(hit) - status);
+  std::size_t count = 0;
+  for (std::size_t i = first; i < r.size(); ++i) count += r.status[i] == Status::invalid_input;
+  throw ArgumentError(invalid_reason(shapes, b, first) + " (" + std::to_string(count) + " of " +
+                      std::to_string(r.size()) + " pairs have invalid input; invalid='status' reports them as "
+                      "per-pair statuses instead of this error)");
+}
 
 QueryOptions options_from(const std::string& level, const std::string& solver, const std::string& precision,
                           double tolerance, double relative_tolerance, double margin, int max_iterations,

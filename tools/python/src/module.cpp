@@ -26,4 +26,5 @@ PYBIND11_MODULE(_batchcol, m) {
   register_collide(m);
   register_scene(m);
   register_io(m);
+  register_derivatives(m);
 }

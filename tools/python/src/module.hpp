@@ -34,5 +34,6 @@ void register_shapes(py::module_& m);
 void register_collide(py::module_& m);
 void register_scene(py::module_& m);
 void register_io(py::module_& m);
+void register_derivatives(py::module_& m);
 
 }  // namespace batchcol::python
