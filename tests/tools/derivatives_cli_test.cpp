@@ -2,6 +2,7 @@
 #include "tools/cli_runner.hpp"
 
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace batchcol::testing {
@@ -20,14 +21,19 @@ std::vector<std::string> split(const std::string& line) {
 
 using DerivativesCli = CliTest;
 
-TEST_F(DerivativesCli, AnalyticAddsTheDerivativeColumns) {
-  const RunResult r = run("query " + file("b.json", kSpheres) + " --derivatives analytic");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::stringstream lines(r.out);
+/// The header's column names and the first row's values of CSV output.
+std::pair<std::vector<std::string>, std::vector<std::string>> first_row(const std::string& csv) {
+  std::stringstream lines(csv);
   std::string header, row;
   std::getline(lines, header);
   std::getline(lines, row);
-  const auto names = split(header), values = split(row);
+  return {split(header), split(row)};
+}
+
+TEST_F(DerivativesCli, AnalyticAddsTheDerivativeColumns) {
+  const RunResult r = run("query " + file("b.json", kSpheres) + " --derivatives analytic");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto [names, values] = first_row(r.out);
   ASSERT_EQ(names.size(), 14u + 1 + 12 + 6 * 18);  // the results, d_status, 2 gradients, 6 Jacobians
   ASSERT_EQ(values.size(), names.size());
   EXPECT_EQ(names[14], "d_status");
@@ -40,11 +46,7 @@ TEST_F(DerivativesCli, AnalyticAddsTheDerivativeColumns) {
 TEST_F(DerivativesCli, GradientsOnlyStopAfterTheGradientColumns) {
   const RunResult r = run("query " + file("b.json", kSpheres) + " --derivatives analytic --gradients-only");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::stringstream lines(r.out);
-  std::string header, row;
-  std::getline(lines, header);
-  std::getline(lines, row);
-  const auto names = split(header), values = split(row);
+  const auto [names, values] = first_row(r.out);
   ASSERT_EQ(names.size(), 14u + 1 + 12);  // the results, d_status, 2 gradients
   ASSERT_EQ(values.size(), names.size());
   EXPECT_EQ(values[14], "smooth");

@@ -51,16 +51,7 @@ std::string invalid_reason(const ShapeTable& shapes, const PairBatchView& b, std
 /// view of the caller's memory itself (same pages: the binding's overhead alone), or on a PairBatch copy.
 std::vector<double> cpp_collide_seconds(const TableHolder& table, const PairBatchView& v, const QueryOptions& o,
                                         int repeats, bool reuse_results, bool copy_to_batch) {
-  PairBatch batch;
-  if (copy_to_batch) {
-    batch.shape_a.assign(v.shape_a.data(), v.shape_a.data() + v.size());
-    batch.shape_b.assign(v.shape_b.data(), v.shape_b.data() + v.size());
-    const auto copy = [](const ConstSpan<double>& s, std::vector<double>& d) { d.assign(s.data(), s.data() + s.size()); };
-    for (auto [from, to] : {std::pair{&v.translation_a, &batch.translation_a}, {&v.translation_b, &batch.translation_b}})
-      copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
-    for (auto [from, to] : {std::pair{&v.rotation_a, &batch.rotation_a}, {&v.rotation_b, &batch.rotation_b}})
-      copy(from->w, to->w), copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
-  }
+  const PairBatch batch = copy_to_batch ? batch_copy(v) : PairBatch();
   std::vector<double> seconds;
   PairResults reused;
   for (int k = 0; k < repeats; ++k) {
@@ -88,6 +79,18 @@ void raise_invalid(const ShapeTable& shapes, const PairBatchView& b, const PairR
   throw ArgumentError(invalid_reason(shapes, b, first) + " (" + std::to_string(count) + " of " +
                       std::to_string(r.size()) + " pairs have invalid input; invalid='status' reports them as "
                       "per-pair statuses instead of this error)");
+}
+
+PairBatch batch_copy(const PairBatchView& v) {
+  PairBatch b;
+  b.shape_a.assign(v.shape_a.data(), v.shape_a.data() + v.size());
+  b.shape_b.assign(v.shape_b.data(), v.shape_b.data() + v.size());
+  const auto copy = [](const ConstSpan<double>& s, std::vector<double>& d) { d.assign(s.data(), s.data() + s.size()); };
+  for (auto [from, to] : {std::pair{&v.translation_a, &b.translation_a}, {&v.translation_b, &b.translation_b}})
+    copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
+  for (auto [from, to] : {std::pair{&v.rotation_a, &b.rotation_a}, {&v.rotation_b, &b.rotation_b}})
+    copy(from->w, to->w), copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
+  return b;
 }
 
 QueryOptions options_from(const std::string& level, const std::string& solver, const std::string& precision,

@@ -22,6 +22,9 @@ PairBatchView batch_input(const py::handle& shape_a, const py::handle& shape_b, 
 /// Raises ArgumentError naming the first pair whose status is invalid_input and why (invalid="raise").
 void raise_invalid(const ShapeTable& shapes, const PairBatchView& b, const PairResults& r);
 
+/// An owning copy of a view's pairs (without warm starts).
+PairBatch batch_copy(const PairBatchView& v);
+
 /// QueryOptions from the keyword arguments of collide() (names parsed and values validated by the engine).
 QueryOptions options_from(const std::string& level, const std::string& solver, const std::string& precision,
                           double tolerance, double relative_tolerance, double margin, int max_iterations,

@@ -45,18 +45,6 @@ NoiseScale parse_noise_scale(const std::string& name) {
   throw ArgumentError("noise_scale must be 'relative' or 'absolute', got '" + name + "'");
 }
 
-PairBatch batch_copy(const PairBatchView& v) {
-  PairBatch b;
-  b.shape_a.assign(v.shape_a.data(), v.shape_a.data() + v.size());
-  b.shape_b.assign(v.shape_b.data(), v.shape_b.data() + v.size());
-  const auto copy = [](const ConstSpan<double>& s, std::vector<double>& d) { d.assign(s.data(), s.data() + s.size()); };
-  for (auto [from, to] : {std::pair{&v.translation_a, &b.translation_a}, {&v.translation_b, &b.translation_b}})
-    copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
-  for (auto [from, to] : {std::pair{&v.rotation_a, &b.rotation_a}, {&v.rotation_b, &b.rotation_b}})
-    copy(from->w, to->w), copy(from->x, to->x), copy(from->y, to->y), copy(from->z, to->z);
-  return b;
-}
-
 }  // namespace
 
 void register_derivatives(py::module_& m) {
