@@ -163,7 +163,12 @@ template <class T> struct WideGjk {
     std::memcpy(dy, &d.y, sizeof dy);
     std::memcpy(dz, &d.z, sizeof dz);
     // Only lanes 0..W-1 exist: a mask bit above them must not index s.hull (UBSan found index W here under the
-    // sanitizer build; the loop over l < W this replaced ignored such bits the same way).
+    // sanitizer build; the loop over l < W this replaced ignored such bits the same way). No caller builds such a
+    // mask: in that build (GCC 12.2, -O2 -fsanitize=address,undefined) the AVX-512 loop spills lane_bits()'s
+    // 8-bit k-mask with a one-byte store (kmovb %k5, slot) and reloads it as 32 bits (mov slot, %ecx) for the
+    // call from minkowski(), so bits 8-31 are the stale bytes of the pointer the slot held before (gdb: live =
+    // 0xfffec9ff with the slot's old value 0x7ffffffec9c0; 16-bit masks alike for float). Release builds (-O3)
+    // pass W bits (the bitwise tests against the reference would fault or differ otherwise).
     static_assert(W < 32, "lane mask");
     for (std::uint32_t bits = live & ((1u << W) - 1u); bits != 0; bits &= bits - 1) {
       const int l = __builtin_ctz(bits);
