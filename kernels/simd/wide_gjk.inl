@@ -163,7 +163,12 @@ template <class T> struct WideGjk {
     std::memcpy(dy, &d.y, sizeof dy);
     std::memcpy(dz, &d.z, sizeof dz);
     // Only lanes 0..W-1 exist: a mask bit above them must not index s.hull (UBSan found index W here under the
-    // sanitizer build; the loop over l < W this replaced ignored such bits the same way).
+    // sanitizer build; the loop over l < W this replaced ignored such bits the same way). No caller builds such a
+    // mask: in that build (GCC 12.2, -O2 -fsanitize=address,undefined) the AVX-512 loop spills lane_bits()'s
+    // 8-bit k-mask with a one-byte store (kmovb %k5, slot) and reloads it as 32 bits (mov slot, %ecx) for the
+    // call from minkowski(), so bits 8-31 are the stale bytes of the pointer the slot held before (gdb: live =
+    // 0xfffec9ff with the slot's old value 0x7ffffffec9c0; 16-bit masks alike for float). Release builds (-O3)
+    // pass W bits (the bitwise tests against the reference would fault or differ otherwise).
     static_assert(W < 32, "lane mask");
     for (std::uint32_t bits = live & ((1u << W) - 1u); bits != 0; bits &= bits - 1) {
       const int l = __builtin_ctz(bits);
@@ -298,6 +303,25 @@ template <class T> struct WideGjk {
             select(ok, kc.x * c.y, zero), select(ok, kc.x * c.z, zero), select(ok, kc.y * c.z, zero)};
   }
 
+  /// Vertex i of `v` (packed xyz triples, `count` of them) into row i of one lane's column of the table, from
+  /// `to` = the lane's element of row 0 of vx (vy and vz follow vx in SmallHulls: fixed offsets from it). One
+  /// pointer walk, unrolled, with no aliasing between the hull and the table: written with three indexed
+  /// arrays, GCC versioned the loop for vectorisation (alias and length checks) and ran it scalar anyway at 8
+  /// vertices (~120 instructions per small hull copied; convex8-convex8 witness copies two per pair).
+  static void copy_rows(T* __restrict to, const double* __restrict v, int count) {
+    static_assert(sizeof(SmallHulls) == 3 * sizeof(real) * kSmallRows, "vx, vy, vz contiguous");
+    constexpr int Y = kSmallRows * W, Z = 2 * kSmallRows * W;
+    int i = 0;
+    for (; i + 4 <= count; i += 4, v += 12, to += 4 * W) {
+      for (int r = 0; r < 4; ++r) {
+        to[r * W] = T(v[3 * r]);
+        to[r * W + Y] = T(v[3 * r + 1]);
+        to[r * W + Z] = T(v[3 * r + 2]);
+      }
+    }
+    for (; i < count; ++i, v += 3, to += W) to[0] = T(v[0]), to[Y] = T(v[1]), to[Z] = T(v[2]);
+  }
+
   /// Puts lane l's small hull into the table: its vertices, then its last vertex up to `rows`; when the hull has
   /// more vertices than `rows`, the other lanes are padded up to the new row count first.
   static void load_small_hull(Side& s, int l, const HullView& hull) {
@@ -317,8 +341,7 @@ template <class T> struct WideGjk {
       }
       s.rows = count;
     }
-    const double* v = hull.vertices;  // packed xyz triples
-    for (int i = 0; i < count; ++i) x[i * W + l] = T(v[3 * i]), y[i * W + l] = T(v[3 * i + 1]), z[i * W + l] = T(v[3 * i + 2]);
+    copy_rows(reinterpret_cast<T*>(s.table) + l, hull.vertices, count);
     const int last = count - 1;
     for (int i = count; i < s.rows; ++i)
       x[i * W + l] = x[last * W + l], y[i * W + l] = y[last * W + l], z[i * W + l] = z[last * W + l];
@@ -610,6 +633,7 @@ template <class T> struct WideGjk {
     real tolerance{}, relative{}, touch{}, core_margin{};
     std::int64_t pair[W];      // pair index of each lane, -1 when empty
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
+    int newton_pair = -1;     // newton_pair_type(A.type, B.type), set by the first refill of the run; -1: not yet
   };
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
@@ -655,6 +679,14 @@ template <class T> struct WideGjk {
     s.hint[l] = SupportHint{};
     if (same) return;
     const std::uint32_t bit = 1u << l;
+    // A run of hulls of one vertex count (a batch of convex8 pairs): the table has exactly its rows, so no lane
+    // is padded and the copy is all (load_small_hull()'s general case cost ~25 more instructions per hull).
+    if (int(hull->vertex_count) == s.rows) [[likely]] {
+      s.small |= bit;
+      copy_rows(reinterpret_cast<T*>(s.table) + l, hull->vertices, s.rows);
+      s.lane_vertices[l] = hull->vertex_count;
+      return;
+    }
     const bool small = hull->vertex_count < kHillClimbMinVertices;
     s.small = small ? s.small | bit : s.small & ~bit;
     if (small) load_small_hull(s, l, *hull);
@@ -715,7 +747,10 @@ template <class T> struct WideGjk {
     L.stale[l] = 0;
     // Newton directions: every lane of a newton_pair_type() run may take them (boolean lanes are left out where
     // the steps are chosen, by L.boolean_only, which the batch-array refill sets per run).
-    L.newton[l] = newton_pair_type(L.A.type, L.B.type) ? -1 : 0;
+    // The run's types are set before its first refill: their type tests once per run, not per refill (~10
+    // instructions).
+    if (L.newton_pair < 0) [[unlikely]] L.newton_pair = newton_pair_type(L.A.type, L.B.type) ? 1 : 0;
+    L.newton[l] = -Int(L.newton_pair);
     L.newton_next[l] = 0;
     L.newton_steps[l] = 0;
   }

@@ -353,10 +353,12 @@ template <class T> struct WideGjkPairs {
       const QueryLevel level = options.level;
       if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(quiet_nan<T>());
       if (level >= QueryLevel::witness) {
-        const Vec3<T> none = Vec3<T>::Constant(quiet_nan<T>());
-        lp.put_world(out.witness_a, i, none, true);
-        lp.put_world(out.witness_b, i, none, true);
-        lp.put_world(out.normal, i, none, false);
+        // write_pair_output()'s R NaN (+ t) of the PairOutput's NaNs, stored without the arithmetic: on x86 a
+        // product or sum with a quiet NaN operand returns that NaN, so every component is double(quiet_nan<T>()),
+        // the default quiet NaN, in either precision (the same bits; tested against the scalar path).
+        const double none = static_cast<double>(quiet_nan<T>());
+        for (double* const* v : {out.witness_a, out.witness_b, out.normal})
+          for (int c = 0; c < 3; ++c) v[c][i] = none;
       }
       lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
       out.iterations[i] = int(L.k[l]);
