@@ -35,7 +35,6 @@ struct Hit {
 // the nodes do not fit a core's L2 (1-2 MB on current x86 servers): 100k mixed objects, +20% rays/s. The traversal
 // prefetches pushed nodes on such trees only, for the same reason.
 constexpr std::size_t kSortedCastMin = 4096;
-constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 constexpr std::size_t kPrefetchAhead = 8;
 
 bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
@@ -110,7 +109,13 @@ class Caster {
       };
       using Leaf = decltype(leaf);
       WideRay w = r.wide;
-      w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
+      // Leaves whose ball the ray misses are skipped without a call: in the node step on trees that fit the L2
+      // (WideBvh::balls(), set by update()), when popped on larger ones (their casts are bound by the node loads).
+      if (s_.wide.balls().empty()) {
+        w.balls = s_.leaf_balls.data();
+      } else {
+        w.node_balls = s_.wide.balls().data();
+      }
       w.prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
       wide_(s_.wide.nodes().data(), w, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
@@ -381,16 +386,30 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
     });
     return;
   }
+  // Input order: the rays' validity and wide setup are computed 8 at a time in SIMD lanes (WideRaySetup: the same
+  // bits as ray_is_valid() and make_wide_ray(), without their data-dependent branches).
+  const WideRaySetup setup = select_wide_ray_setup();
+  const WideRayInput input{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
+                           {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
+                           rays.t_max.data()};
   detail::run_with_threads(options.threads, [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+      WideRay wide[kWideRaySetupLanes];
+      std::uint8_t status[kWideRaySetupLanes];
       for (std::size_t c = range.begin(); c != range.end(); ++c) {
         const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
         for (std::size_t i = begin; i < end; ++i) {
           if (all) chunk_counts[c].push_back(0);
-          if (!detail::ray_is_valid(rays, i)) continue;
-          const RayContext r = context(Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]),
-                                       Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]),
-                                       rays.t_max[i]);
+          const std::size_t lane = (i - begin) % kWideRaySetupLanes;
+          if (lane == 0) setup(input, i, std::min(kWideRaySetupLanes, end - i), wide, status);
+          if (status[lane] == kWideRayInvalid) continue;
+          RayContext r;
+          r.o = Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]);
+          r.d = Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]);
+          r.t_max = rays.t_max[i];
+          r.d2 = r.d.squaredNorm();
+          r.wide_ok = status[lane] == kWideRaySupported;
+          if (r.wide_ok) r.wide = wide[lane];
           bool capped = false;
           if (all) {
             std::vector<Hit>& hits = chunk_hits[c];

@@ -21,6 +21,7 @@
 
 #include "ray_wide_bvh.hpp"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace batchcol {
@@ -45,6 +46,11 @@ struct WideRay {
   float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
   float ball_margin;           // kBallMargin * |o|_1, rounded up
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
+  // Per node (WideBvh::balls()): the same test on all leaf children of a node at once, in its 8-lane step, so the
+  // leaves it rejects are neither ordered, pushed, popped nor branched on one by one (the scalar test's reject is
+  // random data). Lane k runs the scalar test's operations in its order: the same leaves are rejected, the others
+  // visited in the same order, so results are bitwise those of `balls` (which is then not needed).
+  const WideBalls* node_balls = nullptr;
   bool prefetch = false;         // request a pushed node's lines early (worth it when the nodes do not fit the L2)
 };
 
@@ -55,6 +61,27 @@ void make_leaf_ball(const double c[3], double bound, float out[4]);
 /// True when the float test is safe for this ray (see above); o and d are the ray's origin and direction.
 bool wide_ray_supported(const double o[3], const double d[3]);
 WideRay make_wide_ray(const double o[3], const double d[3]);
+
+/// What WideRaySetup found for a ray: invalid (detail::ray_is_valid() false), valid but outside the float test's
+/// range (wide_ray_supported() false: the binary tree in double), or valid and supported (its WideRay is written).
+enum : std::uint8_t { kWideRayInvalid = 0, kWideRayBinary = 1, kWideRaySupported = 2 };
+/// A batch of rays as structure of arrays (origin, direction, t_max), read from index `begin` on.
+struct WideRayInput {
+  const double* o[3];
+  const double* d[3];
+  const double* t_max;
+};
+/// The setup of n <= 8 consecutive rays at once: status[l] for ray begin + l and, for kWideRaySupported, out[l]
+/// bitwise equal to make_wide_ray() (balls nullptr, no prefetch). The scalar setup costs ~260 instructions and ~4
+/// mispredicted branches a ray (the rounding direction and the sign are random data); lanes and masks do not branch.
+using WideRaySetup = void (*)(const WideRayInput& in, std::size_t begin, std::size_t n, WideRay* out,
+                              std::uint8_t* status);
+constexpr std::size_t kWideRaySetupLanes = 8;
+/// The setup for this processor, and per instruction set for the tests (0 baseline, 1 AVX2 (also on AVX-512
+/// processors); nullptr for others and when the processor lacks it).
+WideRaySetup select_wide_ray_setup();
+WideRaySetup wide_ray_setup_for(int isa);
+
 /// The float limit the traversal compares with for a double limit t: t (1 + 2^-20) rounded up to float.
 float wide_limit(double t);
 

@@ -5,12 +5,14 @@
 #include "engine/src/ray_bvh.hpp"
 #include "engine/src/ray_wide_bvh.hpp"
 #include "engine/src/ray_wide_traverse.hpp"
+#include "engine/src/rays_common.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -298,6 +300,149 @@ TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {
   // Rounding of the limit: never below the exact value.
   for (double t : {1.0, 0.1, 1e-30, 3e38, 1e300}) EXPECT_GE(double(wide_limit(t)), t);
   EXPECT_EQ(wide_limit(INFINITY), INFINITY);
+}
+
+// The leaf balls tested in the node step (WideRay::node_balls, from WideBvh::set_leaf_balls) reject exactly the
+// leaves the scalar test on popped leaves (WideRay::balls) rejects: the same leaves visited in the same order, on
+// every instruction set; with random rays and rays grazing a ball at 1 - 1e-7 and 1 + 1e-7 of its radius far from
+// the origin (where the margins decide). Balls are inside their boxes' corners, so boxes hit with balls missed occur.
+TEST(RayWideBvh, NodeBallLanesRejectWhatTheLeafBallTestRejects) {
+  Rng rng(41);
+  const std::size_t n = 1500;
+  const double far = 1e3;
+  broadphase::AabbSoa b;
+  b.resize(n);
+  std::vector<double> centre(3 * n), radius(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    radius[i] = uniform(rng, 0.2, 1.5);
+    for (int k = 0; k < 3; ++k) centre[3 * i + k] = far + uniform(rng, -40.0, 40.0);
+    b.min_x[i] = float(centre[3 * i] - radius[i]), b.max_x[i] = float(centre[3 * i] + radius[i]);
+    b.min_y[i] = float(centre[3 * i + 1] - radius[i]), b.max_y[i] = float(centre[3 * i + 1] + radius[i]);
+    b.min_z[i] = float(centre[3 * i + 2] - radius[i]), b.max_z[i] = float(centre[3 * i + 2] + radius[i]);
+  }
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b);
+  std::vector<float> balls(4 * n);
+  for (std::size_t leaf = 0; leaf < n; ++leaf) {
+    const std::uint32_t i = bvh.leaf_object()[leaf];
+    make_leaf_ball(&centre[3 * i], radius[i], &balls[4 * leaf]);
+  }
+  wide.set_leaf_balls(balls.data());
+  ASSERT_EQ(wide.balls().size(), wide.nodes().size());
+  std::size_t rejected = 0, kept = 0, grazing = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    double o[3], d[3];
+    if (trial % 2 == 0) {
+      for (int k = 0; k < 3; ++k) o[k] = far + uniform(rng, -80, 80), d[k] = far + uniform(rng, -50, 50) - o[k];
+    } else {  // tangent-ish: passes object i at (1 +- 1e-7) of its radius
+      const std::size_t i = rng() % n;
+      double a[3], u[3];
+      for (int k = 0; k < 3; ++k) a[k] = uniform(rng, -1, 1), u[k] = uniform(rng, -1, 1);
+      const double ua = u[0] * a[0] + u[1] * a[1] + u[2] * a[2], aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+      for (int k = 0; k < 3; ++k) u[k] -= ua / aa * a[k];  // u perpendicular to a
+      const double un = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      const double at = radius[i] * (trial % 4 == 1 ? 1.0 - 1e-7 : 1.0 + 1e-7);
+      for (int k = 0; k < 3; ++k) {
+        const double p = centre[3 * i + k] + at * u[k] / un;
+        o[k] = p - 60.0 * a[k];
+        d[k] = a[k];
+      }
+      ++grazing;
+    }
+    if (!wide_ray_supported(o, d)) continue;
+    WideRay scalar = make_wide_ray(o, d), lanes = scalar, none = scalar;
+    scalar.balls = balls.data();
+    lanes.node_balls = wide.balls().data();
+    Leaves all;
+    wide_traverse_for(0)(wide.nodes().data(), none, wide_limit(INFINITY), record, &all);
+    Leaves reference;
+    wide_traverse_for(0)(wide.nodes().data(), scalar, wide_limit(INFINITY), record, &reference);
+    rejected += all.seen.size() - reference.seen.size();
+    kept += reference.seen.size();
+    for (int isa = 0; isa < 3; ++isa) {
+      if (const WideTraverse traverse = wide_traverse_for(isa)) {
+        Leaves seen;
+        traverse(wide.nodes().data(), lanes, wide_limit(INFINITY), record, &seen);
+        ASSERT_EQ(seen.seen, reference.seen) << "isa " << isa << " trial " << trial;
+      }
+    }
+  }
+  EXPECT_GT(rejected, 500u);  // the balls do reject leaves whose boxes the rays reach
+  EXPECT_GT(kept, 500u);
+  EXPECT_GT(grazing, 1000u);
+  // Without balls for the node step, balls() is empty again.
+  wide.set_leaf_balls(nullptr);
+  EXPECT_TRUE(wide.balls().empty());
+}
+
+// The SIMD setup of 8 rays at once (WideRaySetup, used by RaySceneIndex::cast) gives every ray the status of the
+// scalar ray_is_valid() / wide_ray_supported() and, when supported, make_wide_ray()'s fields bit for bit, on every
+// instruction set and for partial groups: random rays, and the cases where the rounding or the sign decides (origins
+// exactly representable in float or not, +-0, subnormal and huge components, the range limits 2^-60 / 2^60), and
+// invalid rays (NaN, inf, zero direction, negative or NaN t_max).
+TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
+  Rng rng(19);
+  RayBatch rays;
+  const double special[] = {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1.0 + 0x1p-40, -(1.0 + 0x1p-40), 0x1p-60, -0x1p-60,
+                            0x1p-61, 0x1p60, -0x1p60, 0x1p61, 1e-310, -1e-310, 1e-45, 3.4e38, 1e300, NAN, INFINITY,
+                            -INFINITY};
+  const std::size_t s = std::size(special);
+  for (int i = 0; i < 20000; ++i) {
+    double o[3], d[3], t = uniform(rng, 0.0, 10.0);
+    for (int k = 0; k < 3; ++k) {
+      const int mode = int(rng() % 4);
+      o[k] = mode == 0 ? special[rng() % s] : uniform(rng, -100.0, 100.0);
+      d[k] = mode == 1 ? special[rng() % s] : uniform(rng, -1.0, 1.0);
+      if (mode == 2) o[k] = double(float(o[k]));  // exactly a float: no rounding step
+    }
+    if (i % 50 == 0) t = special[rng() % s] * (rng() % 2 ? 1.0 : -1.0);
+    if (i % 97 == 0) d[0] = d[1] = d[2] = 0.0;
+    rays.add(Eigen::Vector3d(o[0], o[1], o[2]), Eigen::Vector3d(d[0], d[1], d[2]), t);
+  }
+  const WideRayInput in{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
+                        {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
+                        rays.t_max.data()};
+  std::size_t counts[3] = {0, 0, 0};
+  for (int isa = 0; isa < 3; ++isa) {
+    const WideRaySetup setup = wide_ray_setup_for(isa);
+    if (setup == nullptr) continue;
+    for (std::size_t group : {std::size_t(8), std::size_t(5)}) {
+      for (std::size_t b = 0; b < rays.size(); b += group) {
+        const std::size_t n = std::min(group, rays.size() - b);
+        WideRay out[kWideRaySetupLanes];
+        std::uint8_t status[kWideRaySetupLanes];
+        setup(in, b, n, out, status);
+        for (std::size_t l = 0; l < n; ++l) {
+          const std::size_t i = b + l;
+          const double o[3] = {rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]};
+          const double d[3] = {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]};
+          const bool valid = detail::ray_is_valid(rays, i), supported = valid && wide_ray_supported(o, d);
+          const std::uint8_t expected = supported ? kWideRaySupported : valid ? kWideRayBinary : kWideRayInvalid;
+          ASSERT_EQ(status[l], expected) << "isa " << isa << " ray " << i;
+          if (isa == 0 && group == 8) ++counts[expected];
+          if (!supported) continue;
+          const WideRay w = make_wide_ray(o, d);
+          const WideRay& v = out[l];
+          EXPECT_EQ(std::memcmp(w.o_near, v.o_near, sizeof w.o_near), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.o_far, v.o_far, sizeof w.o_far), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.inv, v.inv, sizeof w.inv), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.near_offset, v.near_offset, sizeof w.near_offset), 0) << "isa " << isa;
+          EXPECT_EQ(std::memcmp(w.far_offset, v.far_offset, sizeof w.far_offset), 0) << "isa " << isa;
+          EXPECT_EQ(std::memcmp(w.ball_o, v.ball_o, sizeof w.ball_o), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.ball_d, v.ball_d, sizeof w.ball_d), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(&w.ball_margin, &v.ball_margin, sizeof w.ball_margin), 0) << "isa " << isa;
+          EXPECT_EQ(v.balls, nullptr);
+          EXPECT_FALSE(v.prefetch);
+        }
+      }
+    }
+  }
+  // Every class occurs often enough to mean something.
+  EXPECT_GT(counts[kWideRayInvalid], 500u);
+  EXPECT_GT(counts[kWideRayBinary], 500u);
+  EXPECT_GT(counts[kWideRaySupported], 5000u);
 }
 
 }  // namespace
