@@ -117,8 +117,6 @@ void RaySceneIndex::update(const Scene& scene, int threads, bool force_rebuild) 
                                          &s.leaf_balls[4 * k]);
                         }
                       });
-    // The node step's copy of the balls, on trees that fit the L2 (larger ones test a leaf's ball when popped).
-    s.wide.set_leaf_balls(s.wide.nodes().size() * sizeof(WideNode) < kLargeTreeBytes ? s.leaf_balls.data() : nullptr);
     s.timings.boxes_ms += ms_since(leaf_start);
   });
   s.halfspaces.clear();

@@ -35,6 +35,7 @@ struct Hit {
 // the nodes do not fit a core's L2 (1-2 MB on current x86 servers): 100k mixed objects, +20% rays/s. The traversal
 // prefetches pushed nodes on such trees only, for the same reason.
 constexpr std::size_t kSortedCastMin = 4096;
+constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 constexpr std::size_t kPrefetchAhead = 8;
 
 bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
@@ -109,13 +110,7 @@ class Caster {
       };
       using Leaf = decltype(leaf);
       WideRay w = r.wide;
-      // Leaves whose ball the ray misses are skipped without a call: in the node step on trees that fit the L2
-      // (WideBvh::balls(), set by update()), when popped on larger ones (their casts are bound by the node loads).
-      if (s_.wide.balls().empty()) {
-        w.balls = s_.leaf_balls.data();
-      } else {
-        w.node_balls = s_.wide.balls().data();
-      }
+      w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
       w.prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
       wide_(s_.wide.nodes().data(), w, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);

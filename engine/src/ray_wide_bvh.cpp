@@ -33,7 +33,6 @@ void set_slot(WideNode& n, int k, const BvhBox& b, std::uint32_t child) {
   n.lo_x[k] = b.lo[0], n.lo_y[k] = b.lo[1], n.lo_z[k] = b.lo[2];
   n.hi_x[k] = b.hi[0], n.hi_y[k] = b.hi[1], n.hi_z[k] = b.hi[2];
   n.child[k] = child;
-  if (child & kLeafBit) n.leaf_bits |= 1u << k;
 }
 
 void clear_slot(WideNode& n, int k) {
@@ -139,7 +138,6 @@ struct CollapsePlan {
 void WideBvh::collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
   nodes_.clear();
   source_.clear();
-  balls_.clear();
   if (bvh.leaf_count() < 2) return;
   CollapsePlan plan;
   plan.plan(bvh, boxes);
@@ -182,27 +180,6 @@ void WideBvh::refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
                         for (int k = 0; k < kWideArity; ++k) {
                           const std::uint32_t ref = source_[i * kWideArity + k];
                           if (ref != kWideEmpty) set_slot(n, k, box_of_ref(bvh, boxes, ref), n.child[k]);
-                        }
-                      }
-                    });
-}
-
-void WideBvh::set_leaf_balls(const float* balls) {
-  if (balls == nullptr) {
-    balls_.clear();
-    return;
-  }
-  balls_.resize(nodes_.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes_.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                        const WideNode& n = nodes_[i];
-                        WideBalls& b = balls_[i];
-                        for (int k = 0; k < kWideArity; ++k) {
-                          const bool leaf = (n.leaf_bits >> k) & 1u;
-                          const float* l = balls + 4 * std::size_t(leaf ? n.child[k] & ~kLeafBit : 0u);
-                          b.x[k] = leaf ? l[0] : 0.0f, b.y[k] = leaf ? l[1] : 0.0f, b.z[k] = leaf ? l[2] : 0.0f;
-                          b.r[k] = leaf ? l[3] : INFINITY;
                         }
                       }
                     });

@@ -11,7 +11,6 @@
 #include "broadphase/aabb_soa.hpp"
 #include "ray_bvh.hpp"
 
-#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -22,26 +21,13 @@ constexpr int kWideArity = 8;
 constexpr std::uint32_t kWideEmpty = 0xffffffffu;
 
 /// One node: child k's box is [lo_x[k], hi_x[k]] x ... ; child[k] is kLeafBit | leaf index (Morton rank), a node
-/// index, or kWideEmpty; bit k of leaf_bits is set when child k is a leaf. 228 bytes of data, aligned to whole
-/// cache lines.
+/// index, or kWideEmpty. 224 bytes of data, aligned to whole cache lines.
 struct alignas(64) WideNode {
   float lo_x[kWideArity], lo_y[kWideArity], lo_z[kWideArity];
   float hi_x[kWideArity], hi_y[kWideArity], hi_z[kWideArity];
   std::uint32_t child[kWideArity];
-  std::uint32_t leaf_bits;  // in the line's spare bytes: the node stays 256 bytes
 };
 static_assert(sizeof(WideNode) == 256, "WideNode layout");
-
-/// The float bounding balls of one node's leaf children (make_leaf_ball(), ray_wide_traverse.hpp), lane k for slot
-/// k; other slots have radius +inf (never rejected). Kept apart from the nodes, so trees without them read the same
-/// 256 bytes a node.
-struct alignas(64) WideBalls {
-  float x[kWideArity], y[kWideArity], z[kWideArity], r[kWideArity];
-};
-
-/// Trees of at least this many bytes of wide nodes do not fit a core's L2 (1-2 MB on current x86 servers): their
-/// casts order the rays, prefetch nodes and keep the leaf balls out of the node step (ray_scene_cast.cpp).
-constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 
 class WideBvh {
  public:
@@ -50,19 +36,12 @@ class WideBvh {
   /// Copies the boxes of a refitted `bvh` (same topology as at collapse()) into the wide nodes, in parallel.
   void refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
 
-  /// Copies the leaves' float balls (4 floats per leaf by Morton rank: x, y, z, radius) into balls() by node and
-  /// slot, in parallel; after every collapse() or refit(). nullptr: balls() is emptied.
-  void set_leaf_balls(const float* balls);
-
   const std::vector<WideNode>& nodes() const { return nodes_; }
-  /// Per node, its leaf children's balls; empty when set_leaf_balls() was not called since the last collapse().
-  const std::vector<WideBalls>& balls() const { return balls_; }
-  void clear() { nodes_.clear(), source_.clear(), balls_.clear(); }
+  void clear() { nodes_.clear(), source_.clear(); }
 
  private:
   std::vector<WideNode> nodes_;        // node 0 is the root
   std::vector<std::uint32_t> source_;  // per node and slot: the binary reference whose box fills the slot
-  std::vector<WideBalls> balls_;
 };
 
 }  // namespace batchcol

@@ -27,11 +27,7 @@ namespace wide_avx2 {
 #define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_BITS
-template <class V> inline V sqrt_avx2(V v) {
-  const __m256d a = _mm256_sqrt_pd(__m256d{v[0], v[1], v[2], v[3]}), b = _mm256_sqrt_pd(__m256d{v[4], v[5], v[6], v[7]});
-  return V{a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]};
-}
-#define BATCHCOL_SETUP_SQRT(v) sqrt_avx2(v)
+#define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
 #include "ray_wide_setup.inl"
 #undef BATCHCOL_SETUP_SQRT
 }  // namespace wide_avx2
@@ -47,7 +43,7 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_BITS
 template <class V> inline V sqrt_lanes(V v) {
-  for (int l = 0; l < 8; ++l) v[l] = __builtin_sqrt(v[l]);
+  for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
   return v;
 }
 #define BATCHCOL_SETUP_SQRT(v) sqrt_lanes(v)

@@ -46,11 +46,6 @@ struct WideRay {
   float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
   float ball_margin;           // kBallMargin * |o|_1, rounded up
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
-  // Per node (WideBvh::balls()): the same test on all leaf children of a node at once, in its 8-lane step, so the
-  // leaves it rejects are neither ordered, pushed, popped nor branched on one by one (the scalar test's reject is
-  // random data). Lane k runs the scalar test's operations in its order: the same leaves are rejected, the others
-  // visited in the same order, so results are bitwise those of `balls` (which is then not needed).
-  const WideBalls* node_balls = nullptr;
   bool prefetch = false;         // request a pushed node's lines early (worth it when the nodes do not fit the L2)
 };
 

@@ -37,24 +37,6 @@ inline bool ball_misses(const float* b, const WideRay& r) {
   return cx * cx + cy * cy + cz * cz > radius * radius;
 }
 
-// The lanes of a node whose leaf ball the ray's line passes farther than its radius plus the margins: ball_misses()
-// lane by lane, the same operations in the same order (no fused multiply-adds), so the same answer; lanes of radius
-// +inf (node and empty slots) never.
-inline std::uint32_t ball_lanes_miss(const WideBalls& b, const WideRay& r) {
-  V x, y, z, rad;
-  __builtin_memcpy(&x, b.x, sizeof x);
-  __builtin_memcpy(&y, b.y, sizeof y);
-  __builtin_memcpy(&z, b.z, sizeof z);
-  __builtin_memcpy(&rad, b.r, sizeof rad);
-  x -= splat(r.ball_o[0]), y -= splat(r.ball_o[1]), z -= splat(r.ball_o[2]);
-  const V dx = splat(r.ball_d[0]), dy = splat(r.ball_d[1]), dz = splat(r.ball_d[2]);
-  const V cx = y * dz - z * dy, cy = z * dx - x * dz, cz = x * dy - y * dx;
-  const V sign = splat(-0.0f);
-  const auto fabs_v = [&](V v) { return V((M)v & ~(M)sign); };
-  const V radius = rad + splat(r.ball_margin) + splat(kBallMargin) * (fabs_v(x) + fabs_v(y) + fabs_v(z));
-  return BATCHCOL_WIDE_BITS((M)(cx * cx + cy * cy + cz * cz > radius * radius));
-}
-
 struct Entry {
   std::uint32_t ref;
   float t;
@@ -130,8 +112,6 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
     tf = tf * scale + slack;
     std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
-    // Leaf children whose box is hit but whose ball is missed go no further (most of the leaves a ray reaches).
-    if (r.node_balls != nullptr && (bits & n->leaf_bits) != 0) bits &= ~ball_lanes_miss(r.node_balls[e.ref], r);
     if (bits == 0) {
       if (!pop()) return;
       continue;
