@@ -215,17 +215,6 @@ class Caster {
   WideTraverse wide_;
 };
 
-RayContext context(const Vec3<double>& o, const Vec3<double>& d, double t_max) {
-  RayContext r;
-  r.o = o;
-  r.d = d;
-  r.t_max = t_max;
-  r.d2 = r.d.squaredNorm();
-  r.wide_ok = wide_ray_supported(r.o.data(), r.d.data());
-  if (r.wide_ok) r.wide = make_wide_ray(r.o.data(), r.d.data());
-  return r;
-}
-
 void store(RayResults& out, std::size_t i, const Hit& h) {
   out.hit[i] = 1;
   out.t[i] = h.t;
@@ -360,19 +349,39 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
       RayOrder order(rays, state_->wide.nodes()[0]);
       std::vector<CastResult> results(n);
       const bool any = options.query == RayQuery::any;
+      const WideRaySetup setup = select_wide_ray_setup();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+        double rows[7][kWideRaySetupLanes];  // 8 records in cast order as structure of arrays
+        const WideRayInput group{{rows[0], rows[1], rows[2]}, {rows[3], rows[4], rows[5]}, rows[6]};
+        WideRay wide[kWideRaySetupLanes];
+        std::uint8_t status[kWideRaySetupLanes];
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
           const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
           for (std::size_t k = begin; k < end; ++k) {
             if (k + kPrefetchAhead < end) order.prefetch(k + kPrefetchAhead);
+            const std::size_t lane = (k - begin) % kWideRaySetupLanes;
+            if (lane == 0) {  // the next 8 records' setup in lanes (as in input order below)
+              const std::size_t m = std::min(kWideRaySetupLanes, end - k);
+              for (std::size_t l = 0; l < m; ++l) {
+                const PackedRay& q = order.ray(k + l);
+                for (int a = 0; a < 3; ++a) rows[a][l] = q.o[a], rows[3 + a][l] = q.d[a];
+                rows[6][l] = q.t_max;
+              }
+              setup(group, 0, m, wide, status);
+            }
             const PackedRay& p = order.ray(k);
             CastResult& res = results[k];
             res.found = false, res.status = RayStatus::invalid_input;
-            if (!p.valid) continue;
+            if (status[lane] == kWideRayInvalid) continue;
+            RayContext r;
+            r.o = Vec3<double>(p.o[0], p.o[1], p.o[2]);
+            r.d = Vec3<double>(p.d[0], p.d[1], p.d[2]);
+            r.t_max = p.t_max;
+            r.d2 = r.d.squaredNorm();
+            r.wide_ok = status[lane] == kWideRaySupported;
+            if (r.wide_ok) r.wide = wide[lane];
             bool capped = false;
-            caster.closest_or_any(context(Vec3<double>(p.o[0], p.o[1], p.o[2]), Vec3<double>(p.d[0], p.d[1], p.d[2]),
-                                          p.t_max),
-                                  any, res.best, res.found, capped);
+            caster.closest_or_any(r, any, res.best, res.found, capped);
             res.status = capped ? RayStatus::max_iterations : RayStatus::ok;
           }
         }
@@ -381,16 +390,30 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
     });
     return;
   }
+  // Input order: the rays' validity and wide setup are computed 8 at a time in SIMD lanes (WideRaySetup: the same
+  // bits as ray_is_valid() and make_wide_ray(), without their data-dependent branches).
+  const WideRaySetup setup = select_wide_ray_setup();
+  const WideRayInput input{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
+                           {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
+                           rays.t_max.data()};
   detail::run_with_threads(options.threads, [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+      WideRay wide[kWideRaySetupLanes];
+      std::uint8_t status[kWideRaySetupLanes];
       for (std::size_t c = range.begin(); c != range.end(); ++c) {
         const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
         for (std::size_t i = begin; i < end; ++i) {
           if (all) chunk_counts[c].push_back(0);
-          if (!detail::ray_is_valid(rays, i)) continue;
-          const RayContext r = context(Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]),
-                                       Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]),
-                                       rays.t_max[i]);
+          const std::size_t lane = (i - begin) % kWideRaySetupLanes;
+          if (lane == 0) setup(input, i, std::min(kWideRaySetupLanes, end - i), wide, status);
+          if (status[lane] == kWideRayInvalid) continue;
+          RayContext r;
+          r.o = Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]);
+          r.d = Vec3<double>(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]);
+          r.t_max = rays.t_max[i];
+          r.d2 = r.d.squaredNorm();
+          r.wide_ok = status[lane] == kWideRaySupported;
+          if (r.wide_ok) r.wide = wide[lane];
           bool capped = false;
           if (all) {
             std::vector<Hit>& hits = chunk_hits[c];

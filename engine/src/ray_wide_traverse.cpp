@@ -27,6 +27,9 @@ namespace wide_avx2 {
 #define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_BITS
+#define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
+#include "ray_wide_setup.inl"
+#undef BATCHCOL_SETUP_SQRT
 }  // namespace wide_avx2
 #pragma GCC pop_options
 
@@ -39,6 +42,13 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
 #define BATCHCOL_WIDE_BITS(m) lane_bits(m)
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_BITS
+template <class V> inline V sqrt_lanes(V v) {
+  for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
+  return v;
+}
+#define BATCHCOL_SETUP_SQRT(v) sqrt_lanes(v)
+#include "ray_wide_setup.inl"
+#undef BATCHCOL_SETUP_SQRT
 }  // namespace wide_baseline
 
 namespace {
@@ -113,6 +123,21 @@ WideTraverse wide_traverse_for(int isa) {
                  : nullptr;
     default: return nullptr;
   }
+}
+
+WideRaySetup wide_ray_setup_for(int isa) {
+  switch (isa) {
+    case 0: return &wide_baseline::setup_rays;
+    case 1: return wide_traverse_for(1) ? &wide_avx2::setup_rays : nullptr;
+    // No AVX-512 build: 8 doubles would fill zmm registers, and 512-bit divisions and square roots can lower the
+    // core's clock for everything after them (the traversal keeps to 256-bit registers for the same reason).
+    default: return nullptr;
+  }
+}
+
+WideRaySetup select_wide_ray_setup() {
+  if (WideRaySetup f = wide_ray_setup_for(1)) return f;
+  return wide_ray_setup_for(0);
 }
 
 WideTraverse select_wide_traverse() {

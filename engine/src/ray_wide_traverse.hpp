@@ -21,6 +21,7 @@
 
 #include "ray_wide_bvh.hpp"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace batchcol {
@@ -55,6 +56,27 @@ void make_leaf_ball(const double c[3], double bound, float out[4]);
 /// True when the float test is safe for this ray (see above); o and d are the ray's origin and direction.
 bool wide_ray_supported(const double o[3], const double d[3]);
 WideRay make_wide_ray(const double o[3], const double d[3]);
+
+/// What WideRaySetup found for a ray: invalid (detail::ray_is_valid() false), valid but outside the float test's
+/// range (wide_ray_supported() false: the binary tree in double), or valid and supported (its WideRay is written).
+enum : std::uint8_t { kWideRayInvalid = 0, kWideRayBinary = 1, kWideRaySupported = 2 };
+/// A batch of rays as structure of arrays (origin, direction, t_max), read from index `begin` on.
+struct WideRayInput {
+  const double* o[3];
+  const double* d[3];
+  const double* t_max;
+};
+/// The setup of n <= 8 consecutive rays at once: status[l] for ray begin + l and, for kWideRaySupported, out[l]
+/// bitwise equal to make_wide_ray() (balls nullptr, no prefetch). The scalar setup costs ~260 instructions and ~4
+/// mispredicted branches a ray (the rounding direction and the sign are random data); lanes and masks do not branch.
+using WideRaySetup = void (*)(const WideRayInput& in, std::size_t begin, std::size_t n, WideRay* out,
+                              std::uint8_t* status);
+constexpr std::size_t kWideRaySetupLanes = 8;
+/// The setup for this processor, and per instruction set for the tests (0 baseline, 1 AVX2 (also on AVX-512
+/// processors); nullptr for others and when the processor lacks it).
+WideRaySetup select_wide_ray_setup();
+WideRaySetup wide_ray_setup_for(int isa);
+
 /// The float limit the traversal compares with for a double limit t: t (1 + 2^-20) rounded up to float.
 float wide_limit(double t);
 

@@ -5,12 +5,14 @@
 #include "engine/src/ray_bvh.hpp"
 #include "engine/src/ray_wide_bvh.hpp"
 #include "engine/src/ray_wide_traverse.hpp"
+#include "engine/src/rays_common.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -298,6 +300,74 @@ TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {
   // Rounding of the limit: never below the exact value.
   for (double t : {1.0, 0.1, 1e-30, 3e38, 1e300}) EXPECT_GE(double(wide_limit(t)), t);
   EXPECT_EQ(wide_limit(INFINITY), INFINITY);
+}
+
+// The SIMD setup of 8 rays at once (WideRaySetup, used by RaySceneIndex::cast) gives every ray the status of the
+// scalar ray_is_valid() / wide_ray_supported() and, when supported, make_wide_ray()'s fields bit for bit, on every
+// instruction set and for partial groups: random rays, and the cases where the rounding or the sign decides (origins
+// exactly representable in float or not, +-0, subnormal and huge components, the range limits 2^-60 / 2^60), and
+// invalid rays (NaN, inf, zero direction, negative or NaN t_max).
+TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
+  Rng rng(19);
+  RayBatch rays;
+  const double special[] = {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1.0 + 0x1p-40, -(1.0 + 0x1p-40), 0x1p-60, -0x1p-60,
+                            0x1p-61, 0x1p60, -0x1p60, 0x1p61, 1e-310, -1e-310, 1e-45, 3.4e38, 1e300, NAN, INFINITY,
+                            -INFINITY};
+  const std::size_t s = std::size(special);
+  for (int i = 0; i < 20000; ++i) {
+    double o[3], d[3], t = uniform(rng, 0.0, 10.0);
+    for (int k = 0; k < 3; ++k) {
+      const int mode = int(rng() % 4);
+      o[k] = mode == 0 ? special[rng() % s] : uniform(rng, -100.0, 100.0);
+      d[k] = mode == 1 ? special[rng() % s] : uniform(rng, -1.0, 1.0);
+      if (mode == 2) o[k] = double(float(o[k]));  // exactly a float: no rounding step
+    }
+    if (i % 50 == 0) t = special[rng() % s] * (rng() % 2 ? 1.0 : -1.0);
+    if (i % 97 == 0) d[0] = d[1] = d[2] = 0.0;
+    rays.add(Eigen::Vector3d(o[0], o[1], o[2]), Eigen::Vector3d(d[0], d[1], d[2]), t);
+  }
+  const WideRayInput in{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
+                        {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
+                        rays.t_max.data()};
+  std::size_t counts[3] = {0, 0, 0};
+  for (int isa = 0; isa < 3; ++isa) {
+    const WideRaySetup setup = wide_ray_setup_for(isa);
+    if (setup == nullptr) continue;
+    for (std::size_t group : {std::size_t(8), std::size_t(5)}) {
+      for (std::size_t b = 0; b < rays.size(); b += group) {
+        const std::size_t n = std::min(group, rays.size() - b);
+        WideRay out[kWideRaySetupLanes];
+        std::uint8_t status[kWideRaySetupLanes];
+        setup(in, b, n, out, status);
+        for (std::size_t l = 0; l < n; ++l) {
+          const std::size_t i = b + l;
+          const double o[3] = {rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]};
+          const double d[3] = {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]};
+          const bool valid = detail::ray_is_valid(rays, i), supported = valid && wide_ray_supported(o, d);
+          const std::uint8_t expected = supported ? kWideRaySupported : valid ? kWideRayBinary : kWideRayInvalid;
+          ASSERT_EQ(status[l], expected) << "isa " << isa << " ray " << i;
+          if (isa == 0 && group == 8) ++counts[expected];
+          if (!supported) continue;
+          const WideRay w = make_wide_ray(o, d);
+          const WideRay& v = out[l];
+          EXPECT_EQ(std::memcmp(w.o_near, v.o_near, sizeof w.o_near), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.o_far, v.o_far, sizeof w.o_far), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.inv, v.inv, sizeof w.inv), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.near_offset, v.near_offset, sizeof w.near_offset), 0) << "isa " << isa;
+          EXPECT_EQ(std::memcmp(w.far_offset, v.far_offset, sizeof w.far_offset), 0) << "isa " << isa;
+          EXPECT_EQ(std::memcmp(w.ball_o, v.ball_o, sizeof w.ball_o), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(w.ball_d, v.ball_d, sizeof w.ball_d), 0) << "isa " << isa << " ray " << i;
+          EXPECT_EQ(std::memcmp(&w.ball_margin, &v.ball_margin, sizeof w.ball_margin), 0) << "isa " << isa;
+          EXPECT_EQ(v.balls, nullptr);
+          EXPECT_FALSE(v.prefetch);
+        }
+      }
+    }
+  }
+  // Every class occurs often enough to mean something.
+  EXPECT_GT(counts[kWideRayInvalid], 500u);
+  EXPECT_GT(counts[kWideRayBinary], 500u);
+  EXPECT_GT(counts[kWideRaySupported], 5000u);
 }
 
 }  // namespace
