@@ -110,6 +110,17 @@ constexpr int flat_newton_side(ShapeType a, ShapeType b) {
 /// cylinder-cylinder 9765 -> 11042, box-cylinder 7357 -> 8751 with every curved pair type enabled.
 /// A polytope against a curved core (flat_newton_side()) takes them too, with the residual taken from the feature of
 /// the polytope that the simplex holds instead of the raw support point (wide_gjk.inl's feature_direction()).
+/// Not cylinder / cone against cylinder / cone (measured at 24fd1aa, branch feat): with them on, close witness
+/// double mean iterations fell (cylinder-cylinder 18.61 -> 17.03, cylinder-cone 17.41 -> 16.31, cone-cone
+/// 15.48 -> 14.80; err_max not worse) but AVX2 instructions per pair rose (8291 -> 8757, 7813 -> 8432,
+/// 7044 -> 7688). By the final normal (scalar reference, 2000 pairs), cylinder-cylinder pairs whose optimum is on
+/// both rims (13%) went 25.9 -> 13.6 iterations; the rest did not move: a side line (55% of the pairs, 20
+/// iterations: the support flips between the rims, which no Hessian sees) or a cap. Treating a side whose simplex
+/// points lie on both rims as an edge along the axis (feature_direction()'s edge step, only while |<n, axis>| <
+/// 0.05) took cylinder-cylinder to 15.4 and cylinder-ellipsoid 15.8 -> 14.8 in that scalar test, side-line pairs
+/// only to ~16-18: the simplex still holds rim points of earlier directions, so GJK needs fresh points on both
+/// rims at the final angle. Not built in the wide kernel (estimate only: 3 iterations x ~420 loop instructions is
+/// about what the Newton calls cost per pair in the measured build, ~1100, before the side test's own cost).
 constexpr bool newton_pair_type(ShapeType a, ShapeType b) {
   const auto round = [](ShapeType t) {
     return t == ShapeType::ellipsoid || t == ShapeType::sphere || t == ShapeType::cylinder || t == ShapeType::cone;
