@@ -72,23 +72,53 @@ inline std::uint32_t pure_cell_vertex(const HullView& hull, std::uint32_t cell) 
   return (e & kHullPureCell) && v < hull.vertex_count ? v : kNoHullVertex;
 }
 
-/// The support vertex of d from its cell's entry of HullView::cell_candidates (`cell` = start_cell(d)): a pure
-/// cell's vertex as it is, else the first maximum of hull_dot over the cell's list, whose indices ascend: the
-/// linear scan's vertex (engine/src/convex_hull.cpp, build_cell_candidates(), has the argument). A few dot
-/// products where a climb takes a few dozen. Returns kNoHullVertex when the cell has no entry (its supports climb).
-/// Only for a climbed hull (hull_climbs()).
-template <class T> inline std::uint32_t cell_vertex(const HullView& hull, std::uint32_t cell, const Vec3<T>& d) {
-  if (hull.cell_candidates == nullptr || cell == kNoHullVertex) return kNoHullVertex;
-  const std::uint32_t e = hull.cell_candidates[cell], n = e & 15u;
-  if (n <= 1) return n == 1 ? e >> 4 : kNoHullVertex;
-  const std::uint32_t* list = hull.cell_candidates + (e >> 4);
+/// The vertex coordinates cell_vertex() reads in precision T: the doubles, or for float the hull's float copies
+/// when it has them (HullView::vertex_floats: the same values, float(p) is the conversion hull_dot does), which
+/// spares a conversion per coordinate in the GJK loop's lookups.
+template <class T> struct ListCoords {
+  static const double* of(const HullView& hull) { return hull.vertices; }
+};
+template <> struct ListCoords<float> {
+  static const float* of(const HullView& hull) { return hull.vertex_floats; }
+};
+/// hull_dot() of vertex i from coordinates xyz (doubles or floats): the same operations in T.
+template <class T, class C> inline T list_dot(const C* xyz, std::uint32_t i, const Vec3<T>& d) {
+  const C* p = xyz + 3 * std::size_t(i);
+  return (T(p[0]) * d.x() + T(p[1]) * d.y()) + T(p[2]) * d.z();
+}
+template <class T, class C> inline std::uint32_t list_first_max(const C* xyz, const std::uint32_t* list, std::uint32_t n,
+                                                                const Vec3<T>& d) {
   std::uint32_t best = list[0];
-  T best_dot = hull_dot(hull, best, d);
+  T best_dot = list_dot(xyz, best, d);
   for (std::uint32_t i = 1; i < n; ++i) {
-    const T di = hull_dot(hull, list[i], d);
+    const T di = list_dot(xyz, list[i], d);
     if (di > best_dot) best_dot = di, best = list[i];
   }
   return best;
+}
+
+/// The support vertex of d from its cell's entry of HullView::cell_candidates (`cell` = start_cell(d)): a pure
+/// cell's vertex as it is, else the first maximum of hull_dot over the cell's list, whose indices ascend: the
+/// linear scan's vertex (engine/src/convex_hull.cpp, build_cell_candidates(), has the argument). A few dot
+/// products where a climb takes a few dozen. Returns kNoHullVertex when the cell has no entry (its supports climb)
+/// or names a vertex the hull does not have. Only for a climbed hull (hull_climbs()).
+template <class T> inline std::uint32_t cell_vertex(const HullView& hull, std::uint32_t cell, const Vec3<T>& d) {
+  if (hull.cell_candidates == nullptr || cell >= kHullStartCells) return kNoHullVertex;
+  const std::uint32_t e = hull.cell_candidates[cell], n = e & 15u;
+  if (n <= 1) return n == 1 && (e >> 4) < hull.vertex_count ? e >> 4 : kNoHullVertex;
+  const std::uint32_t* list = hull.cell_candidates + (e >> 4);
+  // The indices ascend (build_cell_candidates()), so the last one is the largest: one range check for the list.
+  if (!(list[n - 1] < hull.vertex_count)) return kNoHullVertex;
+  const auto* xyz = ListCoords<T>::of(hull);
+  return xyz != nullptr ? list_first_max(xyz, list, n, d) : list_first_max(hull.vertices, list, n, d);
+}
+
+/// Vertex i in precision T from the coordinates cell_vertex() read (ListCoords): hull_point()'s values.
+template <class T> inline Vec3<T> list_point(const HullView& hull, std::uint32_t i) {
+  const auto* xyz = ListCoords<T>::of(hull);
+  if (xyz == nullptr) return hull_point<T>(hull, i);
+  const auto* p = xyz + 3 * std::size_t(i);
+  return Vec3<T>(T(p[0]), T(p[1]), T(p[2]));
 }
 
 template <class T> Vec3<T> hull_support_in_cell(const HullView& hull, const Vec3<T>& d, SupportHint& hint,

@@ -116,41 +116,45 @@ bool near_support_in_cell(const ConvexHull& hull, std::uint32_t u, const Eigen::
                           const Eigen::Vector3d& db, double margin, double dmax, const std::uint32_t* first,
                           std::uint32_t c) {
   if (hull.neighbor_offsets[u] == hull.neighbor_offsets[u + 1]) return false;  // on no face: no support vertex
+  // Neighbour n's constraint g(a, b) = <u - n, d0 + a da + b db> + margin dmax >= -tol, one text for the quick
+  // rejection and the clipping (tol: points within 1e-12 of the line count as on it).
+  struct Line {
+    double g0, ga, gb, tol;
+    double at(double a, double b) const { return g0 + ga * a + gb * b; }
+  };
+  const auto line = [&](std::uint32_t n) {
+    const Eigen::Vector3d e = hull.vertices[u] - hull.vertices[n];
+    Line l{e.dot(d0) + margin * dmax, e.dot(da), e.dot(db), 0.0};
+    l.tol = 1e-12 * (std::abs(l.g0) + std::abs(l.ga) + std::abs(l.gb));
+    return l;
+  };
+  const double lo = -1e-3, hi = 1.0 + 1e-3;  // the widened cell
   if (first != nullptr) {  // the quick rejection: a found neighbour beats u at the widened cell's four corners
-    const double lo = -1e-3, hi = 1.0 + 1e-3;
     for (std::uint32_t k = hull.neighbor_offsets[u]; k < hull.neighbor_offsets[u + 1]; ++k) {
       if (first[hull.neighbors[k]] != c) continue;
-      const Eigen::Vector3d e = hull.vertices[u] - hull.vertices[hull.neighbors[k]];
-      const double g0 = e.dot(d0) + margin * dmax, ga = e.dot(da), gb = e.dot(db);
-      const double tol = 1e-12 * (std::abs(g0) + std::abs(ga) + std::abs(gb));
-      if (g0 + ga * lo + gb * lo < -tol && g0 + ga * hi + gb * lo < -tol && g0 + ga * hi + gb * hi < -tol &&
-          g0 + ga * lo + gb * hi < -tol)
+      const Line l = line(hull.neighbors[k]);
+      if (l.at(lo, lo) < -l.tol && l.at(hi, lo) < -l.tol && l.at(hi, hi) < -l.tol && l.at(lo, hi) < -l.tol)
         return false;
     }
   }
   constexpr int kMax = 32;  // a convex polygon clipped by lines: 4 + one vertex per line at most (the valence)
   double poly[kMax][2], next[kMax][2];
   int count = 4;
-  const double lo = -1e-3, hi = 1.0 + 1e-3;
   const double square[4][2] = {{lo, lo}, {hi, lo}, {hi, hi}, {lo, hi}};
   for (int i = 0; i < 4; ++i) poly[i][0] = square[i][0], poly[i][1] = square[i][1];
-  const Eigen::Vector3d& p = hull.vertices[u];
   for (std::uint32_t k = hull.neighbor_offsets[u]; k < hull.neighbor_offsets[u + 1] && count > 0; ++k) {
-    const Eigen::Vector3d e = p - hull.vertices[hull.neighbors[k]];
-    // g(a, b) = <e, d0 + a da + b db> + margin dmax >= 0
-    const double g0 = e.dot(d0) + margin * dmax, ga = e.dot(da), gb = e.dot(db);
-    const double tol = 1e-12 * (std::abs(g0) + std::abs(ga) + std::abs(gb));
+    const Line l = line(hull.neighbors[k]);
     double g[kMax];
     int inside = 0;
-    for (int i = 0; i < count; ++i) inside += (g[i] = g0 + ga * poly[i][0] + gb * poly[i][1]) >= -tol;
+    for (int i = 0; i < count; ++i) inside += (g[i] = l.at(poly[i][0], poly[i][1])) >= -l.tol;
     if (inside == count) continue;  // the line misses the polygon: nothing clipped (the common case)
     if (inside == 0) return false;
     if (count + 1 >= kMax) return true;  // (cannot happen; unsure = true)
     int out = 0;
     for (int i = 0; i < count; ++i) {
       const int j = (i + 1) % count;
-      if (g[i] >= -tol) next[out][0] = poly[i][0], next[out][1] = poly[i][1], ++out;
-      if ((g[i] >= -tol) != (g[j] >= -tol)) {  // the edge crosses the line: its crossing point
+      if (g[i] >= -l.tol) next[out][0] = poly[i][0], next[out][1] = poly[i][1], ++out;
+      if ((g[i] >= -l.tol) != (g[j] >= -l.tol)) {  // the edge crosses the line: its crossing point
         const double t = g[i] / (g[i] - g[j]);
         next[out][0] = poly[i][0] + t * (poly[j][0] - poly[i][0]);
         next[out][1] = poly[i][1] + t * (poly[j][1] - poly[i][1]);
@@ -163,7 +167,8 @@ bool near_support_in_cell(const ConvexHull& hull, std::uint32_t u, const Eigen::
   return count > 0;
 }
 
-/// ConvexHull::cell_candidates (needs start_vertices and the adjacency; none for hulls the kernels scan). A pure
+/// ConvexHull::cell_candidates and vertex_floats (needs start_vertices and the adjacency; none for hulls the kernels
+/// scan). A pure
 /// cell's entry is its vertex. For a cell that is not pure, the vertices that pass near_support_in_cell() with
 /// margin 2e-5 R (R the largest vertex norm), found by a search over the adjacency from the cell centre's
 /// maximiser that expands from every passing vertex: one is the entry, 2 to kHullCellCandidatesMax are a list in
@@ -197,7 +202,11 @@ void build_cell_candidates(ConvexHull& hull) {
   const double margin = 2e-5 * radius;
   // Small hulls are scanned (kernels::kHillClimbMinVertices), and an entry holds a vertex index in 28 bits.
   hull.cell_candidates.clear();
+  hull.vertex_floats.clear();
   if (nv < kernels::kHillClimbMinVertices || nv >= (std::size_t(1) << 28)) return;
+  hull.vertex_floats.reserve(3 * nv);
+  for (const auto& v : hull.vertices)
+    for (int k = 0; k < 3; ++k) hull.vertex_floats.push_back(static_cast<float>(v[k]));
   hull.cell_candidates.assign(kHullStartCells, 0);
   std::vector<std::uint32_t> mark(nv, kNoHullVertex), passed(nv, kNoHullVertex), stack, found;
   for (std::uint32_t c = 0; c < kHullStartCells; ++c) {
@@ -353,9 +362,10 @@ std::shared_ptr<const ConvexHull> with_search_structures(std::shared_ptr<const C
     lists.neighbors = hull->neighbors;
     lists.start_vertices = hull->start_vertices;
     build_cell_candidates(lists);
-    if (lists.cell_candidates == hull->cell_candidates) return hull;
+    if (lists.cell_candidates == hull->cell_candidates && lists.vertex_floats == hull->vertex_floats) return hull;
     auto with_lists = std::make_shared<ConvexHull>(*hull);
     with_lists->cell_candidates = std::move(lists.cell_candidates);
+    with_lists->vertex_floats = std::move(lists.vertex_floats);
     return with_lists;
   }
   auto full = std::make_shared<ConvexHull>(*hull);

@@ -235,6 +235,8 @@ HullView hull_view(const ConvexHull& hull) {
   h.start_vertices = hull.start_vertices.size() == kHullStartCells ? hull.start_vertices.data() : nullptr;
   h.cell_candidates = h.start_vertices != nullptr && hull.cell_candidates.size() >= kHullStartCells
                           ? hull.cell_candidates.data() : nullptr;
+  h.vertex_floats = h.cell_candidates != nullptr && hull.vertex_floats.size() == 3 * hull.vertices.size()
+                        ? hull.vertex_floats.data() : nullptr;
   if (hull.neighbor_block_offsets.size() == hull.vertices.size() + 1) {
     h.neighbor_block_offsets = hull.neighbor_block_offsets.data();
     h.neighbor_block_index = data(hull.neighbor_block_index);

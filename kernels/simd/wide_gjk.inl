@@ -178,8 +178,8 @@ template <class T> struct WideGjk {
       const std::uint32_t v = climbs ? cell_vertex(h, cell[l], dl) : kNoHullVertex;
       if (v != kNoHullVertex) {
         s.hint[l].vertex = v;
-        const double* p = h.vertices + 3 * std::size_t(v);
-        rx[l] = T(p[0]), ry[l] = T(p[1]), rz[l] = T(p[2]);
+        const Vec3<T> p = list_point<T>(h, v);  // (float: the hull's float copies, no conversion)
+        rx[l] = p.x(), ry[l] = p.y(), rz[l] = p.z();
         continue;
       }
       const Vec3<T> p = BATCHCOL_SIMD_NS::hull_support_in_cell(h, dl, s.hint[l], climbs ? cell[l] : kNoHullVertex);

@@ -245,6 +245,24 @@ TEST(Support, CandidateListsGiveTheLinearScansVertex) {
     const Shape fixed = Shape::convex(forged);
     EXPECT_NE(fixed.hull, forged);
     EXPECT_EQ(fixed.hull->cell_candidates, h.cell_candidates);
+    // The float copies the float lookups read are the vertices rounded to float, and a view whose entries name
+    // vertices it does not have (a hand-built HullView) gets no vertex from them: the climb answers instead.
+    ASSERT_EQ(h.vertex_floats.size(), 3 * h.vertices.size());
+    for (std::size_t i = 0; i < h.vertices.size(); ++i)
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(h.vertex_floats[3 * i + k], static_cast<float>(h.vertices[i][k]));
+    std::uint32_t one = 0;
+    while ((h.cell_candidates[one] & 15u) != 1) ++one;
+    const std::uint32_t list_end = (h.cell_candidates[c] >> 4) + (h.cell_candidates[c] & 15u);
+    HullView shrunk = hv;
+    const Eigen::Vector3d any(0.3, -0.5, 0.8);  // (cell_vertex() takes the cell as given)
+    shrunk.vertex_count = h.cell_candidates[list_end - 1];  // the list's largest index is now out of range
+    EXPECT_EQ(cell_vertex(shrunk, c, any), kNoHullVertex);
+    EXPECT_EQ(cell_vertex(shrunk, c, Eigen::Vector3f(any.cast<float>())), kNoHullVertex);
+    shrunk.vertex_count = h.cell_candidates[one] >> 4;
+    EXPECT_EQ(cell_vertex(shrunk, one, any), kNoHullVertex);
+    shrunk.vertex_count = hv.vertex_count;
+    EXPECT_NE(cell_vertex(shrunk, c, any), kNoHullVertex);
+    EXPECT_EQ(cell_vertex(shrunk, one, any), h.cell_candidates[one] >> 4);
   }
 }
 

@@ -48,6 +48,10 @@ struct ConvexHull {
   /// (engine/src/convex_hull.cpp, build_cell_candidates(), which has the argument for its exactness) for hulls
   /// that are climbed; empty for small hulls (scanned) and when absent (pure cells and climbs only).
   std::vector<std::uint32_t> cell_candidates;
+  /// The vertices rounded to float (x, y, z per vertex; float(v), to nearest, the kernels' own conversion), for the
+  /// float kernels' candidate-list supports: the same values without a conversion per coordinate read. Built with
+  /// cell_candidates (empty when it is).
+  std::vector<float> vertex_floats;
   /// The adjacency again, in blocks of kNeighborBlock neighbours with their coordinates in structure-of-arrays
   /// order, so that one climbing step computes a block's dot products together (kernels/support.hpp). Vertex v's
   /// blocks are [neighbor_block_offsets[v], neighbor_block_offsets[v + 1]); block b's indices are

@@ -66,6 +66,7 @@ struct HullView {
   const double* face_normals = nullptr;     // 3 face_count, unit, outward
   const std::uint32_t* start_vertices = nullptr;  // kHullStartCells entries, or null
   const std::uint32_t* cell_candidates = nullptr;  // ConvexHull::cell_candidates, or null
+  const float* vertex_floats = nullptr;            // ConvexHull::vertex_floats (3 vertex_count), or null
   /// Adjacency in blocks of kHullNeighborBlock (null when the hull has none): vertex_count + 1 offsets, then the
   /// blocks' vertex indices and their coordinates (x of the block's vertices, then y, then z).
   const std::uint32_t* neighbor_block_offsets = nullptr;
