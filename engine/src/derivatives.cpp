@@ -15,8 +15,13 @@
 namespace batchcol {
 namespace detail {
 
-bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
-                      PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b) {
+namespace {
+
+// The test of nominal_geometry() without its rotations and scale: a converged witness query between two shapes with
+// support maps; fills the witness points, normal and distance of `g`. The gradients-only pass uses it alone, so the
+// pairs that get a gradient are the same on both paths.
+bool witness_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+                      PairGeometry& g) {
   if (results.status[i] != Status::converged) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
   if (a >= shapes.size() || b >= shapes.size()) return false;
@@ -26,8 +31,15 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
   g.witness_b = results.witness_b[i];
   g.normal = results.normal[i];
   g.distance = results.distance[i];
-  if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite() || !std::isfinite(g.distance))
-    return false;
+  return g.witness_a.allFinite() && g.witness_b.allFinite() && g.normal.allFinite() && std::isfinite(g.distance);
+}
+
+}  // namespace
+
+bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+                      PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b) {
+  if (!witness_geometry(shapes, batch, results, i, g)) return false;
+  const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
   R_a = batch.rotation_a[i].normalized().toRotationMatrix();
   R_b = batch.rotation_b[i].normalized().toRotationMatrix();
   g.scale = ShapeTableAccess::bounding_radii(shapes)[a] + ShapeTableAccess::bounding_radii(shapes)[b];
@@ -267,7 +279,7 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
 }
 
 // The distance gradients alone (DerivativeOptions::jacobians false): distance_gradients()'s envelope formula from the
-// witness results of every pair nominal_geometry() accepts (the pairs the full derivative gives a gradient), without
+// witness results of every pair witness_geometry() (and so nominal_geometry()) accepts (the pairs the full derivative gives a gradient), without
 // rotations, features or the implicit-function solve. Pairs go through a 12 x 8 buffer and each array gets 8
 // consecutive entries per flush, for StoreBlock's reason: 12 arrays a power of two apart written pair by pair would
 // share one L1 set.
@@ -282,7 +294,6 @@ void gradients_only(const ShapeTable& shapes, const PairBatch& batch, const Pair
     m->data.clear();
   d.smoothed_distance.clear();
   for (Vec3Array* v : {&d.smoothed_witness_a, &d.smoothed_witness_b, &d.smoothed_normal}) v->resize(0);
-  const auto& types = ShapeTableAccess::types(shapes);
   double* const ga = d.distance_gradient_a.data.data();
   double* const gb = d.distance_gradient_b.data.data();
   for_pairs(threads, n, [&](std::size_t begin, std::size_t end) {
@@ -294,16 +305,7 @@ void gradients_only(const ShapeTable& shapes, const PairBatch& batch, const Pair
       const std::size_t count = std::min(kBlock, end - first);
       for (std::size_t j = 0; j < count; ++j) {
         const std::size_t i = first + j;
-        const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
-        bool ok = results.status[i] == Status::converged && a < shapes.size() && b < shapes.size() &&
-                  types[a] != ShapeType::halfspace && types[b] != ShapeType::halfspace;
-        if (ok) {
-          g.witness_a = results.witness_a[i];
-          g.witness_b = results.witness_b[i];
-          g.normal = results.normal[i];
-          ok = g.witness_a.allFinite() && g.witness_b.allFinite() && g.normal.allFinite() &&
-               std::isfinite(results.distance[i]);
-        }
+        const bool ok = witness_geometry(shapes, batch, results, i, g);
         if (ok) {
           distance_gradients(g, grad_a, grad_b);
         } else {
