@@ -18,6 +18,18 @@ const char* to_string(DerivativeMethod method) {
 
 const char* to_string(NoiseScale scale) { return scale == NoiseScale::relative ? "relative" : "absolute"; }
 
+DerivativeMethod parse_derivative_method(const std::string& name) {
+  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
+    if (name == to_string(m)) return m;
+  throw InputError("method: unknown derivative method '" + name + "' (analytic, smoothed0 or smoothed1)");
+}
+
+NoiseScale parse_noise_scale(const std::string& name) {
+  for (NoiseScale n : {NoiseScale::relative, NoiseScale::absolute})
+    if (name == to_string(n)) return n;
+  throw InputError("noise_scale: unknown noise scale '" + name + "' (relative or absolute)");
+}
+
 const char* to_string(DerivativeStatus status) {
   switch (status) {
     case DerivativeStatus::smooth: return "smooth";

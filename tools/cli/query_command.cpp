@@ -96,9 +96,11 @@ int run_query(const QuerySettings& s) {
 }  // namespace
 
 DerivativeMethod parse_derivative_method(const std::string& name) {
-  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
-    if (name == to_string(m)) return m;
-  throw InputError("--derivatives: unknown method '" + name + "' (analytic, smoothed0 or smoothed1)");
+  try {
+    return batchcol::parse_derivative_method(name);
+  } catch (const InputError& error) {  // name the flag the user typed
+    throw InputError(std::string("--derivatives: ") + error.what());
+  }
 }
 
 Command add_query_command(CLI::App& parent) {

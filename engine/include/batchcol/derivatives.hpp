@@ -45,6 +45,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace batchcol {
@@ -54,6 +55,9 @@ enum class NoiseScale : std::uint8_t { relative, absolute };
 
 BATCHCOL_API const char* to_string(DerivativeMethod method);
 BATCHCOL_API const char* to_string(NoiseScale scale);
+/// The inverses of to_string(); InputError naming "method" / "noise_scale" for an unknown name.
+BATCHCOL_API DerivativeMethod parse_derivative_method(const std::string& name);
+BATCHCOL_API NoiseScale parse_noise_scale(const std::string& name);
 
 /// The most samples per pair.
 constexpr int kMaxDerivativeSamples = 1 << 20;

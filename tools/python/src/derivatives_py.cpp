@@ -33,18 +33,6 @@ py::array view_soa(const std::vector<double>& data, std::size_t n, int rows, int
                    {s, columns * N * s, N * s}, p, owner);
 }
 
-DerivativeMethod parse_method(const std::string& name) {
-  for (DerivativeMethod m : {DerivativeMethod::analytic, DerivativeMethod::smoothed0, DerivativeMethod::smoothed1})
-    if (name == to_string(m)) return m;
-  throw ArgumentError("method must be 'analytic', 'smoothed0' or 'smoothed1', got '" + name + "'");
-}
-
-NoiseScale parse_noise_scale(const std::string& name) {
-  if (name == "relative") return NoiseScale::relative;
-  if (name == "absolute") return NoiseScale::absolute;
-  throw ArgumentError("noise_scale must be 'relative' or 'absolute', got '" + name + "'");
-}
-
 }  // namespace
 
 void register_derivatives(py::module_& m) {
@@ -105,7 +93,7 @@ void register_derivatives(py::module_& m) {
         const QueryOptions o = options_from(level, solver, precision, tolerance, relative_tolerance, margin,
                                             max_iterations, epa_max_iterations, closed_forms, threads, isa);
         DerivativeOptions d;
-        d.method = parse_method(method);
+        d.method = parse_derivative_method(method);
         d.samples = samples;
         d.noise = noise;
         d.noise_scale = parse_noise_scale(noise_scale);
