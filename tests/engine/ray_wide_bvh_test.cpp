@@ -370,5 +370,196 @@ TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
   EXPECT_GT(counts[kWideRaySupported], 5000u);
 }
 
+// Quantised nodes (WideQNode): every live slot's dequantised box contains the float box (boxes only grow) and is
+// at most one code step larger per side (the codes are the tightest), the children and the live bits match, at
+// scales 2^-40..2^40 and for flat boxes; again after a refit.
+void check_quantized(const WideBvh& wide) {
+  ASSERT_EQ(wide.quantized().size(), wide.nodes().size());
+  for (std::size_t i = 0; i < wide.nodes().size(); ++i) {
+    const WideNode& n = wide.nodes()[i];
+    const WideQNode& q = wide.quantized()[i];
+    const float* planes[6] = {n.lo_x, n.lo_y, n.lo_z, n.hi_x, n.hi_y, n.hi_z};
+    for (int k = 0; k < kWideArity; ++k) {
+      ASSERT_EQ(q.child[k], n.child[k]);
+      ASSERT_EQ((q.live >> k) & 1u, n.child[k] != kWideEmpty ? 1u : 0u);
+      if (n.child[k] == kWideEmpty) continue;
+      for (int p = 0; p < 6; ++p) {
+        const float v = dequantized(q, p, k), f = planes[p][k];
+        // Containment, and tightness: the next code inwards would cut the float box.
+        if (p < 3) {
+          ASSERT_LE(v, f) << "node " << i << " slot " << k << " plane " << p;
+          if (q.q[p][k] < 255) {
+            ASSERT_GT(q.origin[p] + float(q.q[p][k] + 1) * q.scale[p], f);
+          }
+        } else {
+          ASSERT_GE(v, f) << "node " << i << " slot " << k << " plane " << p;
+          if (q.q[p][k] > 0) {
+            ASSERT_LT(q.origin[p - 3] + float(q.q[p][k] - 1) * q.scale[p - 3], f);
+          }
+        }
+      }
+    }
+    // The frame: 255 steps span the node's box and the step is the least power of two that does (or the least
+    // float), so the growth above is at most 1/127.5 of the node's extent per side.
+    for (int a = 0; a < 3; ++a) {
+      float lo = INFINITY, hi = -INFINITY;
+      for (int k = 0; k < kWideArity; ++k)
+        if (n.child[k] != kWideEmpty) lo = std::min(lo, planes[a][k]), hi = std::max(hi, planes[a + 3][k]);
+      EXPECT_EQ(q.origin[a], lo);
+      EXPECT_GE(q.origin[a] + 255.0f * q.scale[a], hi);
+      if (q.scale[a] > 0x1p-149f) {
+        EXPECT_LT(double(q.scale[a]) * 127.5, double(hi) - double(lo) + 4.0 * 0x1p-24 * std::fabs(double(hi)));
+      }
+    }
+  }
+}
+
+TEST(RayWideBvh, QuantizedBoxesContainTheFloatBoxesTightly) {
+  Rng rng(29);
+  for (int scale_exp : {-40, 0, 40}) {
+    for (std::size_t n : {2u, 9u, 3000u}) {
+      SCOPED_TRACE(n);
+      const double scale = std::ldexp(1.0, scale_exp);
+      broadphase::AabbSoa b = random_boxes(rng, n, 50.0 * scale, 2.0 * scale);
+      RayBvh bvh;
+      bvh.build(b);
+      WideBvh wide;
+      wide.collapse(bvh, b, 0);
+      check_quantized(wide);
+      const broadphase::AabbSoa moved = random_boxes(rng, n, 50.0 * scale, 2.0 * scale);
+      bvh.refit(moved);
+      wide.refit(bvh, moved);
+      check_quantized(wide);
+    }
+  }
+  // Below the size threshold, and with a box that is not finite, only the float nodes exist.
+  broadphase::AabbSoa b = random_boxes(rng, 100, 50.0, 2.0);
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b);
+  EXPECT_TRUE(wide.quantized().empty());
+  b.max_x[3] = INFINITY;
+  bvh.refit(b);
+  wide.collapse(bvh, b, 0);
+  EXPECT_TRUE(wide.quantized().empty());
+  EXPECT_FALSE(wide.nodes().empty());
+}
+
+// Rays built to end exactly (t = t_max) on a boundary point of a slot's dequantised box, as in
+// FloatTestNeverMissesABoxTheSegmentTouches: up to 8 leaves, so every leaf is a slot of the root and its dequantised
+// box is what the node test sees. The quantised traversal visits the leaf on every instruction set. Also rays ending
+// exactly on the float boxes of a deep tree (the dequantised boxes above them contain them).
+TEST(RayWideBvh, QuantizedTestNeverMissesADequantizedBoxTheSegmentTouches) {
+  Rng rng(31);
+  int checked = 0, grazing = 0;
+  for (int scale_exp : {-40, -10, 0, 12, 40}) {
+    const double scale = std::ldexp(1.0, scale_exp);
+    for (int tree = 0; tree < 60; ++tree) {
+      const bool deep = tree % 4 == 3;
+      broadphase::AabbSoa b = random_boxes(rng, deep ? 400 : 2 + rng() % 7, deep ? 400.0 : 40.0, 3.0);
+      for (std::size_t i = 0; i < b.size(); ++i) {
+        b.min_x[i] = float(b.min_x[i] * scale), b.min_y[i] = float(b.min_y[i] * scale);
+        b.min_z[i] = float(b.min_z[i] * scale), b.max_x[i] = float(b.max_x[i] * scale);
+        b.max_y[i] = float(b.max_y[i] * scale), b.max_z[i] = float(b.max_z[i] * scale);
+      }
+      RayBvh bvh;
+      bvh.build(b);
+      WideBvh wide;
+      wide.collapse(bvh, b, 0);
+      ASSERT_FALSE(wide.quantized().empty());
+      ASSERT_TRUE(deep || wide.nodes().size() == 1u);
+      const WideQNode& root = wide.quantized()[0];
+      for (int trial = 0; trial < 100; ++trial) {
+        std::uint32_t leaf;
+        double lo[3], hi[3];
+        if (deep) {
+          const std::size_t target = rng() % b.size();
+          leaf = 0;
+          while (bvh.leaf_object()[leaf] != target) ++leaf;
+          const double l[3] = {b.min_x[target], b.min_y[target], b.min_z[target]};
+          const double h[3] = {b.max_x[target], b.max_y[target], b.max_z[target]};
+          std::copy(l, l + 3, lo), std::copy(h, h + 3, hi);
+        } else {
+          const int k = int(rng() % b.size());
+          leaf = root.child[k] & ~kLeafBit;
+          for (int a = 0; a < 3; ++a) lo[a] = dequantized(root, a, k), hi[a] = dequantized(root, a + 3, k);
+        }
+        double p[3], o[3], d[3];
+        const int fixed = int(rng() % 3) + 1;  // 1 face, 2 edge, 3 corner
+        for (int a = 0; a < 3; ++a) {
+          if (a < fixed) {
+            p[a] = rng() % 2 ? lo[a] : hi[a];
+          } else {
+            p[a] = double(float(uniform(rng, lo[a], hi[a])));
+            p[a] = std::min(std::max(p[a], lo[a]), hi[a]);
+          }
+        }
+        if (std::fabs(p[0]) < 0x1p-7 * scale || std::fabs(p[1]) < 0x1p-7 * scale || std::fabs(p[2]) < 0x1p-7 * scale)
+          continue;
+        for (int a = 0; a < 3; ++a)
+          o[a] = rng() % 4 == 0 ? p[a] : std::floor(uniform(rng, -1.0, 1.0) * 0x1p39) * 0x1p-30 * scale;
+        const int d_exp = int(rng() % 9) - 3;
+        for (int a = 0; a < 3; ++a) d[a] = std::ldexp(p[a] - o[a], d_exp);
+        if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0) continue;
+        const double t_max = std::ldexp(1.0, -d_exp);
+        ASSERT_TRUE(slab_hits(lo, hi, o, d, t_max));  // the construction is exact
+        if (!wide_ray_supported(o, d)) continue;
+        grazing += (d[0] == 0.0) + (d[1] == 0.0) + (d[2] == 0.0) > 0;
+        const WideRay ray = make_wide_ray(o, d);
+        for (int isa = 0; isa < 3; ++isa) {
+          const WideQTraverse traverse = wide_qtraverse_for(isa);
+          if (!traverse) continue;
+          Leaves seen;
+          traverse(wide.quantized().data(), ray, wide_limit(t_max), record, &seen);
+          ASSERT_TRUE(std::find(seen.seen.begin(), seen.seen.end(), leaf) != seen.seen.end())
+              << "isa " << isa << " scale 2^" << scale_exp << " deep " << deep << " o " << o[0] << ' ' << o[1] << ' '
+              << o[2] << " d " << d[0] << ' ' << d[1] << ' ' << d[2];
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 20000);
+  EXPECT_GT(grazing, 1000);
+}
+
+// Random rays: the quantised traversal visits every leaf the float nodes' traversal visits (it may visit more: the
+// boxes grew), the same leaves in the same order on every instruction set; and not many more (the growth is at most
+// a code step per side).
+TEST(RayWideBvh, QuantizedTraversalKeepsEveryFloatVisitAndIsTheSameOnEveryInstructionSet) {
+  Rng rng(37);
+  const broadphase::AabbSoa b = random_boxes(rng, 5000, 60.0, 3.0);
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b, 0);
+  ASSERT_FALSE(wide.quantized().empty());
+  std::size_t float_visits = 0, quantized_visits = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    double o[3], d[3];
+    for (int k = 0; k < 3; ++k) o[k] = uniform(rng, -80, 80), d[k] = uniform(rng, -60, 60) - o[k];
+    if (trial % 5 == 0) d[trial % 3] = 0.0;
+    const double t_max = trial % 3 == 0 ? uniform(rng, 0.5, 1.5) : INFINITY;
+    const WideRay ray = make_wide_ray(o, d);
+    Leaves plain, reference;
+    wide_traverse_for(0)(wide.nodes().data(), ray, wide_limit(t_max), record, &plain);
+    wide_qtraverse_for(0)(wide.quantized().data(), ray, wide_limit(t_max), record, &reference);
+    for (int isa = 1; isa < 3; ++isa) {
+      if (const WideQTraverse traverse = wide_qtraverse_for(isa)) {
+        Leaves seen;
+        traverse(wide.quantized().data(), ray, wide_limit(t_max), record, &seen);
+        EXPECT_EQ(seen.seen, reference.seen) << "isa " << isa;
+      }
+    }
+    std::vector<std::uint32_t> a = plain.seen, q = reference.seen;
+    std::sort(a.begin(), a.end()), std::sort(q.begin(), q.end());
+    EXPECT_TRUE(std::includes(q.begin(), q.end(), a.begin(), a.end())) << "trial " << trial;
+    float_visits += a.size(), quantized_visits += q.size();
+  }
+  EXPECT_GT(float_visits, 2000u);
+  EXPECT_LT(double(quantized_visits), 1.3 * double(float_visits));
+}
+
 }  // namespace
 }  // namespace batchcol
