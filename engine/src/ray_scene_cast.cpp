@@ -65,7 +65,7 @@ double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
 class Caster {
  public:
   Caster(const RaySceneIndex::State& s, const RayOptions& o)
-      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse()), wide_q_(select_wide_qtraverse()) {}
+      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse()) {}
 
   // Intersects one object; true on a hit with t <= t_max.
   bool test(const RayObject& obj, const RayContext& r, double t_max, Hit& hit, bool& capped) const {
@@ -112,12 +112,8 @@ class Caster {
       WideRay w = r.wide;
       w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
       w.prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
-      const WideLeafVisit call = [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); };
-      if (!s_.wide.quantized().empty()) {
-        wide_q_(s_.wide.quantized().data(), w, wide_limit(last), call, &leaf);
-      } else {
-        wide_(s_.wide.nodes().data(), w, wide_limit(last), call, &leaf);
-      }
+      wide_(s_.wide.nodes().data(), w, wide_limit(last),
+            [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
       return;
     }
     RayContext rb = r;  // the reciprocal only this path reads (three divisions the wide path does not need)
@@ -217,7 +213,6 @@ class Caster {
   const RaySceneIndex::State& s_;
   kr::RayGjkSettings gjk_;
   WideTraverse wide_;
-  WideQTraverse wide_q_;  // large trees: quantised nodes, half the lines (WideBvh::quantized())
 };
 
 void store(RayResults& out, std::size_t i, const Hit& h) {

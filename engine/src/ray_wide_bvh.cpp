@@ -3,7 +3,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -136,11 +135,9 @@ struct CollapsePlan {
   }
 };
 
-void WideBvh::collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes, std::size_t quantize_from) {
+void WideBvh::collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
   nodes_.clear();
   source_.clear();
-  qnodes_.clear();
-  quantize_from_ = quantize_from;
   if (bvh.leaf_count() < 2) return;
   CollapsePlan plan;
   plan.plan(bvh, boxes);
@@ -173,7 +170,6 @@ void WideBvh::collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes, std:
       }
     }
   }
-  quantize();
 }
 
 void WideBvh::refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
@@ -187,80 +183,6 @@ void WideBvh::refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
                         }
                       }
                     });
-  quantize();
-}
-
-void WideBvh::quantize() {
-  qnodes_.clear();
-  if (nodes_.size() * sizeof(WideNode) < quantize_from_) return;
-  qnodes_.resize(nodes_.size());
-  std::atomic<bool> ok{true};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes_.size(), 512),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i < r.end(); ++i)
-                        if (!quantize_wide_node(nodes_[i], qnodes_[i])) ok.store(false, std::memory_order_relaxed);
-                    });
-  if (!ok.load()) qnodes_.clear();  // the float nodes serve
-}
-
-namespace {
-
-// The code of the tightest dequantised plane at or below (lo) / at or above (hi) v. The dequantised value is
-// monotone in the code (a correctly rounded sum of a monotone product), so a guess from the division, moved while
-// the next code still satisfies the bound, is the tightest; code 0 is the origin (<= every lo) and 255 is at or
-// above every hi (the frame is chosen so).
-std::uint8_t code_below(const WideQNode& n, int axis, float v) {
-  const auto at = [&](int q) { return n.origin[axis] + float(q) * n.scale[axis]; };
-  // 1 / scale is exact (a power of two): a product instead of a division.
-  int q = static_cast<int>(std::floor((double(v) - n.origin[axis]) * (1.0 / n.scale[axis])));
-  q = std::min(std::max(q, 0), 255);
-  while (q > 0 && at(q) > v) --q;
-  while (q < 255 && at(q + 1) <= v) ++q;
-  return static_cast<std::uint8_t>(q);
-}
-
-std::uint8_t code_above(const WideQNode& n, int axis, float v) {
-  const auto at = [&](int q) { return n.origin[axis] + float(q) * n.scale[axis]; };
-  int q = static_cast<int>(std::ceil((double(v) - n.origin[axis]) * (1.0 / n.scale[axis])));
-  q = std::min(std::max(q, 0), 255);
-  while (q < 255 && at(q) < v) ++q;
-  while (q > 0 && at(q - 1) >= v) --q;
-  return static_cast<std::uint8_t>(q);
-}
-
-}  // namespace
-
-bool quantize_wide_node(const WideNode& in, WideQNode& out) {
-  const float* planes[6] = {in.lo_x, in.lo_y, in.lo_z, in.hi_x, in.hi_y, in.hi_z};
-  out.live = 0;
-  for (int k = 0; k < kWideArity; ++k) {
-    out.child[k] = in.child[k];
-    if (in.child[k] != kWideEmpty) out.live |= 1u << k;
-  }
-  if (out.live == 0) return false;
-  for (int a = 0; a < 3; ++a) {
-    float lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k < kWideArity; ++k)
-      if (out.live & (1u << k)) lo = std::fmin(lo, planes[a][k]), hi = std::fmax(hi, planes[a + 3][k]);
-    if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo <= hi)) return false;
-    // The smallest power of two whose 255 steps from the origin reach hi (as the float sum), at least 2^-149 (the
-    // least float), at most 2^100 (255 codes of it stay far from float's overflow, so products are exact).
-    const double extent = double(hi) - double(lo);
-    int e = extent > 0.0 ? std::max(std::ilogb(extent / 255.0), -149) : -149;
-    out.origin[a] = lo;
-    for (;; ++e) {
-      if (e > 100) return false;
-      out.scale[a] = std::ldexp(1.0f, e);
-      if (lo + 255.0f * out.scale[a] >= hi) break;
-    }
-  }
-  for (int p = 0; p < 6; ++p)
-    for (int k = 0; k < kWideArity; ++k) {
-      const bool live = (out.live & (1u << k)) != 0;
-      out.q[p][k] = !live ? std::uint8_t(p < 3 ? 255 : 0)
-                          : p < 3 ? code_below(out, p, planes[p][k]) : code_above(out, p - 3, planes[p][k]);
-    }
-  return true;
 }
 
 }  // namespace batchcol

@@ -11,7 +11,6 @@
 #include "broadphase/aabb_soa.hpp"
 #include "ray_bvh.hpp"
 
-#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -30,55 +29,19 @@ struct alignas(64) WideNode {
 };
 static_assert(sizeof(WideNode) == 256, "WideNode layout");
 
-/// The same node with its child boxes quantised to 8 bits in a per-node frame (after Ylitie et al., HPG 2017), half
-/// the size: trees of WideNodes larger than a core's L2 (100k objects: 7.6 MB) miss it on most node visits, and this
-/// halves the lines a visit loads. Plane p of slot k (p: lo_x, lo_y, lo_z, hi_x, hi_y, hi_z; axis a = p % 3) is the
-/// float origin[a] + float(q[p][k]) * scale[a], evaluated in that order in float (scale is a power of two, so the
-/// product is exact and a fused multiply-add gives the same bits). The codes are chosen against exactly that value
-/// (quantize(), ray_wide_bvh.cpp): lo planes at or below the WideNode's, hi planes at or above, so a dequantised box
-/// contains the float box and the traversal's conservative float slab test (ray_wide_traverse.hpp) holds for it
-/// unchanged; boxes only grow. Slots without a child have their bit clear in `live` (their codes are no box).
-struct alignas(64) WideQNode {
-  float origin[3], scale[3];
-  std::uint8_t q[6][kWideArity];
-  std::uint32_t child[kWideArity];
-  std::uint32_t live;
-};
-static_assert(sizeof(WideQNode) == 128, "WideQNode layout");
-
-/// Trees of WideNodes from this size on also get quantised nodes (WideBvh::quantized()): smaller ones stay in the L2
-/// as floats, where dequantising would only add instructions.
-constexpr std::size_t kWideQuantizeBytes = std::size_t(1) << 20;
-
 class WideBvh {
  public:
-  /// Collapses `bvh` (which must have at least 2 leaves; with fewer there is nothing to collapse); the nodes are also
-  /// quantised when they take at least `quantize_from` bytes as WideNodes (the tests pass 0).
-  void collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes, std::size_t quantize_from = kWideQuantizeBytes);
-  /// Copies the boxes of a refitted `bvh` (same topology as at collapse()) into the wide nodes, in parallel (and
-  /// quantises them again, as at collapse()).
+  /// Collapses `bvh` (which must have at least 2 leaves; with fewer there is nothing to collapse).
+  void collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
+  /// Copies the boxes of a refitted `bvh` (same topology as at collapse()) into the wide nodes, in parallel.
   void refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
 
   const std::vector<WideNode>& nodes() const { return nodes_; }
-  /// The nodes quantised (same indices and children), or empty: trees below kWideQuantizeBytes, and trees with a box
-  /// coordinate that is not finite or too large for an exact frame (those keep the float nodes only).
-  const std::vector<WideQNode>& quantized() const { return qnodes_; }
-  void clear() { nodes_.clear(), source_.clear(), qnodes_.clear(); }
+  void clear() { nodes_.clear(), source_.clear(); }
 
  private:
   std::vector<WideNode> nodes_;        // node 0 is the root
   std::vector<std::uint32_t> source_;  // per node and slot: the binary reference whose box fills the slot
-  std::vector<WideQNode> qnodes_;
-  std::size_t quantize_from_ = kWideQuantizeBytes;
-  void quantize();
 };
-
-/// Quantises one node (see WideQNode); false when a live box has a coordinate that is not finite or the frame's scale
-/// would pass 2^100 (the codes' products must stay exact and finite).
-bool quantize_wide_node(const WideNode& in, WideQNode& out);
-/// Plane p of slot k as the traversal computes it.
-inline float dequantized(const WideQNode& n, int p, int k) {
-  return n.origin[p % 3] + float(n.q[p][k]) * n.scale[p % 3];
-}
 
 }  // namespace batchcol

@@ -13,27 +13,19 @@
 namespace batchcol {
 
 #pragma GCC push_options
-#pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw,fma")
+#pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
 namespace wide_avx512 {
 #define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
-#define BATCHCOL_WIDE_MADD(a, b, c) V(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c)))
-#define BATCHCOL_WIDE_CODES(p) V(_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i*)(p)))))
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_CODES
-#undef BATCHCOL_WIDE_MADD
 #undef BATCHCOL_WIDE_BITS
 }  // namespace wide_avx512
 #pragma GCC pop_options
 
 #pragma GCC push_options
-#pragma GCC target("avx2,fma")
+#pragma GCC target("avx2")
 namespace wide_avx2 {
 #define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
-#define BATCHCOL_WIDE_MADD(a, b, c) V(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c)))
-#define BATCHCOL_WIDE_CODES(p) V(_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i*)(p)))))
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_CODES
-#undef BATCHCOL_WIDE_MADD
 #undef BATCHCOL_WIDE_BITS
 #define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
 #include "ray_wide_setup.inl"
@@ -48,16 +40,7 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
   return bits;
 }
 #define BATCHCOL_WIDE_BITS(m) lane_bits(m)
-template <class V> inline V byte_lanes(const std::uint8_t* p) {
-  V v;
-  for (int l = 0; l < 8; ++l) v[l] = float(p[l]);
-  return v;
-}
-#define BATCHCOL_WIDE_MADD(a, b, c) ((a) * (b) + (c))
-#define BATCHCOL_WIDE_CODES(p) byte_lanes<V>(p)
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_CODES
-#undef BATCHCOL_WIDE_MADD
 #undef BATCHCOL_WIDE_BITS
 template <class V> inline V sqrt_lanes(V v) {
   for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
@@ -129,34 +112,17 @@ void make_leaf_ball(const double c[3], double bound, float out[4]) {
 
 float wide_limit(double t) { return round_up(t * double(kFarScale)); }
 
-namespace {
-bool has_isa(int isa) {
+WideTraverse wide_traverse_for(int isa) {
   switch (isa) {
-    case 0: return true;
-    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case 0: return &wide_baseline::traverse;
+    case 1: return __builtin_cpu_supports("avx2") ? &wide_avx2::traverse : nullptr;
     case 2:
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-             __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("fma");
-    default: return false;
+                     __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
+                 ? &wide_avx512::traverse
+                 : nullptr;
+    default: return nullptr;
   }
-}
-}  // namespace
-
-WideTraverse wide_traverse_for(int isa) {
-  if (!has_isa(isa)) return nullptr;
-  return isa == 0 ? &wide_baseline::traverse : isa == 1 ? &wide_avx2::traverse : &wide_avx512::traverse;
-}
-
-WideQTraverse wide_qtraverse_for(int isa) {
-  if (!has_isa(isa)) return nullptr;
-  return isa == 0 ? &wide_baseline::traverse_quantized
-                  : isa == 1 ? &wide_avx2::traverse_quantized : &wide_avx512::traverse_quantized;
-}
-
-WideQTraverse select_wide_qtraverse() {
-  for (int isa = 2; isa > 0; --isa)
-    if (WideQTraverse f = wide_qtraverse_for(isa)) return f;
-  return wide_qtraverse_for(0);
 }
 
 WideRaySetup wide_ray_setup_for(int isa) {

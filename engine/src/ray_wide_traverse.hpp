@@ -90,11 +90,5 @@ WideTraverse select_wide_traverse();
 /// The traversal of one instruction set, for the tests: 0 baseline, 1 AVX2, 2 AVX-512; nullptr when the processor
 /// lacks it.
 WideTraverse wide_traverse_for(int isa);
-/// The same traversal over quantised nodes (WideBvh::quantized(): the dequantised boxes contain the float ones, so
-/// it visits every leaf the float nodes' traversal visits, and perhaps a few more, in an order that may differ).
-using WideQTraverse = void (*)(const WideQNode* nodes, const WideRay& ray, float limit, WideLeafVisit visit,
-                               void* context);
-WideQTraverse select_wide_qtraverse();
-WideQTraverse wide_qtraverse_for(int isa);
 
 }  // namespace batchcol

@@ -1,7 +1,5 @@
 // The body of the wide traversal (see ray_wide_traverse.hpp), included once per instruction set inside a
-// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_BITS(m): the 8 lane bits of a mask,
-// BATCHCOL_WIDE_MADD(a, b, c): a * b + c lane-wise (fused or not: it only meets exact products), and
-// BATCHCOL_WIDE_CODES(p): the 8 bytes at p as floats (GCC scalarises __builtin_convertvector's byte-to-float form).
+// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_BITS(m): the 8 lane bits of a mask.
 
 namespace {
 
@@ -10,21 +8,11 @@ typedef int M __attribute__((vector_size(32)));
 
 inline V splat(float x) { return V{x, x, x, x, x, x, x, x}; }
 
-// Plane p (lo_x, lo_y, lo_z, hi_x, hi_y, hi_z) of a node's 8 slots: float nodes hold them as 6 consecutive arrays;
-// quantised ones dequantise (ray_wide_bvh.hpp: origin + code * scale, the product exact, so BATCHCOL_WIDE_MADD's
-// fused form gives the bits of the two roundings the codes were chosen against).
-template <int p> inline V plane(const WideNode* node) {
+inline V load_at(const WideNode* node, std::size_t byte_offset) {
   V v;
-  __builtin_memcpy(&v, reinterpret_cast<const char*>(node) + p * sizeof v, sizeof v);
+  __builtin_memcpy(&v, reinterpret_cast<const char*>(node) + byte_offset, sizeof v);
   return v;
 }
-template <int p> inline V plane(const WideQNode* node) {
-  return BATCHCOL_WIDE_MADD(BATCHCOL_WIDE_CODES(node->q[p]), splat(node->scale[p % 3]), splat(node->origin[p % 3]));
-}
-// The hit slots that hold a child: a float node's empty slots have the box +-inf, never hit; a quantised node's
-// codes for them are no box, so its live bits decide.
-inline std::uint32_t live_hits(const WideNode*, std::uint32_t bits) { return bits; }
-inline std::uint32_t live_hits(const WideQNode* node, std::uint32_t bits) { return bits & node->live; }
 
 // Ordered max / min: a NaN lane of x keeps acc (see the header).
 inline V max_into(V x, V acc) { return x > acc ? x : acc; }
@@ -33,10 +21,10 @@ inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 // A node that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
 // larger than the L2 (WideRay::prefetch) its four cache lines are requested now, so the loads overlap the work in
 // between; on smaller trees the lines are there anyway and the requests only cost issue slots.
-template <class Node> inline void prefetch_node(const Node* nodes, std::uint32_t ref) {
+inline void prefetch_node(const WideNode* nodes, std::uint32_t ref) {
   if (ref & kLeafBit) return;
   const char* p = reinterpret_cast<const char*>(nodes + ref);
-  for (std::size_t line = 0; line < sizeof(Node) / 64; ++line) __builtin_prefetch(p + 64 * line);
+  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
 }
 
 // True when the ray's line passes the leaf's ball farther than its radius plus the margins (ray_wide_traverse.hpp).
@@ -65,11 +53,15 @@ struct Entry {
 // same on every instruction set.
 namespace {
 
-template <int kOctant, class Node>
-void traverse_octant(const Node* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+template <int kOctant>
+void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
   constexpr bool neg_x = (kOctant & 1) != 0, neg_y = (kOctant & 2) != 0, neg_z = (kOctant & 4) != 0;
-  constexpr int near_x = neg_x ? 3 : 0, near_y = neg_y ? 4 : 1, near_z = neg_z ? 5 : 2;  // plane<>() indices
-  constexpr int far_x = neg_x ? 0 : 3, far_y = neg_y ? 1 : 4, far_z = neg_z ? 2 : 5;
+  constexpr std::size_t near_x = neg_x ? offsetof(WideNode, hi_x) : offsetof(WideNode, lo_x);
+  constexpr std::size_t near_y = neg_y ? offsetof(WideNode, hi_y) : offsetof(WideNode, lo_y);
+  constexpr std::size_t near_z = neg_z ? offsetof(WideNode, hi_z) : offsetof(WideNode, lo_z);
+  constexpr std::size_t far_x = neg_x ? offsetof(WideNode, lo_x) : offsetof(WideNode, hi_x);
+  constexpr std::size_t far_y = neg_y ? offsetof(WideNode, lo_y) : offsetof(WideNode, hi_y);
+  constexpr std::size_t far_z = neg_z ? offsetof(WideNode, lo_z) : offsetof(WideNode, hi_z);
   const V onx = splat(r.o_near[0]), ony = splat(r.o_near[1]), onz = splat(r.o_near[2]);
   const V ofx = splat(r.o_far[0]), ofy = splat(r.o_far[1]), ofz = splat(r.o_far[2]);
   const V nix = splat(-r.inv[0]), niy = splat(-r.inv[1]), niz = splat(-r.inv[2]);
@@ -109,17 +101,17 @@ void traverse_octant(const Node* nodes, const WideRay& r, float limit, WideLeafV
       if (!go_on || !pop()) return;
       continue;
     }
-    const Node* n = nodes + e.ref;
+    const WideNode* n = nodes + e.ref;
     V tn = zero;
-    tn = max_into((onx - plane<near_x>(n)) * nix, tn);
-    tn = max_into((ony - plane<near_y>(n)) * niy, tn);
-    tn = max_into((onz - plane<near_z>(n)) * niz, tn);
+    tn = max_into((onx - load_at(n, near_x)) * nix, tn);
+    tn = max_into((ony - load_at(n, near_y)) * niy, tn);
+    tn = max_into((onz - load_at(n, near_z)) * niz, tn);
     V tf = lim_v;
-    tf = min_into((ofx - plane<far_x>(n)) * nix, tf);
-    tf = min_into((ofy - plane<far_y>(n)) * niy, tf);
-    tf = min_into((ofz - plane<far_z>(n)) * niz, tf);
+    tf = min_into((ofx - load_at(n, far_x)) * nix, tf);
+    tf = min_into((ofy - load_at(n, far_y)) * niy, tf);
+    tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
     tf = tf * scale + slack;
-    std::uint32_t bits = live_hits(n, BATCHCOL_WIDE_BITS((M)(tn <= tf)));
+    std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
     if (bits == 0) {
       if (!pop()) return;
       continue;
@@ -166,27 +158,19 @@ void traverse_octant(const Node* nodes, const WideRay& r, float limit, WideLeafV
 }
 }  // namespace
 
-template <class Node>
-void traverse_nodes(const Node* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
+void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
   // The octant is read back from the near planes make_wide_ray() chose (hi: a negative component).
   const int octant = (r.near_offset[0] == offsetof(WideNode, hi_x) ? 1 : 0) |
                      (r.near_offset[1] == offsetof(WideNode, hi_y) ? 2 : 0) |
                      (r.near_offset[2] == offsetof(WideNode, hi_z) ? 4 : 0);
   switch (octant) {
-    case 0: return traverse_octant<0, Node>(nodes, r, limit, visit, context);
-    case 1: return traverse_octant<1, Node>(nodes, r, limit, visit, context);
-    case 2: return traverse_octant<2, Node>(nodes, r, limit, visit, context);
-    case 3: return traverse_octant<3, Node>(nodes, r, limit, visit, context);
-    case 4: return traverse_octant<4, Node>(nodes, r, limit, visit, context);
-    case 5: return traverse_octant<5, Node>(nodes, r, limit, visit, context);
-    case 6: return traverse_octant<6, Node>(nodes, r, limit, visit, context);
-    default: return traverse_octant<7, Node>(nodes, r, limit, visit, context);
+    case 0: return traverse_octant<0>(nodes, r, limit, visit, context);
+    case 1: return traverse_octant<1>(nodes, r, limit, visit, context);
+    case 2: return traverse_octant<2>(nodes, r, limit, visit, context);
+    case 3: return traverse_octant<3>(nodes, r, limit, visit, context);
+    case 4: return traverse_octant<4>(nodes, r, limit, visit, context);
+    case 5: return traverse_octant<5>(nodes, r, limit, visit, context);
+    case 6: return traverse_octant<6>(nodes, r, limit, visit, context);
+    default: return traverse_octant<7>(nodes, r, limit, visit, context);
   }
-}
-
-void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
-  traverse_nodes(nodes, r, limit, visit, context);
-}
-void traverse_quantized(const WideQNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
-  traverse_nodes(nodes, r, limit, visit, context);
 }
