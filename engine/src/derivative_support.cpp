@@ -76,44 +76,37 @@ void triangle_feature(SupportJacobian& J, const std::array<Eigen::Vector3d, 3>& 
   }
 }
 
+/// Zeroes a_pq of a symmetric 3x3 by a Jacobi rotation in the (p, q) plane; r is the third index (a_rp, a_rq the
+/// entries it mixes). The smaller root t = tan(angle) of t^2 + 2 theta t - 1 = 0 (|angle| <= pi/4), overflow-safe
+/// for large theta.
+inline void jacobi_rotate(double& app, double& aqq, double& apq, double& arp, double& arq) {
+  if (apq == 0.0) return;
+  const double theta = (aqq - app) / (2.0 * apq), at = std::abs(theta);
+  const double t = std::copysign(at > 1e150 ? 0.5 / at : 1.0 / (at + std::sqrt(at * at + 1.0)), theta);
+  const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+  app -= t * apq;
+  aqq += t * apq;
+  apq = 0.0;
+  const double rp = arp, rq = arq;
+  arp = c * rp - s * rq;
+  arq = s * rp + c * rq;
+}
+
 /// The eigenvalues of symmetric A by cyclic Jacobi rotations (no eigenvectors: psd_projection() needs only the
-/// values). Each rotation zeroes one off-diagonal entry exactly; a sweep whose entries are all negligible against
-/// their diagonal ends it (3x3 converges quadratically: ~3-4 sweeps). Only + - * / and sqrt, so the bits are the
-/// same on every machine and instruction set (libm's acos / cos of the closed-form cubic may differ by ISA variant).
+/// values), until the off-diagonal entries are below 1e-18 of the diagonal's (the eigenvalues then to rounding;
+/// 3x3 converges quadratically: ~3 sweeps). Only + - * / and sqrt, so the bits are the same on every machine and
+/// instruction set (libm's acos / cos of the closed-form cubic may differ by ISA variant).
 Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
-  double a[3][3];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) a[r][c] = A(r, c);
-  static constexpr int kPairs[3][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}};  // p, q and the third index r
-  for (int sweep = 0; sweep < 50; ++sweep) {
-    bool rotated = false;
-    for (const auto& pq : kPairs) {
-      const int p = pq[0], q = pq[1], r = pq[2];
-      const double apq = a[p][q];
-      if (apq == 0.0) continue;
-      const double app = a[p][p], aqq = a[q][q];
-      // Negligible: adding it to both diagonal entries (scaled up) changes neither (Numerical Recipes' test).
-      if (std::abs(app) + 100.0 * std::abs(apq) == std::abs(app) &&
-          std::abs(aqq) + 100.0 * std::abs(apq) == std::abs(aqq)) {
-        a[p][q] = a[q][p] = 0.0;
-        continue;
-      }
-      rotated = true;
-      // The smaller root t = tan(angle) of t^2 + 2 theta t - 1 = 0 (|angle| <= pi/4), overflow-safe for large theta.
-      const double theta = (aqq - app) / (2.0 * apq);
-      const double t = std::abs(theta) > 1e150 ? 0.5 / theta
-                                               : std::copysign(1.0, theta) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
-      const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
-      a[p][p] = app - t * apq;
-      a[q][q] = aqq + t * apq;
-      a[p][q] = a[q][p] = 0.0;
-      const double arp = a[r][p], arq = a[r][q];
-      a[r][p] = a[p][r] = c * arp - s * arq;
-      a[r][q] = a[q][r] = s * arp + c * arq;
-    }
-    if (!rotated) break;
+  double a00 = A(0, 0), a11 = A(1, 1), a22 = A(2, 2), a01 = A(0, 1), a02 = A(0, 2), a12 = A(1, 2);
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const double off = std::max(std::max(std::abs(a01), std::abs(a02)), std::abs(a12));
+    const double diagonal = std::max(std::max(std::abs(a00), std::abs(a11)), std::abs(a22));
+    if (!(off > 1e-18 * diagonal)) break;
+    jacobi_rotate(a00, a11, a01, a02, a12);  // (p, q, r) = (0, 1, 2)
+    jacobi_rotate(a00, a22, a02, a01, a12);  // (0, 2, 1)
+    jacobi_rotate(a11, a22, a12, a01, a02);  // (1, 2, 0)
   }
-  return {a[0][0], a[1][1], a[2][2]};
+  return {a00, a11, a22};
 }
 
 }  // namespace
@@ -127,7 +120,10 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   if (m1 > 0.0 && m2 > 0.0 && det > 0.0) return H;
   if (!H.allFinite()) return H;  // NaN in, NaN out (as the eigendecomposition did), no rotations on NaN
   Eigen::Vector3d l = symmetric_eigenvalues(H);
-  std::sort(l.data(), l.data() + 3, [](double x, double y) { return x > y; });  // l0 >= l1 >= l2
+  // l0 >= l1 >= l2
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
+  if (l[2] > l[1]) std::swap(l[1], l[2]);
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
   if (l[2] >= 0.0) return H;
   if (l[0] <= 0.0) return Eigen::Matrix3d::Zero();
   // With eigenvalues l_i and spectral projectors Q_i, Q_i = prod_{j != i} (H - l_j) / (l_i - l_j). One negative
