@@ -113,11 +113,17 @@ Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
 
 Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   // Positive definite by Sylvester's criterion (the leading minors): the projection is H itself. The common case
-  // on curved shapes, and no eigenvalues needed.
-  const double m1 = H(0, 0), m2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
-  const double det = H(0, 0) * (H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2)) - H(0, 1) * (H(0, 1) * H(2, 2) - H(1, 2) * H(0, 2)) +
-                     H(0, 2) * (H(0, 1) * H(1, 2) - H(1, 1) * H(0, 2));
-  if (m1 > 0.0 && m2 > 0.0 && det > 0.0) return H;
+  // on curved shapes at larger M, and no eigenvalues needed. Each minor must clear 1e-12 of the sum of its terms'
+  // magnitudes, far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by
+  // rounding alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+  const double a00 = H(0, 0), a11 = H(1, 1), a22 = H(2, 2), a01 = H(0, 1), a02 = H(0, 2), a12 = H(1, 2);
+  const double m2 = a00 * a11 - a01 * a01, m2_size = std::abs(a00 * a11) + a01 * a01;
+  const double c0 = a11 * a22 - a12 * a12, c1 = a01 * a22 - a12 * a02, c2 = a01 * a12 - a11 * a02;
+  const double det = a00 * c0 - a01 * c1 + a02 * c2;
+  const double det_size = std::abs(a00) * (std::abs(a11 * a22) + a12 * a12) +
+                          std::abs(a01) * (std::abs(a01 * a22) + std::abs(a12 * a02)) +
+                          std::abs(a02) * (std::abs(a01 * a12) + std::abs(a11 * a02));
+  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return H;
   if (!H.allFinite()) return H;  // NaN in, NaN out (as the eigendecomposition did), no rotations on NaN
   Eigen::Vector3d l = symmetric_eigenvalues(H);
   // l0 >= l1 >= l2
