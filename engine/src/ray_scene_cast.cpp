@@ -83,7 +83,12 @@ class Caster {
     if (ball_misses(obj, r, t_max, ball_entry)) return false;
     const Vec3<double> o = kernels::mul_transposed(obj.R, Vec3<double>(r.o - obj.t));
     const Vec3<double> d = kernels::mul_transposed(obj.R, r.d);
-    const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_, ball_entry);
+    // Uninflated hulls (the ball filter always passes them with an entry) go straight to the walk.
+    const kr::RayShape<double>& shape = s_.prepared.shapes[obj.shape];
+    const kr::LocalHit<double> h =
+        shape.core.type == ShapeType::convex && !(shape.inflation > 0.0) && ball_entry == ball_entry
+            ? kr::ray_local_hull(shape, o, d, t_max, ball_entry)
+            : kr::ray_local(shape, o, d, t_max, gjk_, ball_entry);
     capped = capped || h.status != kr::LocalStatus::converged;
     if (!h.hit) return false;
     hit = {h.t, kernels::mul(obj.R, h.normal), obj.handle};
