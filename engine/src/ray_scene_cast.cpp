@@ -195,7 +195,7 @@ class Caster {
     }
   }
 
-  void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found, bool& capped) const {
+  [[gnu::always_inline]] void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found, bool& capped) const {
     double limit = r.t_max;
     Hit h;
     for (const RayObject& obj : s_.halfspaces) {

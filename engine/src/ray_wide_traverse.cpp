@@ -110,20 +110,7 @@ void make_leaf_ball(const double c[3], double bound, float out[4]) {
   out[3] = bound > 0.0 && std::isfinite(radius) && radius < 0x1p100 ? std::max(round_up(radius), 0x1p-60f) : INFINITY;
 }
 
-float wide_limit(double t) {
-  const double x = t * double(kFarScale);
-  if (!(x >= 0.0)) return round_up(x);
-  // Limits are t >= 0 (t_max or a hit): round_up() without its branches, which were mispredicted about once in three
-  // calls (a hit moves the limit). For f >= +0 the next float up has the next bit pattern (0 -> the smallest
-  // subnormal, FLT_MAX -> +inf, as next_up()); f = -0 (x = -0) and f = +inf are never below x. The same bits.
-  const float f = static_cast<float>(x);
-  std::uint32_t u;
-  __builtin_memcpy(&u, &f, sizeof u);
-  u += double(f) < x ? 1u : 0u;
-  float r;
-  __builtin_memcpy(&r, &u, sizeof r);
-  return r;
-}
+float wide_limit_round_up(double x) { return round_up(x); }
 
 WideTraverse wide_traverse_for(int isa) {
   switch (isa) {
