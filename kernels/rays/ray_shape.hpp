@@ -39,7 +39,7 @@ inline bool uses_ray_gjk(const ShapeView& shape) {
 /// the walk from there, or every plane clipped when the walk gives up. ray_local()'s convex case, callable on its own
 /// so that a caller that already knows the shape type (the scene's leaf visits: ~60 instructions a call for the
 /// dispatch, its tests and the extra copy of the result) skips the dispatch.
-template <class T> LocalHit<T> ray_local_hull(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d, T t_max,
+template <class T> [[gnu::always_inline]] inline LocalHit<T> ray_local_hull(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d, T t_max,
                                               T ball_entry) {
   if (s.planes->walk.planes() > 0) {
     bool ok = false;
