@@ -42,21 +42,6 @@ struct Entry {
   float t;
 };
 
-inline std::uint64_t pack(std::uint32_t ref, float t) {
-  const Entry e{ref, t};
-  std::uint64_t w;
-  __builtin_memcpy(&w, &e, sizeof w);
-  return w;
-}
-
-inline Entry unpack(std::uint64_t w) {
-  Entry e;
-  __builtin_memcpy(&e, &w, sizeof e);
-  return e;
-}
-
-inline void store(Entry* slot, std::uint64_t w) { __builtin_memcpy(slot, &w, sizeof w); }
-
 }  // namespace
 
 // The loop for one octant of ray directions (bit k of kOctant: the direction's component k is negative, -0
@@ -95,7 +80,6 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   // loop, refreshed after every visit, so the node test neither reloads nor broadcasts it.
   float lim = limit;
   V lim_v = splat(lim);
-  const bool prefetch = r.prefetch;  // a local: visit() is opaque, so r.prefetch would be reloaded after it
   // The next entry still within reach (a closer hit may have been found since it was pushed); false when none.
   const auto pop = [&] {
     do {
@@ -133,25 +117,24 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       continue;
     }
     const V& entry = tn;  // read lane by lane below (a copy into a float array was split and copied twice)
-    // One or two hit children (on 2000 hulls 3.5 and 1.7 of the 10.6 nodes a ray tests) take one path without a
-    // branch on which: the two cases, and which of two children is nearer, are random data, and as branches they
-    // were mispredicted 3.5 times a ray (callgrind --branch-sim). k0 = lowest hit slot, k1 = highest (= k0 for one
-    // child), the lower slot first unless the other one is strictly nearer (the order of the general case below);
-    // the farther one is written above the stack and kept only when there are two, the nearer one is next. The same
-    // entries in the same order as the branches gave.
+    // One child reached (the common case deep in the tree): it is next, no sort and no stack.
+    if ((bits & (bits - 1)) == 0) {
+      const int k = __builtin_ctz(bits);
+      e = Entry{n->child[k], entry[k]};
+      continue;
+    }
+    // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
+    // keep the slot order (the sort is stable), so the order is a function of the node and the ray only.
+    // Two children (half of the nodes with several hits) need one comparison, not the general loop below; the
+    // order is the same (the lower slot first unless the other one is strictly nearer).
     const std::uint32_t rest = bits & (bits - 1);
     if ((rest & (rest - 1)) == 0) {
-      const int k0 = __builtin_ctz(bits), k1 = 31 - __builtin_clz(bits);
-      const float t0 = entry[k0], t1 = entry[k1];
-      // The two entries as words, exchanged by a mask (GCC compiles `swap ? k1 : k0` to a mispredicted branch).
-      const std::uint64_t a = pack(n->child[k0], t0), b = pack(n->child[k1], t1);
-      const std::uint64_t x = (a ^ b) & (std::uint64_t(0) - std::uint64_t(t1 < t0));
-      store(stack + top, b ^ x);  // the farther one
-      top += rest != 0;
-      e = unpack(a ^ x);  // the nearer one
-      // With one child this prefetches the nearer one, loaded next anyway. Not `prefetch && rest != 0`: GCC tests
-      // rest first, a mispredicted branch on trees that never prefetch.
-      if (prefetch) prefetch_node(nodes, std::uint32_t(b ^ x));
+      const int k0 = __builtin_ctz(bits), k1 = __builtin_ctz(rest);
+      const bool swap = entry[k1] < entry[k0];
+      const int near = swap ? k1 : k0, far = swap ? k0 : k1;
+      stack[top++] = Entry{n->child[far], entry[far]};
+      if (r.prefetch) prefetch_node(nodes, n->child[far]);
+      e = Entry{n->child[near], entry[near]};
       continue;
     }
     // Three or more: each hit child's rank in that order, counted without branches on the data: the hit children
@@ -167,12 +150,9 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
       const int rank = __builtin_popcount(bits & (nearer | (same & ((1u << k) - 1u))));
       base[-rank] = Entry{n->child[k], t};
+      if (r.prefetch && rank != 0) prefetch_node(nodes, n->child[k]);
     }
     top += count - 1;
-    // The pushed ones (all but rank 0) prefetched after the loop: `r.prefetch && rank != 0` inside it was compiled
-    // with the rank test first, mispredicted 1.3 times a ray on trees that never prefetch.
-    if (prefetch)
-      for (int j = 1; j < count; ++j) prefetch_node(nodes, stack[top - j].ref);
     e = stack[top];  // rank 0: the nearest child next, without a trip through the stack
   }
 }
