@@ -63,22 +63,18 @@ template <class T> struct WideGjkSamples {
     }
 
     /// setup_pair_into() and set_gjk_parameters() for the next sample (gjk_limits() from its own |t|, the warm
-    /// direction when finite and non-zero, else the centres' difference), then WideGjk::start_lane()'s writes
-    /// straight into lane l: building its LaneStart and copying it in cost ~60 instructions per sample, a twentieth
-    /// of a warm-started sample. A field start_lane() gains must be written here too (as in wide_gjk_pairs.inl's
-    /// refill); the search state is reset_search()'s, shared.
+    /// direction when finite and non-zero, else the centres' difference), then WideGjk::start_lane()'s two halves
+    /// straight into lane l: building a LaneStart and copying it in cost ~60 instructions per sample, a twentieth
+    /// of a warm-started sample.
     bool load(Lanes& L, int l) {
       if (next == in.samples) return false;
       const std::size_t s = next++;
       if (in.shape_a[s] != shape_a || in.shape_b[s] != shape_b) share(in.shape_a[s], in.shape_b[s]);
-      L.pair[l] = std::int64_t(s);
       T R[9];
-      for (int e = 0; e < 9; ++e) L.R[e][l] = R[e] = T(in.R[e][s]);
+      for (int e = 0; e < 9; ++e) R[e] = T(in.R[e][s]);
       const double tx = in.t[0][s], ty = in.t[1][s], tz = in.t[2][s];
       const T t[3] = {T(tx), T(ty), T(tz)};
-      for (int i = 0; i < 3; ++i) L.t[i][l] = t[i];
-      G::load_side(L.A, G::side_start(shared.core_a), l);
-      G::load_side(L.B, G::side_start(shared.core_b), l);
+      G::start_pose(L, l, R, t, G::side_start(shared.core_a), G::side_start(shared.core_b), std::int64_t(s));
       const GjkLimits<T> g = gjk_limits<T>(shared.core_a.radius, shared.core_b.radius, shared.bounding_a, shared.bounding_b,
                                            std::sqrt((tx * tx + ty * ty) + tz * tz), options);
       Vec3<T> init(T(in.direction[0][s]), T(in.direction[1][s]), T(in.direction[2][s]));
@@ -89,16 +85,7 @@ template <class T> struct WideGjkSamples {
                                (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + t[2]);
         init = shared.center_a - b_center;
       }
-      if (!(kernels::norm2(init) > T(0))) init = Vec3<T>::UnitX();  // start_lane()'s rule
-      G::reset_search(L, l, init);
-      L.max_iterations[l] = g.max_iterations;
-      L.momentum[l] = options.solver != Solver::gjk ? -1 : 0;
-      L.normalize[l] = normalize ? -1 : 0;
-      L.boolean_only[l] = g.boolean_only ? -1 : 0;
-      L.tolerance[l] = g.tolerance;
-      L.relative[l] = g.relative;
-      L.touch[l] = g.touch;
-      L.core_margin[l] = g.core_margin;
+      G::start_search(L, l, init, g, options.solver != Solver::gjk, normalize);
       sample[l] = std::uint32_t(s);
       completion[l] = {shared.core_a.radius, shared.core_b.radius, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
       return true;
