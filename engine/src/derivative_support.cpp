@@ -6,7 +6,6 @@
 #include "kernels/support.hpp"
 #include "shape_table_access.hpp"
 
-
 #include <emmintrin.h>  // SSE2: the x86-64 baseline this file is compiled for
 
 #include <algorithm>
@@ -107,6 +106,14 @@ Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
     jacobi_rotate(a11, a22, a12, a01, a02);  // (1, 2, 0)
   }
   return {a00, a11, a22};
+}
+
+/// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
+/// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.
+inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vector3d& d) {
+  if (!(radius > 0.0)) return;
+  const double n = d.norm();
+  if (n > 0.0) p += radius * d / n;
 }
 
 }  // namespace
@@ -325,8 +332,7 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
   const auto core = kernels::make_core<double>(view.view);
   kernels::SupportHint hint;
   Eigen::Vector3d p = kernels::support(core, u, hint);
-  const double n = u.norm();
-  if (core.radius > 0.0 && n > 0.0) p += core.radius * u / n;
+  add_swept_radius(p, core.radius, u);
   return p;
 }
 
@@ -338,10 +344,7 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d p = kernels::support(core, d, hint);
-    if (core.radius > 0.0) {  // the norm (a square root) only for a swept radius
-      const double n = d.norm();
-      if (n > 0.0) p += core.radius * d / n;
-    }
+    add_swept_radius(p, core.radius, d);
     return p;
   };
   const Eigen::Vector3d s0 = support(u);
@@ -431,9 +434,7 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
         const std::size_t j = j0 + l;
         const double* p = v + 3 * static_cast<std::size_t>(index[l]);
         Eigen::Vector3d point(p[0], p[1], p[2]);
-        const Eigen::Vector3d dj(d[0][j], d[1][j], d[2][j]);  // support()'s swept radius
-        const double norm = dj.norm();
-        if (norm > 0.0) point += core.radius * dj / norm;
+        add_swept_radius(point, core.radius, Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));  // as support()
         for (int r = 0; r < 3; ++r) q[3 * j + r] = point[r] - s0[r];
       }
     }
