@@ -43,13 +43,15 @@ template <class T> struct WideGjkSamples {
     std::uint32_t shape_a = ~0u, shape_b = ~0u;  // the shapes `shared` was made of
     Shared shared;
     bool normalize;
+    bool witness_level;  // finish() keeps every value (below the witness level it writes NaNs)
     std::uint32_t sample[W] = {};
     GjkCompletion<T> completion[W];
 
     Source(const PairView& shapes_, const SampleBatch& in_, const QueryOptions& options_, const SampleResults& out_,
            std::uint32_t* fallback_, ShapeType a, ShapeType b)
         : shapes(shapes_), in(in_), options(options_), out(out_), fallback(fallback_),
-          normalize(!(a == ShapeType::ellipsoid && b == ShapeType::ellipsoid)) {}
+          normalize(!(a == ShapeType::ellipsoid && b == ShapeType::ellipsoid)),
+          witness_level(options_.level >= QueryLevel::witness) {}
 
     void share(std::uint32_t ia, std::uint32_t ib) {
       shape_a = ia;
@@ -93,6 +95,35 @@ template <class T> struct WideGjkSamples {
 
     /// complete_from_gjk() for lane l's sample, written in A's frame; what it cannot finish goes to the fallback.
     void done(const Lanes& L, int l, GjkStatus status) {
+      if (status == GjkStatus::converged && witness_level) [[likely]] {
+        // complete_from_gjk()'s converged case straight from the lane, in its operations and order (|x| as below;
+        // n = -x / |x|; the cores' witness points as GjkResult::witness_a() combines them from zero): the
+        // GjkResult copy (four simplex vertices), the call and the PairOutput cost ~70 instructions per sample.
+        const GjkCompletion<T>& c = completion[l];
+        const T x[3] = {L.x.x[l], L.x.y[l], L.x.z[l]};
+        // Eigen's Vec3 norm: a 2-lane packet plus the last square in double, a halving unroll in float.
+        const T xx = x[0] * x[0], yy = x[1] * x[1], zz = x[2] * x[2];
+        const T xn = std::sqrt(std::is_same_v<T, double> ? (xx + yy) + zz : xx + (yy + zz));
+        T n[3], pa[3] = {T(0), T(0), T(0)}, pb[3] = {T(0), T(0), T(0)};
+        for (int i = 0; i < 3; ++i) n[i] = -x[i] / xn;
+        const int count = int(L.count[l]);
+        for (int m = 0; m < count; ++m) {
+          const int q = int(L.slot[m][l]) & 3;
+          const T lambda = L.lambda[m][l];
+          pa[0] += lambda * L.a[q].x[l], pa[1] += lambda * L.a[q].y[l], pa[2] += lambda * L.a[q].z[l];
+          pb[0] += lambda * L.b[q].x[l], pb[1] += lambda * L.b[q].y[l], pb[2] += lambda * L.b[q].z[l];
+        }
+        const std::uint32_t s = sample[l];
+        out.status[s] = Status::converged;
+        const std::size_t k = s * out.stride;
+        out.distance[k] = double(xn - c.radii);
+        for (int i = 0; i < 3; ++i) {
+          out.witness_a[i][k] = double(pa[i] + c.radius_a * n[i]);
+          out.witness_b[i][k] = double(pb[i] - c.radius_b * n[i]);
+          out.normal[i][k] = double(n[i]);
+        }
+        return;
+      }
       GjkResult<T> g;
       G::finish(L, l, status, g, true);
       PairOutput<T> r;
