@@ -74,8 +74,27 @@ template <std::size_t N> void load3(const double (&rows)[3][N], std::size_t l, V
 // theorem from n, x_a, x_b, and for each entry (i, j) of the 3x6 derivatives with respect to the twist of a, given
 // by entry(i, j, wa, wb, dn) (dx_a/dxi_a, dx_b/dxi_a, dn/dxi_a), those and the twist of b's by the rigid-motion
 // identity (write_from_twist_a()'s order and formulas).
-template <class Put, class Entry>
+// kNormalB: only normal_wrt_b (entries 102-119), the smoothed0 samples' first-order start (dn/dxi_b); the other
+// entries are neither computed nor written.
+template <bool kNormalB = false, class Put, class Entry>
 void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
+  if constexpr (kNormalB) {
+#pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i)
+#pragma GCC unroll 6
+      for (int j = 0; j < 6; ++j) {
+        const int e = 6 * i + j;
+        V wa, wb, dn;
+        entry(i, j, wa, wb, dn);
+        if (j < 3 || j - 3 == i) {
+          put(102 + e, 0.0 - dn);
+        } else {
+          const int k = j - 3, other = 3 - i - k;
+          put(102 + e, (i + 1) % 3 == k ? n[other] - dn : -n[other] - dn);
+        }
+      }
+    return;
+  }
   put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
   put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
   put(6, n[0]), put(7, n[1]), put(8, n[2]);
@@ -151,7 +170,12 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
 // pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
 // whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
 // per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
-void SmoothLanes::solve(double* const* out) const {
+void SmoothLanes::solve(double* const* out, bool normal_b_only) const {
+  if (normal_b_only) solve_lanes<true>(out);
+  else solve_lanes<false>(out);
+}
+
+template <bool kNormalB> void SmoothLanes::solve_lanes(double* const* out) const {
   run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
     const V d = load(&sd[l]);
     V n[3], xa[3], xb[3];
@@ -203,7 +227,7 @@ void SmoothLanes::solve(double* const* out) const {
       }
     V nY[6];
     for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    put_outputs(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
+    put_outputs<kNormalB>(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
       wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
       wa = wb + d * Y[i][j];
       dn = n[i] * nY[j] - Y[i][j];

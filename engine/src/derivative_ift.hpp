@@ -105,7 +105,11 @@ struct SmoothLanes {
   /// Writes the 120 entries of every lane l < count to out[e][column[l]] (write_jacobians()'s order; out[e] points
   /// to column 0 of entry e: a block buffer's row or the output array itself). Whole registers are stored when
   /// the columns are 0, 1, 2, ... (a block of smooth pairs only), single lanes otherwise.
-  void solve(double* const* out) const;
+  /// normal_b_only: only normal_wrt_b's 18 entries (the other rows of `out` are left as they were).
+  void solve(double* const* out, bool normal_b_only = false) const;
+
+ private:
+  template <bool kNormalB> void solve_lanes(double* const* out) const;
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two

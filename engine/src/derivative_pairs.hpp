@@ -71,6 +71,9 @@ class StoreBlock {
   void flush();
 
   DerivativeResults& d;
+  /// Smooth pairs write normal_wrt_b only (the smoothed0 samples' predictor reads nothing else); the other pairs
+  /// still write all their entries.
+  bool normal_b_only = false;
 
  private:
   alignas(64) double buf_[kEntries][kStride] = {};
@@ -88,6 +91,11 @@ void store_nothing(StoreBlock& out, std::size_t i);
 /// Sizes `d` for n pairs (the smoothed arrays only when `smoothed`) without filling it: the callers write every
 /// entry of every pair (store() or store_nothing()), so a reused result is not written twice.
 void size_for(DerivativeResults& d, std::size_t n, bool smoothed);
+
+/// The analytic derivatives as differentiate_results() computes them, for the smoothed0 samples' first-order start:
+/// statuses and normal_wrt_b are those bits; the smooth pairs (SmoothLanes) write no other entry, the rest may.
+void analytic_normal_b(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
+                       const DerivativeOptions& analytic, int threads, DerivativeResults& derivatives);
 
 /// The 0th-order estimator (derivative_smoothed0.cpp); `results` holds the unperturbed query.
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,

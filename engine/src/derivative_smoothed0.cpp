@@ -239,42 +239,79 @@ void accumulate(const Context& c, Block& b, std::size_t first, std::size_t count
   kernels::simd::accumulate_samples(c.isa, b.row(first), b.status.data() + first, z, count, (count + 1) / 2, sums);
 }
 
-/// The estimator from the sums, mapped from A's frame and A-frame noise to the world.
+/// The estimator from the sums, mapped from A's frame and A-frame noise to the world, written straight into the
+/// pair's StoreBlock slot. Scalar loops in the operation order of the Eigen expressions they replace (products
+/// summed k = 0, 1, 2 left to right, except row 2 of Ra times a 3-row block, which Eigen computes after its 2-row
+/// packet as a0 + (a1 + a2); the same divisions; the rigid-motion blocks' signed zeros), so the bits are those of
+/// the Eigen version; that one cost ~1600 instructions per pair (block temporaries, a PairJacobians copy
+/// and write_jacobians()), more than four M = 4 samples' GJK.
 void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlock& out) {
   const std::size_t i = p.i;
   if (sums.valid == 0) return store_nothing(out, i);
   DerivativeResults& d = out.d;
-  const Eigen::Matrix<double, 10, 1> mean_a = Eigen::Map<const Eigen::Matrix<double, 10, 1>>(sums.mean) / sums.valid;
-  Eigen::Matrix<double, 10, 6> G =
-      Eigen::Map<const Eigen::Matrix<double, 10, 6>, 0, Eigen::OuterStride<12>>(sums.G[0]) / sums.valid;
-  // The score of the Gaussian over the noise scale: S^-1 z.
-  G.leftCols<3>() /= p.s.translation;
-  G.rightCols<3>() /= p.s.rotation;
+  const double valid = double(sums.valid);
+  double mean[10];
+  for (int r = 0; r < 10; ++r) mean[r] = sums.mean[r] / valid;
+  // G(r, e) = sums.G[e][r] / valid, then divided by the noise scale: the score of the Gaussian is S^-1 z.
+  double G[10][6];
+  for (int e = 0; e < 6; ++e) {
+    const double s = e < 3 ? p.s.translation : p.s.rotation;
+    for (int r = 0; r < 10; ++r) G[r][e] = sums.G[e][r] / valid / s;
+  }
   // Values and noise to the world: v_world - g0_world = Ra (v_A - g0_A) for the points and the normal, and the
   // world noise is Ra z.
-  const Eigen::Matrix3d& Ra = p.Ra;
-  for (int r = 1; r < 10; r += 3) G.middleRows<3>(r) = (Ra * G.middleRows<3>(r)).eval();
-  G.leftCols<3>() = (G.leftCols<3>() * Ra.transpose()).eval();
-  G.rightCols<3>() = (G.rightCols<3>() * Ra.transpose()).eval();
+  double Ra[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) Ra[r][q] = p.Ra(r, q);
+  for (int r = 1; r < 10; r += 3)
+    for (int e = 0; e < 6; ++e) {
+      const double g0 = G[r][e], g1 = G[r + 1][e], g2 = G[r + 2][e];
+      for (int q = 0; q < 2; ++q) G[r + q][e] = (Ra[q][0] * g0 + Ra[q][1] * g1) + Ra[q][2] * g2;
+      G[r + 2][e] = Ra[2][0] * g0 + (Ra[2][1] * g1 + Ra[2][2] * g2);
+    }
+  for (int r = 0; r < 10; ++r)
+    for (int h = 0; h < 6; h += 3) {
+      const double g0 = G[r][h], g1 = G[r][h + 1], g2 = G[r][h + 2];
+      for (int q = 0; q < 3; ++q) G[r][h + q] = (g0 * Ra[q][0] + g1 * Ra[q][1]) + g2 * Ra[q][2];
+    }
   // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
   const Eigen::Vector3d t_b = c.batch.translation_b[i];
-  G.rightCols<3>() -= G.leftCols<3>() * skew(t_b);
-  PairJacobians J;
-  J.distance_b = G.row(0);
-  J.distance_a = -J.distance_b;
-  J.witness_a_b = G.middleRows<3>(1);
-  J.witness_b_b = G.middleRows<3>(4);
-  J.normal_b = G.middleRows<3>(7);
-  const Eigen::Vector3d xa = Ra * mean_a.segment<3>(1) + p.ta, xb = Ra * mean_a.segment<3>(4) + p.ta;
-  const Eigen::Vector3d n = Ra * mean_a.segment<3>(7);
-  J.witness_a_a = rigid_motion(xa) - J.witness_a_b;
-  J.witness_b_a = rigid_motion(xb) - J.witness_b_b;
-  J.normal_a = (Mat36() << Eigen::Matrix3d::Zero(), -skew(n)).finished() - J.normal_b;
-  store(out, i, J);
-  d.smoothed_distance[i] = mean_a(0);
-  d.smoothed_witness_a.set(i, xa);
-  d.smoothed_witness_b.set(i, xb);
-  d.smoothed_normal.set(i, n);
+  const double S[3][3] = {{0.0, -t_b.z(), t_b.y()}, {t_b.z(), 0.0, -t_b.x()}, {-t_b.y(), t_b.x(), 0.0}};  // skew()
+  for (int r = 0; r < 10; ++r)
+    for (int q = 0; q < 3; ++q) G[r][3 + q] -= (G[r][0] * S[0][q] + G[r][1] * S[1][q]) + G[r][2] * S[2][q];
+  const auto world = [&](int r0, double* v) {  // Ra m + ta (r0 = 1, 4) or Ra m (r0 = 7)
+    for (int q = 0; q < 2; ++q) v[q] = (Ra[q][0] * mean[r0] + Ra[q][1] * mean[r0 + 1]) + Ra[q][2] * mean[r0 + 2];
+    v[2] = Ra[2][0] * mean[r0] + (Ra[2][1] * mean[r0 + 1] + Ra[2][2] * mean[r0 + 2]);
+  };
+  double xa[3], xb[3], n[3];
+  world(1, xa), world(4, xb), world(7, n);
+  for (int q = 0; q < 3; ++q) xa[q] += p.ta[q], xb[q] += p.ta[q];
+  // write_jacobians()'s order: distance_a, distance_b, then witness_a_a, witness_a_b, witness_b_a, witness_b_b,
+  // normal_a, normal_b (3x6, row-major).
+  double* slot = out.slot(i);
+  constexpr std::size_t kS = StoreBlock::kStride;
+  for (int e = 0; e < 6; ++e) slot[e * kS] = -G[0][e], slot[(6 + e) * kS] = G[0][e];
+  // The a-twist blocks: [I, -[x]x] - the b-twist block (rigid_motion(); [0, -[n]x] for the normal), -[x]x with
+  // rigid_motion()'s -0.0 diagonal.
+  const auto a_block = [&](std::size_t e0, const double* x, double identity, int r0) {
+    const double minus_skew[3][3] = {{-0.0, x[2], -x[1]}, {-x[2], -0.0, x[0]}, {x[1], -x[0], -0.0}};
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 6; ++q) {
+        const double m = q < 3 ? (r == q ? identity : 0.0) : minus_skew[r][q - 3];
+        slot[(e0 + 6 * r + q) * kS] = m - G[r0 + r][q];
+      }
+  };
+  const auto b_block = [&](std::size_t e0, int r0) {
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 6; ++q) slot[(e0 + 6 * r + q) * kS] = G[r0 + r][q];
+  };
+  a_block(12, xa, 1.0, 1), b_block(30, 1);
+  a_block(48, xb, 1.0, 4), b_block(66, 4);
+  a_block(84, n, 0.0, 7), b_block(102, 7);
+  d.smoothed_distance[i] = mean[0];
+  d.smoothed_witness_a.set(i, Eigen::Vector3d(xa[0], xa[1], xa[2]));
+  d.smoothed_witness_b.set(i, Eigen::Vector3d(xb[0], xb[1], xb[2]));
+  d.smoothed_normal.set(i, Eigen::Vector3d(n[0], n[1], n[2]));
   d.status[i] = sums.valid == c.o.samples ? DerivativeStatus::smooth : DerivativeStatus::partial_samples;
 }
 
@@ -289,28 +326,32 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
   StoreBlock out(d);
   Sums sums;
   std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
-  PairPlan current;
-  bool planned = false;
+  bool planned = false;          // pair i is planned, in plans[count - 1] (its samples continue in this block)
+  std::size_t count = 0;         // plans in use; the vector only grows, so a pair is planned in place, not copied
   while (i < end) {
-    // Fill the block with whole antithetic pairs of samples, pair after pair.
-    plans.clear();
+    // Fill the block with whole antithetic pairs of samples, pair after pair; a pair left unfinished by the last
+    // block keeps its plan, moved to the front.
+    if (planned && count > 1) plans[0] = plans[count - 1];
+    count = planned ? 1 : 0;
     spans.clear();
     std::size_t used = 0;
     while (i < end && used + 2 <= kBlockSamples) {
       if (!planned) {
-        plan_pair(c, i, current);
-        planned = true;
+        if (count == plans.size()) plans.emplace_back();
+        PairPlan& p = plans[count];
+        plan_pair(c, i, p);
         j = 0;
-        if (!current.ok) {
+        if (!p.ok) {
           store_nothing(out, i);
           ++i;
-          planned = false;
           continue;
         }
+        ++count;
+        planned = true;
       }
+      const PairPlan& current = plans[count - 1];
       const std::size_t take = std::min(M - j, (kBlockSamples - used) & ~std::size_t(1));
-      plans.push_back(current);
-      spans.push_back({plans.size() - 1, used, take, j});
+      spans.push_back({count - 1, used, take, j});
       build(c, current, j, take, block, used);
       used += take;
       j += take;
@@ -360,7 +401,7 @@ void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOpti
   if (any_curved) {
     DerivativeOptions analytic = o;
     analytic.method = DerivativeMethod::analytic;
-    differentiate_results(shapes, batch, results, analytic, query.threads, predictor);
+    analytic_normal_b(shapes, batch, results, analytic, query.threads, predictor);
   }
   QueryOptions q = query;
   q.solver = resolve_solver(query.solver, query.level);

@@ -62,14 +62,14 @@ void StoreBlock::flush() {
   for (int a = 0; a < 8; ++a)
     for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
   if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
-    smooth_.solve(rows);
+    smooth_.solve(rows, normal_b_only);
   } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
     polytope_.solve(rows);
   } else {
     if (smooth_.count > 0 || polytope_.count > 0) {
       double* buffer_rows[kEntries];
       for (int k = 0; k < kEntries; ++k) buffer_rows[k] = buf_[k];
-      if (smooth_.count > 0) smooth_.solve(buffer_rows);
+      if (smooth_.count > 0) smooth_.solve(buffer_rows, normal_b_only);
       if (polytope_.count > 0) polytope_.solve(buffer_rows);
     }
     if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
@@ -335,7 +335,7 @@ void check_sizes(const PairBatch& batch, const PairResults& results) {
 /// choice only follows QueryOptions::isa when differentiate() calls it).
 void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                               const DerivativeOptions& options, int threads, InstructionSet isa,
-                              DerivativeResults& derivatives) {
+                              DerivativeResults& derivatives, bool normal_b_only = false) {
   validate(options);
   if (options.method == DerivativeMethod::smoothed0)
     throw InputError("method: smoothed0 runs new queries; call differentiate() instead of differentiate_results()");
@@ -348,11 +348,17 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
   detail::size_for(derivatives, batch.size(), false);  // every pair writes all its entries
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
     detail::StoreBlock out(derivatives);
+    out.normal_b_only = normal_b_only;
     for (std::size_t i = begin; i < end; ++i) differentiate_pair(shapes, batch, results, options, isa, i, out);
   });
 }
 
 }  // namespace
+
+void analytic_normal_b(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
+                       const DerivativeOptions& analytic, int threads, DerivativeResults& derivatives) {
+  differentiate_results_on(shapes, batch, results, analytic, threads, resolve_instruction_set(), derivatives, true);
+}
 }  // namespace detail
 
 void differentiate_results(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
