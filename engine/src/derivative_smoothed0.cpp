@@ -17,6 +17,7 @@
 #include "validate.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <vector>
 
@@ -240,7 +241,7 @@ void accumulate(const Context& c, Block& b, std::size_t first, std::size_t count
 }
 
 /// The estimator from the sums, mapped from A's frame and A-frame noise to the world, written straight into the
-/// pair's StoreBlock slot. Scalar loops in the operation order of the Eigen expressions they replace (products
+/// pair's StoreBlock slot. Loops in the operation order of the Eigen expressions they replace (products
 /// summed k = 0, 1, 2 left to right, except row 2 of Ra times a 3-row block, which Eigen computes after its 2-row
 /// packet as a0 + (a1 + a2); the same divisions; the rigid-motion blocks' signed zeros), so the bits are those of
 /// the Eigen version; that one cost ~1600 instructions per pair (block temporaries, a PairJacobians copy
@@ -252,33 +253,40 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
   const double valid = double(sums.valid);
   double mean[10];
   for (int r = 0; r < 10; ++r) mean[r] = sums.mean[r] / valid;
-  // G(r, e) = sums.G[e][r] / valid, then divided by the noise scale: the score of the Gaussian is S^-1 z.
-  double G[10][6];
+  // Column-major like the sums, GT[e][r] = G(r, e), two rows per SSE2 register where the operation runs along a
+  // column (every entry still gets its own operations in the scalar order: the bits do not change).
+  using V2 = double __attribute__((vector_size(16)));
+  const auto ld = [](const double* p) { V2 v; std::memcpy(&v, p, sizeof v); return v; };
+  const auto st = [](double* p, V2 v) { std::memcpy(p, &v, sizeof v); };
+  // G = sums / valid, divided by the noise scale: the score of the Gaussian is S^-1 z.
+  double GT[6][10];
   for (int e = 0; e < 6; ++e) {
     const double s = e < 3 ? p.s.translation : p.s.rotation;
-    for (int r = 0; r < 10; ++r) G[r][e] = sums.G[e][r] / valid / s;
+    for (int r = 0; r < 10; r += 2) st(&GT[e][r], ld(&sums.G[e][r]) / valid / s);
   }
   // Values and noise to the world: v_world - g0_world = Ra (v_A - g0_A) for the points and the normal, and the
   // world noise is Ra z.
   double Ra[3][3];
   for (int r = 0; r < 3; ++r)
     for (int q = 0; q < 3; ++q) Ra[r][q] = p.Ra(r, q);
-  for (int r = 1; r < 10; r += 3)
-    for (int e = 0; e < 6; ++e) {
-      const double g0 = G[r][e], g1 = G[r + 1][e], g2 = G[r + 2][e];
-      for (int q = 0; q < 2; ++q) G[r + q][e] = (Ra[q][0] * g0 + Ra[q][1] * g1) + Ra[q][2] * g2;
-      G[r + 2][e] = Ra[2][0] * g0 + (Ra[2][1] * g1 + Ra[2][2] * g2);
-    }
-  for (int r = 0; r < 10; ++r)
-    for (int h = 0; h < 6; h += 3) {
-      const double g0 = G[r][h], g1 = G[r][h + 1], g2 = G[r][h + 2];
-      for (int q = 0; q < 3; ++q) G[r][h + q] = (g0 * Ra[q][0] + g1 * Ra[q][1]) + g2 * Ra[q][2];
+  for (int e = 0; e < 6; ++e)
+    for (int r = 1; r < 10; r += 3) {
+      double* g = &GT[e][r];
+      const double g0 = g[0], g1 = g[1], g2 = g[2];
+      for (int q = 0; q < 2; ++q) g[q] = (Ra[q][0] * g0 + Ra[q][1] * g1) + Ra[q][2] * g2;
+      g[2] = Ra[2][0] * g0 + (Ra[2][1] * g1 + Ra[2][2] * g2);
     }
   // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
   const Eigen::Vector3d t_b = c.batch.translation_b[i];
   const double S[3][3] = {{0.0, -t_b.z(), t_b.y()}, {t_b.z(), 0.0, -t_b.x()}, {-t_b.y(), t_b.x(), 0.0}};  // skew()
-  for (int r = 0; r < 10; ++r)
-    for (int q = 0; q < 3; ++q) G[r][3 + q] -= (G[r][0] * S[0][q] + G[r][1] * S[1][q]) + G[r][2] * S[2][q];
+  for (int r = 0; r < 10; r += 2) {  // G.leftCols() * Ra^T, G.rightCols() * Ra^T, then minus G.leftCols() [t_b]x
+    V2 col[6], w[6];
+    for (int e = 0; e < 6; ++e) col[e] = ld(&GT[e][r]);
+    for (int h = 0; h < 6; h += 3)
+      for (int q = 0; q < 3; ++q) w[h + q] = (col[h] * Ra[q][0] + col[h + 1] * Ra[q][1]) + col[h + 2] * Ra[q][2];
+    for (int q = 0; q < 3; ++q) w[3 + q] -= (w[0] * S[0][q] + w[1] * S[1][q]) + w[2] * S[2][q];
+    for (int e = 0; e < 6; ++e) st(&GT[e][r], w[e]);
+  }
   const auto world = [&](int r0, double* v) {  // Ra m + ta (r0 = 1, 4) or Ra m (r0 = 7)
     for (int q = 0; q < 2; ++q) v[q] = (Ra[q][0] * mean[r0] + Ra[q][1] * mean[r0 + 1]) + Ra[q][2] * mean[r0 + 2];
     v[2] = Ra[2][0] * mean[r0] + (Ra[2][1] * mean[r0 + 1] + Ra[2][2] * mean[r0 + 2]);
@@ -290,7 +298,7 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
   // normal_a, normal_b (3x6, row-major).
   double* slot = out.slot(i);
   constexpr std::size_t kS = StoreBlock::kStride;
-  for (int e = 0; e < 6; ++e) slot[e * kS] = -G[0][e], slot[(6 + e) * kS] = G[0][e];
+  for (int e = 0; e < 6; ++e) slot[e * kS] = -GT[e][0], slot[(6 + e) * kS] = GT[e][0];
   // The a-twist blocks: [I, -[x]x] - the b-twist block (rigid_motion(); [0, -[n]x] for the normal), -[x]x with
   // rigid_motion()'s -0.0 diagonal.
   const auto a_block = [&](std::size_t e0, const double* x, double identity, int r0) {
@@ -298,12 +306,12 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
     for (int r = 0; r < 3; ++r)
       for (int q = 0; q < 6; ++q) {
         const double m = q < 3 ? (r == q ? identity : 0.0) : minus_skew[r][q - 3];
-        slot[(e0 + 6 * r + q) * kS] = m - G[r0 + r][q];
+        slot[(e0 + 6 * r + q) * kS] = m - GT[q][r0 + r];
       }
   };
   const auto b_block = [&](std::size_t e0, int r0) {
     for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 6; ++q) slot[(e0 + 6 * r + q) * kS] = G[r0 + r][q];
+      for (int q = 0; q < 6; ++q) slot[(e0 + 6 * r + q) * kS] = GT[q][r0 + r];
   };
   a_block(12, xa, 1.0, 1), b_block(30, 1);
   a_block(48, xb, 1.0, 4), b_block(66, 4);
