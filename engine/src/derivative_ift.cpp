@@ -78,27 +78,14 @@ template <std::size_t N> void load3(const double (&rows)[3][N], std::size_t l, V
 // entries are neither computed nor written.
 template <bool kNormalB = false, class Put, class Entry>
 void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
-  if constexpr (kNormalB) {
-#pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 6
-      for (int j = 0; j < 6; ++j) {
-        const int e = 6 * i + j;
-        V wa, wb, dn;
-        entry(i, j, wa, wb, dn);
-        if (j < 3 || j - 3 == i) {
-          put(102 + e, 0.0 - dn);
-        } else {
-          const int k = j - 3, other = 3 - i - k;
-          put(102 + e, (i + 1) % 3 == k ? n[other] - dn : -n[other] - dn);
-        }
-      }
-    return;
-  }
-  put(0, -n[0]), put(1, -n[1]), put(2, -n[2]);
-  put(3, n[1] * xa[2] - n[2] * xa[1]), put(4, n[2] * xa[0] - n[0] * xa[2]), put(5, n[0] * xa[1] - n[1] * xa[0]);
-  put(6, n[0]), put(7, n[1]), put(8, n[2]);
-  put(9, xb[1] * n[2] - xb[2] * n[1]), put(10, xb[2] * n[0] - xb[0] * n[2]), put(11, xb[0] * n[1] - xb[1] * n[0]);
+  // put() for the entries kNormalB keeps: after unrolling, e is a constant and the test folds away.
+  const auto keep = [&](int e, const V& v) {
+    if (!kNormalB || e >= 102) put(e, v);
+  };
+  keep(0, -n[0]), keep(1, -n[1]), keep(2, -n[2]);
+  keep(3, n[1] * xa[2] - n[2] * xa[1]), keep(4, n[2] * xa[0] - n[0] * xa[2]), keep(5, n[0] * xa[1] - n[1] * xa[0]);
+  keep(6, n[0]), keep(7, n[1]), keep(8, n[2]);
+  keep(9, xb[1] * n[2] - xb[2] * n[1]), keep(10, xb[2] * n[0] - xb[0] * n[2]), keep(11, xb[0] * n[1] - xb[1] * n[0]);
   // Unrolled: with (i, j) constants the case tests vanish and the operands stay in registers; rolled, GCC kept
   // this a loop over stack arrays with the tests inside (~2.8x the instructions of the PolytopeLanes solve).
 #pragma GCC unroll 3
@@ -108,22 +95,22 @@ void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb
       const int e = 6 * i + j;
       V wa, wb, dn;
       entry(i, j, wa, wb, dn);
-      put(12 + e, wa);  // witness_a_a
-      put(48 + e, wb);  // witness_b_a
-      put(84 + e, dn);  // normal_a
+      keep(12 + e, wa);  // witness_a_a
+      keep(48 + e, wb);  // witness_b_a
+      keep(84 + e, dn);  // normal_a
       // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
       if (j < 3) {
         const double one = i == j ? 1.0 : 0.0;
-        put(30 + e, one - wa), put(66 + e, one - wb), put(102 + e, 0.0 - dn);
+        keep(30 + e, one - wa), keep(66 + e, one - wb), keep(102 + e, 0.0 - dn);
       } else if (j - 3 == i) {
-        put(30 + e, 0.0 - wa), put(66 + e, 0.0 - wb), put(102 + e, 0.0 - dn);
+        keep(30 + e, 0.0 - wa), keep(66 + e, 0.0 - wb), keep(102 + e, 0.0 - dn);
       } else {
         const int k = j - 3, other = 3 - i - k;
         // -[x]x(i, k) = eps(i, k, other) x_other
         if ((i + 1) % 3 == k) {
-          put(30 + e, xa[other] - wa), put(66 + e, xb[other] - wb), put(102 + e, n[other] - dn);
+          keep(30 + e, xa[other] - wa), keep(66 + e, xb[other] - wb), keep(102 + e, n[other] - dn);
         } else {
-          put(30 + e, -xa[other] - wa), put(66 + e, -xb[other] - wb), put(102 + e, -n[other] - dn);
+          keep(30 + e, -xa[other] - wa), keep(66 + e, -xb[other] - wb), keep(102 + e, -n[other] - dn);
         }
       }
     }
