@@ -140,4 +140,23 @@ constexpr double kNewtonSwitch = 0.5;
 /// amplified by the curvature on close pairs; 0.01 took 8.58 mean iterations on close ellipsoids, 1 took 8.99.
 constexpr double kNewtonPlainGap = 0.01;
 
+/// Cylinder / capsule pairs (at least one cylinder; capsule-capsule is a closed form) whose distance / witness lanes
+/// start from the closed-form side contact (wide_gjk.inl's side_start()).
+constexpr bool side_start_pair(ShapeType a, ShapeType b) {
+  const bool axial_a = a == ShapeType::cylinder || a == ShapeType::capsule;
+  const bool axial_b = b == ShapeType::cylinder || b == ShapeType::capsule;
+  return axial_a && axial_b && (a == ShapeType::cylinder || b == ShapeType::cylinder);
+}
+/// Side-rim fits (wide_gjk.inl's side_rim()): a side line (cylinder, or a capsule's core segment) against a rim
+/// (cylinder, cone). Bit 1: A's side against B's rim; bit 2: B's side against A's rim.
+constexpr int side_rim_pair(ShapeType a, ShapeType b) {
+  const auto side = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::capsule; };
+  const auto rim = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; };
+  return (side(a) && rim(b) ? 1 : 0) | (side(b) && rim(a) ? 2 : 0);
+}
+/// The iteration at which side_rim() fits the rim's angle (GJK's direction then starts its Newton steps).
+constexpr int kSideRimIteration = 5;
+/// Newton steps of side_rim()'s fit.
+constexpr int kSideRimNewtonSteps = 4;
+
 }  // namespace batchcol::kernels

@@ -638,7 +638,8 @@ template <class T> struct WideGjk {
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
-  AI static void start(Lanes& L) {
+  /// `side`: the run may have distance / witness lanes (side_start(); boolean runs never do).
+  AI static void start(Lanes& L, bool side) {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
@@ -648,7 +649,152 @@ template <class T> struct WideGjk {
     L.b[0] = pick(m, sb, L.b[0]);
     L.x = pick(m, sw, L.x);
     L.last_s = pick(m, sw, L.last_s);
+    if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     L.fresh = 0;
+  }
+
+  /// The start point of a cylinder / capsule pair's distance and witness lanes (`m`) in closed form, where it is
+  /// a side contact. A cylinder of radius r lies inside the capsule of its axis segment and radius r, and the two
+  /// share the side; so when the closest points of the axis segments (a capsule core's own segment) are interior
+  /// to every cylinder's axis segment, their offset is orthogonal to those axes, the capsules' witness points lie
+  /// on the cylinders' sides, and they are the cylinders' witness points. Replaces the first support point by
+  /// that point of D (and its points of A and B) where it is closer to the origin; the lane's first iteration is
+  /// then a plain step (momentum off) whose duality gap certifies it, as any GJK answer, or GJK goes on from there.
+  /// Why: on a side line GJK's support points flip between the two rims at angles that converge only linearly
+  /// (cylinder-cylinder: 55% of close pairs, ~20 iterations; bench/results/history/narrowphase-sessions.md).
+  /// A's axis is (0, 0, z), |z| <= A.s1; B's is t + z b, b = R e_z, |z| <= B.s1 (Ericson's segment-segment
+  /// order: B's parameter from the lines' closest points, clamped; A's from it, clamped; B's again if A's was).
+  /// tests/support/reference_gjk.hpp's side_start() has the same operations.
+  __attribute__((noinline)) static void side_start(Lanes& L, mask m) {
+    if (!any(m)) return;
+    const real zero = splat(T(0));
+    const real ha = L.A.s1, hb = L.B.s1;
+    const real ra = L.A.type == ShapeType::cylinder ? L.A.s0 : zero;
+    const real rb = L.B.type == ShapeType::cylinder ? L.B.s0 : zero;
+    const V3 c = {L.t[0], L.t[1], L.t[2]};
+    const V3 b = {L.R[2], L.R[5], L.R[8]};
+    const real beta = b.z, cb = dot(c, b), bb = norm2(b);
+    const real denom = bb - beta * beta;
+    const real zb1 = select(denom > zero, (beta * c.z - cb) / denom, zero);
+    const mask out_b1 = (zb1 > hb) | (zb1 < -hb);
+    const real zb1c = select(zb1 > hb, hb, select(zb1 < -hb, -hb, zb1));
+    const real za = c.z + zb1c * beta;
+    const mask out_a = (za > ha) | (za < -ha);
+    const real zac = select(za > ha, ha, select(za < -ha, -ha, za));
+    const real zb2 = (zac * beta - cb) / bb;
+    const mask out_b2 = (zb2 > hb) | (zb2 < -hb);
+    const real zb = select(out_a, select(zb2 > hb, hb, select(zb2 < -hb, -hb, zb2)), zb1c);
+    mask ok = m;
+    if (L.A.type == ShapeType::cylinder) ok &= ~out_a;
+    if (L.B.type == ShapeType::cylinder) ok &= ~select(out_a, out_b2, out_b1);
+    const V3 qa = {zero, zero, zac}, qb = add(c, scale(zb, b));
+    const V3 v = sub(qa, qb);
+    const real vn = norm(v);
+    ok &= vn > ra + rb;
+    const V3 u = divide(v, vn);
+    const V3 pa = sub(qa, scale(ra, u)), pb = add(qb, scale(rb, u));
+    const V3 x = sub(pa, pb);
+    ok &= norm2(x) < norm2(L.x);
+    if (!any(ok)) return;
+    L.w[0] = pick(ok, x, L.w[0]);
+    L.a[0] = pick(ok, pa, L.a[0]);  // slot[0] = 0 (start_lane())
+    L.b[0] = pick(ok, pb, L.b[0]);
+    L.x = pick(ok, x, L.x);
+    L.last_s = pick(ok, x, L.last_s);
+    L.momentum &= ~ok;
+  }
+
+  /// The rim point c + r (cos e1 + sin e2) closest to the z axis (the side's axis, in the side's frame), by Newton
+  /// steps on the angle from (cs, sn): the closest point to the origin of the rim's projection on the xy plane (an
+  /// ellipse). f = |E|^2 / 2 with E the projected point: f' = <E, E'>, f'' = |E'|^2 - <E, E - c>; a step where f''
+  /// is not positive is none, a step is at most 0.5 rad, and the angle moves as (cs, sn) + delta (-sn, cs)
+  /// normalised. Returns the rim point (the side's frame) and leaves the angle in cs, sn.
+  AI static V3 rim_fit(const V3& c, const V3& e1, const V3& e2, real r, real& cs, real& sn) {
+    const real zero = splat(T(0)), half = splat(T(0.5));
+    for (int i = 0; i < kSideRimNewtonSteps; ++i) {
+      const real ex = c.x + r * (cs * e1.x + sn * e2.x), ey = c.y + r * (cs * e1.y + sn * e2.y);
+      const real tx = r * (cs * e2.x - sn * e1.x), ty = r * (cs * e2.y - sn * e1.y);
+      const real f1 = ex * tx + ey * ty;
+      const real f2 = (tx * tx + ty * ty) - ((ex - c.x) * ex + (ey - c.y) * ey);
+      const real step = select(f2 > zero, -(f1 / f2), zero);
+      const real delta = select(step > half, half, select(step < -half, -half, step));
+      const real nc = cs - delta * sn, ns = sn + delta * cs;
+      const real len = wsqrt<T>(nc * nc + ns * ns);
+      cs = nc / len;
+      sn = ns / len;
+    }
+    return {c.x + r * (cs * e1.x + sn * e2.x), c.y + r * (cs * e1.y + sn * e2.y), c.z + r * (cs * e1.z + sn * e2.z)};
+  }
+  /// Side-rim fit, at iteration kSideRimIteration of the distance / witness lanes `m` of a side_rim_pair(): on a
+  /// side line against a rim (a cylinder's side or a capsule's core segment, against a cylinder's or a cone's rim)
+  /// the support of the side flips between its two ends at angles that converge linearly, so GJK needs ~20
+  /// iterations (bench/results/history/narrowphase-sessions.md). Here the rim's angle is fitted instead (rim_fit(),
+  /// Newton from the rim's support angle along GJK's present x), the side's point is the axis point at the rim
+  /// point's height, offset towards it by the side's radius, and the pair of points replaces the simplex where its
+  /// point of D is closer to the origin than x: a one-vertex simplex whose first plain step (momentum off) certifies
+  /// it by the duality gap like any GJK answer, or GJK goes on from it. Both points lie on their shapes (the side
+  /// point only where the rim point's height is within the side's axis), so x stays a point of D. Where both sides
+  /// have a side and a rim (cylinder-cylinder), the closer valid fit of the two is taken.
+  /// tests/support/reference_gjk.hpp's side_rim() has the same operations.
+  __attribute__((noinline)) static void side_rim(Lanes& L, mask m) {
+    const real zero = splat(T(0)), one = splat(T(1));
+    const int sides = side_rim_pair(L.A.type, L.B.type);
+    const real* R = L.R;
+    const V3 t = {L.t[0], L.t[1], L.t[2]};
+    const V3 x0 = L.x;
+    mask ok = splat_mask(0);
+    V3 pa = x0, pb = x0, x = x0;
+    real best = norm2(x0);
+    if (sides & 1) {  // A's side (A's frame), B's rim: c = t + z_rim b, e1, e2 = B's x and y axes
+      const V3 db = {(R[0] * x0.x + R[3] * x0.y) + R[6] * x0.z, (R[1] * x0.x + R[4] * x0.y) + R[7] * x0.z,
+                     (R[2] * x0.x + R[5] * x0.y) + R[8] * x0.z};  // B's support direction, B's frame
+      const real rho = wsqrt<T>(db.x * db.x + db.y * db.y);
+      real cs = db.x / rho, sn = db.y / rho;
+      const real zr = L.B.type == ShapeType::cone ? -L.B.s1 : select(db.z < zero, -L.B.s1, L.B.s1);
+      const V3 c = {t.x + zr * R[2], t.y + zr * R[5], t.z + zr * R[8]};
+      const V3 p = rim_fit(c, V3{R[0], R[3], R[6]}, V3{R[1], R[4], R[7]}, L.B.s0, cs, sn);
+      const real rs = L.A.type == ShapeType::cylinder ? L.A.s0 : zero;
+      const real vn = wsqrt<T>(p.x * p.x + p.y * p.y);
+      const V3 sp = {rs * (p.x / vn), rs * (p.y / vn), p.z};
+      const V3 w = sub(sp, p);
+      const real ww = norm2(w);
+      const mask take = m & (rho > zero) & ~(p.z > L.A.s1) & ~(p.z < -L.A.s1) & (vn > rs) & (ww < best);
+      best = select(take, ww, best);
+      pa = pick(take, sp, pa), pb = pick(take, p, pb), x = pick(take, w, x);
+      ok |= take;
+    }
+    if (sides & 2) {  // B's side (B's frame), A's rim: c = R^T (z_rim e_z - t), e1, e2 = rows 0 and 1 of R
+      const V3 da = neg(x0);  // A's support direction
+      const real rho = wsqrt<T>(da.x * da.x + da.y * da.y);
+      real cs = da.x / rho, sn = da.y / rho;
+      const real zr = L.A.type == ShapeType::cone ? -L.A.s1 : select(da.z < zero, -L.A.s1, L.A.s1);
+      const V3 o = {-t.x, -t.y, zr - t.z};
+      const V3 c = {(R[0] * o.x + R[3] * o.y) + R[6] * o.z, (R[1] * o.x + R[4] * o.y) + R[7] * o.z,
+                    (R[2] * o.x + R[5] * o.y) + R[8] * o.z};
+      const V3 p = rim_fit(c, V3{R[0], R[1], R[2]}, V3{R[3], R[4], R[5]}, L.A.s0, cs, sn);
+      const real rs = L.B.type == ShapeType::cylinder ? L.B.s0 : zero;
+      const real vn = wsqrt<T>(p.x * p.x + p.y * p.y);
+      const V3 sb = {rs * (p.x / vn), rs * (p.y / vn), p.z};  // B's side point, B's frame
+      const V3 qa = {L.A.s0 * cs, L.A.s0 * sn, zr};           // A's rim point, A's frame
+      const V3 qb = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + t.x, ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + t.y,
+                     ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + t.z};
+      const V3 w = sub(qa, qb);
+      const real ww = norm2(w);
+      const mask take = m & (rho > zero) & ~(p.z > L.B.s1) & ~(p.z < -L.B.s1) & (vn > rs) & (ww < best);
+      best = select(take, ww, best);
+      pa = pick(take, qa, pa), pb = pick(take, qb, pb), x = pick(take, w, x);
+      ok |= take;
+    }
+    if (!any(ok)) return;
+    L.count = select(ok, splat_mask(1), L.count);
+    L.slot[0] = select(ok, splat_mask(0), L.slot[0]);
+    L.lambda[0] = select(ok, one, L.lambda[0]);
+    L.w[0] = pick(ok, x, L.w[0]);
+    L.a[0] = pick(ok, pa, L.a[0]);
+    L.b[0] = pick(ok, pb, L.b[0]);
+    L.x = pick(ok, x, L.x);
+    L.last_s = pick(ok, x, L.last_s);
+    L.momentum &= ~ok;
   }
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
@@ -1000,6 +1146,7 @@ template <class T> struct WideGjk {
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
     const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
+    const bool side_rim_run = !Boolean && side_rim_pair(L.A.type, L.B.type) != 0;  // side_rim()
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -1007,7 +1154,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L);
+      start(L, !Boolean);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
@@ -1020,6 +1167,10 @@ template <class T> struct WideGjk {
       }
       mask live = lanes_of(active);
       L.k = select(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
+      if (side_rim_run) {
+        const mask fit = live & ~L.boolean_only & (L.k == splat_mask(kSideRimIteration));
+        if (any(fit)) side_rim(L, fit);
+      }
 
       const V3 x = L.x;
       const real xx = norm2(x);

@@ -197,6 +197,120 @@ Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, 
   return wadd(n, delta);
 }
 
+/// The closed-form start point of a cylinder / capsule pair (wide_gjk.inl's side_start(), where
+/// the reasoning is), with its operations: true and the point of D with its points of A and B where the axis
+/// segments' closest points are a side contact.
+template <class T> bool side_start(const MinkowskiDifference<T>& D, SupportPoint<T>& p) {
+  const auto clamp = [](T z, T h) { return z > h ? h : (z < -h ? -h : z); };
+  const T ha = D.A->size.y(), hb = D.B->size.y();
+  const bool cyl_a = D.A->type == ShapeType::cylinder, cyl_b = D.B->type == ShapeType::cylinder;
+  const T ra = cyl_a ? D.A->size.x() : T(0), rb = cyl_b ? D.B->size.x() : T(0);
+  const Vec3<T> c = D.b_in_a.t;
+  const Vec3<T> b(D.b_in_a.R(0, 2), D.b_in_a.R(1, 2), D.b_in_a.R(2, 2));
+  const T beta = b.z(), cb = dot3(c, b), bb = dot3(b, b);
+  const T denom = bb - beta * beta;
+  const T zb1 = denom > T(0) ? (beta * c.z() - cb) / denom : T(0);
+  const bool out_b1 = zb1 > hb || zb1 < -hb;
+  const T zb1c = clamp(zb1, hb);
+  const T za = c.z() + zb1c * beta;
+  const bool out_a = za > ha || za < -ha;
+  const T zac = clamp(za, ha);
+  const T zb2 = (zac * beta - cb) / bb;
+  const bool out_b2 = zb2 > hb || zb2 < -hb;
+  const T zb = out_a ? clamp(zb2, hb) : zb1c;
+  if (cyl_a && out_a) return false;
+  if (cyl_b && (out_a ? out_b2 : out_b1)) return false;
+  const Vec3<T> qa(T(0), T(0), zac), qb = wadd(c, wscale(zb, b));
+  const Vec3<T> v = wsub(qa, qb);
+  const T vn = std::sqrt(dot3(v, v));
+  if (!(vn > ra + rb)) return false;
+  const Vec3<T> u = wdivide(v, vn);
+  p.a = wsub(qa, wscale(ra, u));
+  p.b = wadd(qb, wscale(rb, u));
+  p.w = wsub(p.a, p.b);
+  return true;
+}
+
+/// wide_gjk.inl's rim_fit(): the rim point c + r (cos e1 + sin e2) closest to the z axis by Newton on the angle.
+template <class T>
+Vec3<T> rim_fit(const Vec3<T>& c, const Vec3<T>& e1, const Vec3<T>& e2, T r, T& cs, T& sn) {
+  for (int i = 0; i < kSideRimNewtonSteps; ++i) {
+    const T ex = c.x() + r * (cs * e1.x() + sn * e2.x()), ey = c.y() + r * (cs * e1.y() + sn * e2.y());
+    const T tx = r * (cs * e2.x() - sn * e1.x()), ty = r * (cs * e2.y() - sn * e1.y());
+    const T f1 = ex * tx + ey * ty;
+    const T f2 = (tx * tx + ty * ty) - ((ex - c.x()) * ex + (ey - c.y()) * ey);
+    const T step = f2 > T(0) ? -(f1 / f2) : T(0);
+    const T delta = step > T(0.5) ? T(0.5) : (step < T(-0.5) ? T(-0.5) : step);
+    const T nc = cs - delta * sn, ns = sn + delta * cs;
+    const T len = std::sqrt(nc * nc + ns * ns);
+    cs = nc / len;
+    sn = ns / len;
+  }
+  return Vec3<T>(c.x() + r * (cs * e1.x() + sn * e2.x()), c.y() + r * (cs * e1.y() + sn * e2.y()),
+                 c.z() + r * (cs * e1.z() + sn * e2.z()));
+}
+
+/// wide_gjk.inl's side_rim() (the reasoning is there), with its operations: true and the fitted point of D with its
+/// points of A and B where a fit is valid and closer to the origin than x.
+template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>& x0, SupportPoint<T>& out) {
+  const ShapeCore<T>& A = *D.A;
+  const ShapeCore<T>& B = *D.B;
+  const int sides = side_rim_pair(A.type, B.type);
+  const auto& M = D.b_in_a.R;
+  const T R[9] = {M(0, 0), M(0, 1), M(0, 2), M(1, 0), M(1, 1), M(1, 2), M(2, 0), M(2, 1), M(2, 2)};
+  const Vec3<T> t = D.b_in_a.t;
+  bool ok = false;
+  T best = dot3(x0, x0);
+  if (sides & 1) {
+    const Vec3<T> db((R[0] * x0.x() + R[3] * x0.y()) + R[6] * x0.z(), (R[1] * x0.x() + R[4] * x0.y()) + R[7] * x0.z(),
+                     (R[2] * x0.x() + R[5] * x0.y()) + R[8] * x0.z());
+    const T rho = std::sqrt(db.x() * db.x() + db.y() * db.y());
+    T cs = db.x() / rho, sn = db.y() / rho;
+    const T hb = B.size.y();
+    const T zr = B.type == ShapeType::cone ? -hb : (db.z() < T(0) ? -hb : hb);
+    const Vec3<T> c(t.x() + zr * R[2], t.y() + zr * R[5], t.z() + zr * R[8]);
+    const Vec3<T> p = rim_fit(c, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), cs, sn);
+    const T rs = A.type == ShapeType::cylinder ? A.size.x() : T(0);
+    const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
+    const Vec3<T> sp(rs * (p.x() / vn), rs * (p.y() / vn), p.z());
+    const Vec3<T> w = wsub(sp, p);
+    const T ww = dot3(w, w);
+    const T ha = A.size.y();
+    if (rho > T(0) && !(p.z() > ha) && !(p.z() < -ha) && vn > rs && ww < best) {
+      best = ww;
+      out.a = sp, out.b = p, out.w = w;
+      ok = true;
+    }
+  }
+  if (sides & 2) {
+    const Vec3<T> da(-x0.x(), -x0.y(), -x0.z());
+    const T rho = std::sqrt(da.x() * da.x() + da.y() * da.y());
+    T cs = da.x() / rho, sn = da.y() / rho;
+    const T ha = A.size.y();
+    const T zr = A.type == ShapeType::cone ? -ha : (da.z() < T(0) ? -ha : ha);
+    const Vec3<T> o(-t.x(), -t.y(), zr - t.z());
+    const Vec3<T> c((R[0] * o.x() + R[3] * o.y()) + R[6] * o.z(), (R[1] * o.x() + R[4] * o.y()) + R[7] * o.z(),
+                    (R[2] * o.x() + R[5] * o.y()) + R[8] * o.z());
+    const Vec3<T> p = rim_fit(c, Vec3<T>(R[0], R[1], R[2]), Vec3<T>(R[3], R[4], R[5]), A.size.x(), cs, sn);
+    const T rs = B.type == ShapeType::cylinder ? B.size.x() : T(0);
+    const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
+    const Vec3<T> sb(rs * (p.x() / vn), rs * (p.y() / vn), p.z());
+    const Vec3<T> qa(A.size.x() * cs, A.size.x() * sn, zr);
+    const Vec3<T> qb(((R[0] * sb.x() + R[1] * sb.y()) + R[2] * sb.z()) + t.x(),
+                     ((R[3] * sb.x() + R[4] * sb.y()) + R[5] * sb.z()) + t.y(),
+                     ((R[6] * sb.x() + R[7] * sb.y()) + R[8] * sb.z()) + t.z());
+    const Vec3<T> w = wsub(qa, qb);
+    const T ww = dot3(w, w);
+    const T hb = B.size.y();
+    if (rho > T(0) && !(p.z() > hb) && !(p.z() < -hb) && vn > rs && ww < best) {
+      best = ww;
+      out.a = qa, out.b = qb, out.w = w;
+      ok = true;
+    }
+  }
+  return ok;
+}
+
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -210,6 +324,17 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
+  // Cylinder / capsule pairs: the closed-form side contact replaces the first support point where it is closer,
+  // and the first step is then a plain one (wide_gjk.inl's side_start()).
+  if (!params.boolean_only && side_start_pair(D.A->type, D.B->type)) {
+    SupportPoint<T> p;
+    if (side_start(D, p) && norm2(p.w) < norm2(x)) {
+      S.v[0] = p;
+      x = p.w;
+      last_s = x;
+      momentum = false;
+    }
+  }
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound
   // Newton directions (witness / distance queries of newton_pair_type()s) until one fails to progress.
@@ -222,6 +347,18 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
+    // Side-rim pairs: the fitted side-rim point replaces the simplex where it is closer (wide_gjk.inl's side_rim()).
+    if (k + 1 == kSideRimIteration && !params.boolean_only && side_rim_pair(D.A->type, D.B->type) != 0) {
+      SupportPoint<T> p;
+      if (side_rim(D, x, p)) {
+        S.count = 1;
+        S.v[0] = p;
+        S.lambda[0] = T(1);
+        x = p.w;
+        last_s = x;
+        momentum = false;
+      }
+    }
     const T xx = norm2(x);
     const T xn = std::sqrt(xx);
     if (xn <= params.touch_tolerance) { r.status = GjkStatus::overlap; break; }
