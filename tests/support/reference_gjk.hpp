@@ -250,6 +250,34 @@ Vec3<T> rim_fit(const Vec3<T>& c, const Vec3<T>& e1, const Vec3<T>& e2, T r, T& 
                  c.z() + r * (cs * e1.z() + sn * e2.z()));
 }
 
+/// wide_gjk.inl's rim_pair_fit(): the closest points of two rims by Newton on both angles.
+template <class T>
+void rim_pair_fit(T ra, T za, const Vec3<T>& cb, const Vec3<T>& f1, const Vec3<T>& f2, T rb, T& ac, T& as, T& bc, T& bs,
+                  Vec3<T>& p, Vec3<T>& q) {
+  const auto clamp = [](T v) { return v > T(0.5) ? T(0.5) : (v < T(-0.5) ? T(-0.5) : v); };
+  for (int i = 0; i < kSideRimNewtonSteps; ++i) {
+    const Vec3<T> pa(ra * ac, ra * as, za);
+    const Vec3<T> dp(-(ra * as), ra * ac, T(0));
+    const Vec3<T> u = wadd(wscale(bc, f1), wscale(bs, f2));
+    const Vec3<T> qb = wadd(cb, wscale(rb, u));
+    const Vec3<T> dq = wscale(rb, wsub(wscale(bc, f2), wscale(bs, f1)));
+    const Vec3<T> r = wsub(pa, qb);
+    const T gp = dot3(r, dp), gq = -dot3(r, dq);
+    const T hpp = dot3(dp, dp) - ra * (r.x() * ac + r.y() * as);
+    const T hqq = dot3(dq, dq) + rb * dot3(r, u);
+    const T hpq = -dot3(dp, dq);
+    const T det = hpp * hqq - hpq * hpq;
+    const bool good = hpp > T(0) && det > T(0);
+    const T sp = clamp(good ? -((hqq * gp - hpq * gq) / det) : T(0));
+    const T sq = clamp(good ? -((hpp * gq - hpq * gp) / det) : T(0));
+    const T nac = ac - sp * as, nas = as + sp * ac, nbc = bc - sq * bs, nbs = bs + sq * bc;
+    const T la = std::sqrt(nac * nac + nas * nas), lb = std::sqrt(nbc * nbc + nbs * nbs);
+    ac = nac / la, as = nas / la, bc = nbc / lb, bs = nbs / lb;
+  }
+  p = Vec3<T>(ra * ac, ra * as, za);
+  q = wadd(cb, wscale(rb, wadd(wscale(bc, f1), wscale(bs, f2))));
+}
+
 /// wide_gjk.inl's side_rim() (the reasoning is there), with its operations: true and the fitted point of D with its
 /// points of A and B where a fit is valid and closer to the origin than x.
 template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>& x0, SupportPoint<T>& out) {
@@ -261,14 +289,18 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
   const Vec3<T> t = D.b_in_a.t;
   bool ok = false;
   T best = dot3(x0, x0);
+  const Vec3<T> db((R[0] * x0.x() + R[3] * x0.y()) + R[6] * x0.z(), (R[1] * x0.x() + R[4] * x0.y()) + R[7] * x0.z(),
+                   (R[2] * x0.x() + R[5] * x0.y()) + R[8] * x0.z());
+  const Vec3<T> da(-x0.x(), -x0.y(), -x0.z());
+  const T rho_b = std::sqrt(db.x() * db.x() + db.y() * db.y()), rho_a = std::sqrt(da.x() * da.x() + da.y() * da.y());
+  const T hb_ = B.size.y(), ha_ = A.size.y();
+  const T zb = B.type == ShapeType::cone ? -hb_ : (db.z() < T(0) ? -hb_ : hb_);
+  const T za = A.type == ShapeType::cone ? -ha_ : (da.z() < T(0) ? -ha_ : ha_);
+  const Vec3<T> cb(t.x() + zb * R[2], t.y() + zb * R[5], t.z() + zb * R[8]);
   if (sides & 1) {
-    const Vec3<T> db((R[0] * x0.x() + R[3] * x0.y()) + R[6] * x0.z(), (R[1] * x0.x() + R[4] * x0.y()) + R[7] * x0.z(),
-                     (R[2] * x0.x() + R[5] * x0.y()) + R[8] * x0.z());
-    const T rho = std::sqrt(db.x() * db.x() + db.y() * db.y());
+    const T rho = rho_b;
     T cs = db.x() / rho, sn = db.y() / rho;
-    const T hb = B.size.y();
-    const T zr = B.type == ShapeType::cone ? -hb : (db.z() < T(0) ? -hb : hb);
-    const Vec3<T> c(t.x() + zr * R[2], t.y() + zr * R[5], t.z() + zr * R[8]);
+    const Vec3<T> c = cb;
     const Vec3<T> p = rim_fit(c, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), cs, sn);
     const T rs = A.type == ShapeType::cylinder ? A.size.x() : T(0);
     const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
@@ -283,11 +315,9 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
     }
   }
   if (sides & 2) {
-    const Vec3<T> da(-x0.x(), -x0.y(), -x0.z());
-    const T rho = std::sqrt(da.x() * da.x() + da.y() * da.y());
+    const T rho = rho_a;
     T cs = da.x() / rho, sn = da.y() / rho;
-    const T ha = A.size.y();
-    const T zr = A.type == ShapeType::cone ? -ha : (da.z() < T(0) ? -ha : ha);
+    const T zr = za;
     const Vec3<T> o(-t.x(), -t.y(), zr - t.z());
     const Vec3<T> c((R[0] * o.x() + R[3] * o.y()) + R[6] * o.z(), (R[1] * o.x() + R[4] * o.y()) + R[7] * o.z(),
                     (R[2] * o.x() + R[5] * o.y()) + R[8] * o.z());
@@ -305,6 +335,19 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
     if (rho > T(0) && !(p.z() > hb) && !(p.z() < -hb) && vn > rs && ww < best) {
       best = ww;
       out.a = qa, out.b = qb, out.w = w;
+      ok = true;
+    }
+  }
+  if (sides & 4) {
+    T ac = da.x() / rho_a, as = da.y() / rho_a, bc = db.x() / rho_b, bs = db.y() / rho_b;
+    Vec3<T> p, q;
+    rim_pair_fit(A.size.x(), za, cb, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), ac, as, bc, bs,
+                 p, q);
+    const Vec3<T> w = wsub(p, q);
+    const T ww = dot3(w, w);
+    if (rho_a > T(0) && rho_b > T(0) && ww < best) {
+      best = ww;
+      out.a = p, out.b = q, out.w = w;
       ok = true;
     }
   }
