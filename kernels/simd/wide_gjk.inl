@@ -777,6 +777,15 @@ template <class T> struct WideGjk {
     mask ok = splat_mask(0);
     V3 pa = x0, pb = x0, x = x0;
     real best = norm2(x0);
+    // A fit's points, kept in the lanes of m where valid and closer than the best so far.
+    const auto offer = [&](mask valid, const V3& a, const V3& b) {
+      const V3 w = sub(a, b);
+      const real ww = norm2(w);
+      const mask take = m & valid & (ww < best);
+      best = select(take, ww, best);
+      pa = pick(take, a, pa), pb = pick(take, b, pb), x = pick(take, w, x);
+      ok |= take;
+    };
     // The rims' support angles along x: B's direction R^T x (B's frame), A's -x; a rim's height: a cylinder's by the
     // direction's sign (support()'s), a cone's bottom.
     const V3 db = {(R[0] * x0.x + R[3] * x0.y) + R[6] * x0.z, (R[1] * x0.x + R[4] * x0.y) + R[7] * x0.z,
@@ -795,12 +804,7 @@ template <class T> struct WideGjk {
       const real rs = L.A.type == ShapeType::cylinder ? L.A.s0 : zero;
       const real vn = wsqrt<T>(p.x * p.x + p.y * p.y);
       const V3 sp = {rs * (p.x / vn), rs * (p.y / vn), p.z};
-      const V3 w = sub(sp, p);
-      const real ww = norm2(w);
-      const mask take = m & (rho > zero) & ~(p.z > L.A.s1) & ~(p.z < -L.A.s1) & (vn > rs) & (ww < best);
-      best = select(take, ww, best);
-      pa = pick(take, sp, pa), pb = pick(take, p, pb), x = pick(take, w, x);
-      ok |= take;
+      offer((rho > zero) & ~(p.z > L.A.s1) & ~(p.z < -L.A.s1) & (vn > rs), sp, p);
     }
     if (sides & 2) {  // B's side (B's frame), A's rim: c = R^T (z_rim e_z - t), e1, e2 = rows 0 and 1 of R
       const real rho = wsqrt<T>(da.x * da.x + da.y * da.y);
@@ -816,24 +820,14 @@ template <class T> struct WideGjk {
       const V3 qa = {L.A.s0 * cs, L.A.s0 * sn, zr};           // A's rim point, A's frame
       const V3 qb = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + t.x, ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + t.y,
                      ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + t.z};
-      const V3 w = sub(qa, qb);
-      const real ww = norm2(w);
-      const mask take = m & (rho > zero) & ~(p.z > L.B.s1) & ~(p.z < -L.B.s1) & (vn > rs) & (ww < best);
-      best = select(take, ww, best);
-      pa = pick(take, qa, pa), pb = pick(take, qb, pb), x = pick(take, w, x);
-      ok |= take;
+      offer((rho > zero) & ~(p.z > L.B.s1) & ~(p.z < -L.B.s1) & (vn > rs), qa, qb);
     }
     if (sides & 4) {  // A's rim against B's rim
       const real rho_b = wsqrt<T>(db.x * db.x + db.y * db.y), rho_a = wsqrt<T>(da.x * da.x + da.y * da.y);
       real ac = da.x / rho_a, as = da.y / rho_a, bc = db.x / rho_b, bs = db.y / rho_b;
       V3 p, q;
       rim_pair_fit(L.A.s0, za, cb, V3{R[0], R[3], R[6]}, V3{R[1], R[4], R[7]}, L.B.s0, ac, as, bc, bs, p, q);
-      const V3 w = sub(p, q);
-      const real ww = norm2(w);
-      const mask take = m & (rho_a > zero) & (rho_b > zero) & (ww < best);
-      best = select(take, ww, best);
-      pa = pick(take, p, pa), pb = pick(take, q, pb), x = pick(take, w, x);
-      ok |= take;
+      offer((rho_a > zero) & (rho_b > zero), p, q);
     }
     if (!any(ok)) return;
     L.count = select(ok, splat_mask(1), L.count);

@@ -289,6 +289,12 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
   const Vec3<T> t = D.b_in_a.t;
   bool ok = false;
   T best = dot3(x0, x0);
+  // A fit's points, kept where valid and closer than the best so far.
+  const auto offer = [&](bool valid, const Vec3<T>& a, const Vec3<T>& b) {
+    const Vec3<T> w = wsub(a, b);
+    const T ww = dot3(w, w);
+    if (valid && ww < best) best = ww, out.a = a, out.b = b, out.w = w, ok = true;
+  };
   const Vec3<T> db((R[0] * x0.x() + R[3] * x0.y()) + R[6] * x0.z(), (R[1] * x0.x() + R[4] * x0.y()) + R[7] * x0.z(),
                    (R[2] * x0.x() + R[5] * x0.y()) + R[8] * x0.z());
   const Vec3<T> da(-x0.x(), -x0.y(), -x0.z());
@@ -305,14 +311,8 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
     const T rs = A.type == ShapeType::cylinder ? A.size.x() : T(0);
     const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
     const Vec3<T> sp(rs * (p.x() / vn), rs * (p.y() / vn), p.z());
-    const Vec3<T> w = wsub(sp, p);
-    const T ww = dot3(w, w);
     const T ha = A.size.y();
-    if (rho > T(0) && !(p.z() > ha) && !(p.z() < -ha) && vn > rs && ww < best) {
-      best = ww;
-      out.a = sp, out.b = p, out.w = w;
-      ok = true;
-    }
+    offer(rho > T(0) && !(p.z() > ha) && !(p.z() < -ha) && vn > rs, sp, p);
   }
   if (sides & 2) {
     const T rho = rho_a;
@@ -329,27 +329,15 @@ template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>&
     const Vec3<T> qb(((R[0] * sb.x() + R[1] * sb.y()) + R[2] * sb.z()) + t.x(),
                      ((R[3] * sb.x() + R[4] * sb.y()) + R[5] * sb.z()) + t.y(),
                      ((R[6] * sb.x() + R[7] * sb.y()) + R[8] * sb.z()) + t.z());
-    const Vec3<T> w = wsub(qa, qb);
-    const T ww = dot3(w, w);
     const T hb = B.size.y();
-    if (rho > T(0) && !(p.z() > hb) && !(p.z() < -hb) && vn > rs && ww < best) {
-      best = ww;
-      out.a = qa, out.b = qb, out.w = w;
-      ok = true;
-    }
+    offer(rho > T(0) && !(p.z() > hb) && !(p.z() < -hb) && vn > rs, qa, qb);
   }
   if (sides & 4) {
     T ac = da.x() / rho_a, as = da.y() / rho_a, bc = db.x() / rho_b, bs = db.y() / rho_b;
     Vec3<T> p, q;
     rim_pair_fit(A.size.x(), za, cb, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), ac, as, bc, bs,
                  p, q);
-    const Vec3<T> w = wsub(p, q);
-    const T ww = dot3(w, w);
-    if (rho_a > T(0) && rho_b > T(0) && ww < best) {
-      best = ww;
-      out.a = p, out.b = q, out.w = w;
-      ok = true;
-    }
+    offer(rho_a > T(0) && rho_b > T(0), p, q);
   }
   return ok;
 }
