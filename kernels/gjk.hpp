@@ -147,20 +147,5 @@ constexpr bool side_start_pair(ShapeType a, ShapeType b) {
   const bool axial_b = b == ShapeType::cylinder || b == ShapeType::capsule;
   return axial_a && axial_b && (a == ShapeType::cylinder || b == ShapeType::cylinder);
 }
-/// Side-rim and rim-rim fits (wide_gjk.inl's side_rim()): a side line (cylinder, or a capsule's core segment)
-/// against a rim (cylinder, cone), and two rims. Bit 1: A's side against B's rim; bit 2: B's side against A's rim;
-/// bit 4: A's rim against B's rim, only beside a side fit: cone-cone (rim-rim alone) went from 15.8 to 14.4 mean
-/// iterations but 7051 -> 7099 instructions per pair (callgrind, AVX2, close witness double), the fit costing what
-/// it saved.
-constexpr int side_rim_pair(ShapeType a, ShapeType b) {
-  const auto side = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::capsule; };
-  const auto rim = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; };
-  const int sides = (side(a) && rim(b) ? 1 : 0) | (side(b) && rim(a) ? 2 : 0);
-  return sides != 0 && rim(a) && rim(b) ? sides | 4 : sides;
-}
-/// The iteration at which side_rim() fits the rim's angle (GJK's direction then starts its Newton steps).
-constexpr int kSideRimIteration = 5;
-/// Newton steps of side_rim()'s fit.
-constexpr int kSideRimNewtonSteps = 4;
 
 }  // namespace batchcol::kernels

@@ -704,143 +704,6 @@ template <class T> struct WideGjk {
     L.momentum &= ~ok;
   }
 
-  /// The rim point c + r (cos e1 + sin e2) closest to the z axis (the side's axis, in the side's frame), by Newton
-  /// steps on the angle from (cs, sn): the closest point to the origin of the rim's projection on the xy plane (an
-  /// ellipse). f = |E|^2 / 2 with E the projected point: f' = <E, E'>, f'' = |E'|^2 - <E, E - c>; a step where f''
-  /// is not positive is none, a step is at most 0.5 rad, and the angle moves as (cs, sn) + delta (-sn, cs)
-  /// normalised. Returns the rim point (the side's frame) and leaves the angle in cs, sn.
-  AI static V3 rim_fit(const V3& c, const V3& e1, const V3& e2, real r, real& cs, real& sn) {
-    const real zero = splat(T(0)), half = splat(T(0.5));
-    for (int i = 0; i < kSideRimNewtonSteps; ++i) {
-      const real ex = c.x + r * (cs * e1.x + sn * e2.x), ey = c.y + r * (cs * e1.y + sn * e2.y);
-      const real tx = r * (cs * e2.x - sn * e1.x), ty = r * (cs * e2.y - sn * e1.y);
-      const real f1 = ex * tx + ey * ty;
-      const real f2 = (tx * tx + ty * ty) - ((ex - c.x) * ex + (ey - c.y) * ey);
-      const real step = select(f2 > zero, -(f1 / f2), zero);
-      const real delta = select(step > half, half, select(step < -half, -half, step));
-      const real nc = cs - delta * sn, ns = sn + delta * cs;
-      const real len = wsqrt<T>(nc * nc + ns * ns);
-      cs = nc / len;
-      sn = ns / len;
-    }
-    return {c.x + r * (cs * e1.x + sn * e2.x), c.y + r * (cs * e1.y + sn * e2.y), c.z + r * (cs * e1.z + sn * e2.z)};
-  }
-  /// The closest points of two rims, A's (ra (ac, as, 0) + (0, 0, za), A's frame) and B's (cb + rb (bc f1 + bs f2)),
-  /// by Newton steps on both angles from (ac, as), (bc, bs): f = |p - q|^2 / 2, gradient (<r, p'>, -<r, q'>),
-  /// Hessian [|p'|^2 + <r, p''>, -<p', q'>; ., |q'|^2 - <r, q''>] (r = p - q); a step where the Hessian is not
-  /// positive definite is none, each angle moves at most 0.5 rad, as rim_fit()'s. Returns p and q for the angles
-  /// left in ac, as, bc, bs.
-  AI static void rim_pair_fit(real ra, real za, const V3& cb, const V3& f1, const V3& f2, real rb, real& ac, real& as,
-                              real& bc, real& bs, V3& p, V3& q) {
-    const real zero = splat(T(0)), half = splat(T(0.5));
-    const auto clamp = [&](real v) { return select(v > half, half, select(v < -half, -half, v)); };
-    for (int i = 0; i < kSideRimNewtonSteps; ++i) {
-      const V3 pa = {ra * ac, ra * as, za};
-      const V3 dp = {-(ra * as), ra * ac, zero};
-      const V3 u = add(scale(bc, f1), scale(bs, f2));
-      const V3 qb = add(cb, scale(rb, u));
-      const V3 dq = scale(rb, sub(scale(bc, f2), scale(bs, f1)));
-      const V3 r = sub(pa, qb);
-      const real gp = dot(r, dp), gq = -dot(r, dq);
-      const real hpp = dot(dp, dp) - ra * (r.x * ac + r.y * as);
-      const real hqq = dot(dq, dq) + rb * dot(r, u);
-      const real hpq = -dot(dp, dq);
-      const real det = hpp * hqq - hpq * hpq;
-      const mask good = (hpp > zero) & (det > zero);
-      const real sp = clamp(select(good, -((hqq * gp - hpq * gq) / det), zero));
-      const real sq = clamp(select(good, -((hpp * gq - hpq * gp) / det), zero));
-      const real nac = ac - sp * as, nas = as + sp * ac, nbc = bc - sq * bs, nbs = bs + sq * bc;
-      const real la = wsqrt<T>(nac * nac + nas * nas), lb = wsqrt<T>(nbc * nbc + nbs * nbs);
-      ac = nac / la, as = nas / la, bc = nbc / lb, bs = nbs / lb;
-    }
-    p = {ra * ac, ra * as, za};
-    q = add(cb, scale(rb, add(scale(bc, f1), scale(bs, f2))));
-  }
-  /// Side-rim fit, at iteration kSideRimIteration of the distance / witness lanes `m` of a side_rim_pair(): on a
-  /// side line against a rim (a cylinder's side or a capsule's core segment, against a cylinder's or a cone's rim)
-  /// the support of the side flips between its two ends at angles that converge linearly, so GJK needs ~20
-  /// iterations (bench/results/history/narrowphase-sessions.md). Here the rim's angle is fitted instead (rim_fit(),
-  /// Newton from the rim's support angle along GJK's present x), the side's point is the axis point at the rim
-  /// point's height, offset towards it by the side's radius, and the pair of points replaces the simplex where its
-  /// point of D is closer to the origin than x: a one-vertex simplex whose first plain step (momentum off) certifies
-  /// it by the duality gap like any GJK answer, or GJK goes on from it. Both points lie on their shapes (the side
-  /// point only where the rim point's height is within the side's axis), so x stays a point of D. Where both sides
-  /// have a side and a rim (cylinder-cylinder), the closer valid fit of the two is taken; where both have a rim, the
-  /// two rims' closest points (rim_pair_fit()) are a third fit (rim-rim contacts: ~26 iterations of GJK).
-  /// tests/support/reference_gjk.hpp's side_rim() has the same operations.
-  __attribute__((noinline)) static void side_rim(Lanes& L, mask m) {
-    const real zero = splat(T(0)), one = splat(T(1));
-    const int sides = side_rim_pair(L.A.type, L.B.type);
-    const real* R = L.R;
-    const V3 t = {L.t[0], L.t[1], L.t[2]};
-    const V3 x0 = L.x;
-    mask ok = splat_mask(0);
-    V3 pa = x0, pb = x0, x = x0;
-    real best = norm2(x0);
-    // A fit's points, kept in the lanes of m where valid and closer than the best so far.
-    const auto offer = [&](mask valid, const V3& a, const V3& b) {
-      const V3 w = sub(a, b);
-      const real ww = norm2(w);
-      const mask take = m & valid & (ww < best);
-      best = select(take, ww, best);
-      pa = pick(take, a, pa), pb = pick(take, b, pb), x = pick(take, w, x);
-      ok |= take;
-    };
-    // The rims' support angles along x: B's direction R^T x (B's frame), A's -x; a rim's height: a cylinder's by the
-    // direction's sign (support()'s), a cone's bottom.
-    const V3 db = {(R[0] * x0.x + R[3] * x0.y) + R[6] * x0.z, (R[1] * x0.x + R[4] * x0.y) + R[7] * x0.z,
-                   (R[2] * x0.x + R[5] * x0.y) + R[8] * x0.z};
-    const V3 da = neg(x0);
-    // (|db_xy| and |da_xy| are taken in each block: computed here, GCC 12 flagged the AVX-512 square root's
-    // undefined-register idiom as used uninitialised, bug 105593.)
-    const real zb = L.B.type == ShapeType::cone ? -L.B.s1 : select(db.z < zero, -L.B.s1, L.B.s1);
-    const real za = L.A.type == ShapeType::cone ? -L.A.s1 : select(da.z < zero, -L.A.s1, L.A.s1);
-    const V3 cb = {t.x + zb * R[2], t.y + zb * R[5], t.z + zb * R[8]};  // B's rim centre, A's frame
-    if (sides & 1) {  // A's side (A's frame), B's rim: c = t + z_rim b, e1, e2 = B's x and y axes
-      const real rho = wsqrt<T>(db.x * db.x + db.y * db.y);
-      real cs = db.x / rho, sn = db.y / rho;
-      const V3 c = cb;
-      const V3 p = rim_fit(c, V3{R[0], R[3], R[6]}, V3{R[1], R[4], R[7]}, L.B.s0, cs, sn);
-      const real rs = L.A.type == ShapeType::cylinder ? L.A.s0 : zero;
-      const real vn = wsqrt<T>(p.x * p.x + p.y * p.y);
-      const V3 sp = {rs * (p.x / vn), rs * (p.y / vn), p.z};
-      offer((rho > zero) & ~(p.z > L.A.s1) & ~(p.z < -L.A.s1) & (vn > rs), sp, p);
-    }
-    if (sides & 2) {  // B's side (B's frame), A's rim: c = R^T (z_rim e_z - t), e1, e2 = rows 0 and 1 of R
-      const real rho = wsqrt<T>(da.x * da.x + da.y * da.y);
-      real cs = da.x / rho, sn = da.y / rho;
-      const real zr = za;
-      const V3 o = {-t.x, -t.y, zr - t.z};
-      const V3 c = {(R[0] * o.x + R[3] * o.y) + R[6] * o.z, (R[1] * o.x + R[4] * o.y) + R[7] * o.z,
-                    (R[2] * o.x + R[5] * o.y) + R[8] * o.z};
-      const V3 p = rim_fit(c, V3{R[0], R[1], R[2]}, V3{R[3], R[4], R[5]}, L.A.s0, cs, sn);
-      const real rs = L.B.type == ShapeType::cylinder ? L.B.s0 : zero;
-      const real vn = wsqrt<T>(p.x * p.x + p.y * p.y);
-      const V3 sb = {rs * (p.x / vn), rs * (p.y / vn), p.z};  // B's side point, B's frame
-      const V3 qa = {L.A.s0 * cs, L.A.s0 * sn, zr};           // A's rim point, A's frame
-      const V3 qb = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + t.x, ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + t.y,
-                     ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + t.z};
-      offer((rho > zero) & ~(p.z > L.B.s1) & ~(p.z < -L.B.s1) & (vn > rs), qa, qb);
-    }
-    if (sides & 4) {  // A's rim against B's rim
-      const real rho_b = wsqrt<T>(db.x * db.x + db.y * db.y), rho_a = wsqrt<T>(da.x * da.x + da.y * da.y);
-      real ac = da.x / rho_a, as = da.y / rho_a, bc = db.x / rho_b, bs = db.y / rho_b;
-      V3 p, q;
-      rim_pair_fit(L.A.s0, za, cb, V3{R[0], R[3], R[6]}, V3{R[1], R[4], R[7]}, L.B.s0, ac, as, bc, bs, p, q);
-      offer((rho_a > zero) & (rho_b > zero), p, q);
-    }
-    if (!any(ok)) return;
-    L.count = select(ok, splat_mask(1), L.count);
-    L.slot[0] = select(ok, splat_mask(0), L.slot[0]);
-    L.lambda[0] = select(ok, one, L.lambda[0]);
-    L.w[0] = pick(ok, x, L.w[0]);
-    L.a[0] = pick(ok, pa, L.a[0]);
-    L.b[0] = pick(ok, pb, L.b[0]);
-    L.x = pick(ok, x, L.x);
-    L.last_s = pick(ok, x, L.last_s);
-    L.momentum &= ~ok;
-  }
-
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
   struct SideStart {
     T size[3];
@@ -1190,7 +1053,6 @@ template <class T> struct WideGjk {
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
     const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
-    const bool side_rim_run = !Boolean && side_rim_pair(L.A.type, L.B.type) != 0;  // side_rim()
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -1211,10 +1073,6 @@ template <class T> struct WideGjk {
       }
       mask live = lanes_of(active);
       L.k = select(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
-      if (side_rim_run) {
-        const mask fit = live & ~L.boolean_only & (L.k == splat_mask(kSideRimIteration));
-        if (any(fit)) side_rim(L, fit);
-      }
 
       const V3 x = L.x;
       const real xx = norm2(x);

@@ -185,54 +185,6 @@ TEST(WideGjk, CylinderSideContactsStartInClosedForm) {
   }
 }
 
-// A side (cylinder, capsule) against a rim (cylinder, cone), the rim's closest point to the side's axis placed by
-// construction: the rim's tangent there is horizontal and the rim's centre lies farther from the axis, so every
-// point of the rim shape is at least as far from the axis (the rim shape's body goes away from it). The lanes' fit
-// at iteration kSideRimIteration (side_rim()) gives the answer, certified by the next plain step; GJK alone needs
-// ~20 iterations on such pairs. Both orders (A's side, B's side).
-TEST(WideGjk, SideRimContactsAreFittedAndCertified) {
-  Rng rng(515);
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-8;
-  int fitted = 0, runs = 0;
-  for (const ShapeType side : {ShapeType::cylinder, ShapeType::capsule}) {
-    for (const ShapeType rim : {ShapeType::cylinder, ShapeType::cone}) {
-      for (int trial = 0; trial < 40; ++trial) {
-        const double ra = testing::uniform(rng, 0.02, 0.2), ha = testing::uniform(rng, 0.02, 0.3);
-        const double rb = testing::uniform(rng, 0.02, 0.2), hb = testing::uniform(rng, 0.02, 0.3);
-        const Shape a = side == ShapeType::cylinder ? Shape::cylinder(ra, ha) : Shape::capsule(ra, ha);
-        const Shape b = rim == ShapeType::cylinder ? Shape::cylinder(rb, hb) : Shape::cone(rb, hb);
-        const double z0 = testing::uniform(rng, -0.8, 0.8) * ha, alpha = testing::uniform(rng, 0.2, 1.3);
-        const double gap = std::pow(10.0, testing::uniform(rng, -5, -1.5));
-        const Eigen::Vector3d pa(ra, 0, z0), pb(ra + gap, 0, z0);
-        const Eigen::Vector3d q(std::cos(alpha), 0, std::sin(alpha));  // from the rim point to the rim's centre
-        const Eigen::Vector3d axis_b = Eigen::Vector3d::UnitY().cross(q);  // B's axis: its body goes to +x
-        // The rim is B's bottom (a cone's only rim); the body goes along +axis_b from it.
-        const Eigen::Vector3d cb = pb + rb * q + hb * axis_b;
-        const Eigen::Quaterniond qb = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis_b) *
-                                      Eigen::Quaterniond(Eigen::AngleAxisd(testing::uniform(rng, 0, 6), Eigen::Vector3d::UnitZ()));
-        const Eigen::Quaterniond Q = testing::random_rotation(rng);
-        const Eigen::Vector3d T = testing::random_vector(rng);
-        const Pose pose_a{T, Q}, pose_b{T + Q * cb, Q * qb};
-        for (const bool swap : {false, true}) {
-          const auto r = swap ? testing::run_pair(b, pose_b, a, pose_a, opt) : testing::run_pair(a, pose_a, b, pose_b, opt);
-          SCOPED_TRACE(std::string(to_string(side)) + "-" + to_string(rim) + " trial " + std::to_string(trial) +
-                       " swap " + std::to_string(swap) + " gap " + std::to_string(gap));
-          const Eigen::Vector3d wa = swap ? r.witness_b : r.witness_a, wb = swap ? r.witness_a : r.witness_b;
-          EXPECT_EQ(r.status, Status::converged);
-          EXPECT_NEAR(r.distance, gap, 1e-8);
-          EXPECT_LT((wa - (T + Q * pa)).norm(), 1e-4);
-          EXPECT_LT((wb - (T + Q * pb)).norm(), 1e-4);
-          fitted += r.iterations <= kernels::kSideRimIteration ? 1 : 0;
-          ++runs;
-        }
-      }
-    }
-  }
-  EXPECT_GT(fitted, runs * 9 / 10) << fitted << " of " << runs << " pairs ended by the fit";
-}
-
 // The lanes take the solver the setups were made with; `automatic` must have been resolved before.
 template <class T> void expect_start_cells_match(const std::vector<Eigen::Matrix<T, 3, 1>>& dirs) {
   std::vector<T> xyz;

@@ -231,117 +231,6 @@ template <class T> bool side_start(const MinkowskiDifference<T>& D, SupportPoint
   return true;
 }
 
-/// wide_gjk.inl's rim_fit(): the rim point c + r (cos e1 + sin e2) closest to the z axis by Newton on the angle.
-template <class T>
-Vec3<T> rim_fit(const Vec3<T>& c, const Vec3<T>& e1, const Vec3<T>& e2, T r, T& cs, T& sn) {
-  for (int i = 0; i < kSideRimNewtonSteps; ++i) {
-    const T ex = c.x() + r * (cs * e1.x() + sn * e2.x()), ey = c.y() + r * (cs * e1.y() + sn * e2.y());
-    const T tx = r * (cs * e2.x() - sn * e1.x()), ty = r * (cs * e2.y() - sn * e1.y());
-    const T f1 = ex * tx + ey * ty;
-    const T f2 = (tx * tx + ty * ty) - ((ex - c.x()) * ex + (ey - c.y()) * ey);
-    const T step = f2 > T(0) ? -(f1 / f2) : T(0);
-    const T delta = step > T(0.5) ? T(0.5) : (step < T(-0.5) ? T(-0.5) : step);
-    const T nc = cs - delta * sn, ns = sn + delta * cs;
-    const T len = std::sqrt(nc * nc + ns * ns);
-    cs = nc / len;
-    sn = ns / len;
-  }
-  return Vec3<T>(c.x() + r * (cs * e1.x() + sn * e2.x()), c.y() + r * (cs * e1.y() + sn * e2.y()),
-                 c.z() + r * (cs * e1.z() + sn * e2.z()));
-}
-
-/// wide_gjk.inl's rim_pair_fit(): the closest points of two rims by Newton on both angles.
-template <class T>
-void rim_pair_fit(T ra, T za, const Vec3<T>& cb, const Vec3<T>& f1, const Vec3<T>& f2, T rb, T& ac, T& as, T& bc, T& bs,
-                  Vec3<T>& p, Vec3<T>& q) {
-  const auto clamp = [](T v) { return v > T(0.5) ? T(0.5) : (v < T(-0.5) ? T(-0.5) : v); };
-  for (int i = 0; i < kSideRimNewtonSteps; ++i) {
-    const Vec3<T> pa(ra * ac, ra * as, za);
-    const Vec3<T> dp(-(ra * as), ra * ac, T(0));
-    const Vec3<T> u = wadd(wscale(bc, f1), wscale(bs, f2));
-    const Vec3<T> qb = wadd(cb, wscale(rb, u));
-    const Vec3<T> dq = wscale(rb, wsub(wscale(bc, f2), wscale(bs, f1)));
-    const Vec3<T> r = wsub(pa, qb);
-    const T gp = dot3(r, dp), gq = -dot3(r, dq);
-    const T hpp = dot3(dp, dp) - ra * (r.x() * ac + r.y() * as);
-    const T hqq = dot3(dq, dq) + rb * dot3(r, u);
-    const T hpq = -dot3(dp, dq);
-    const T det = hpp * hqq - hpq * hpq;
-    const bool good = hpp > T(0) && det > T(0);
-    const T sp = clamp(good ? -((hqq * gp - hpq * gq) / det) : T(0));
-    const T sq = clamp(good ? -((hpp * gq - hpq * gp) / det) : T(0));
-    const T nac = ac - sp * as, nas = as + sp * ac, nbc = bc - sq * bs, nbs = bs + sq * bc;
-    const T la = std::sqrt(nac * nac + nas * nas), lb = std::sqrt(nbc * nbc + nbs * nbs);
-    ac = nac / la, as = nas / la, bc = nbc / lb, bs = nbs / lb;
-  }
-  p = Vec3<T>(ra * ac, ra * as, za);
-  q = wadd(cb, wscale(rb, wadd(wscale(bc, f1), wscale(bs, f2))));
-}
-
-/// wide_gjk.inl's side_rim() (the reasoning is there), with its operations: true and the fitted point of D with its
-/// points of A and B where a fit is valid and closer to the origin than x.
-template <class T> bool side_rim(const MinkowskiDifference<T>& D, const Vec3<T>& x0, SupportPoint<T>& out) {
-  const ShapeCore<T>& A = *D.A;
-  const ShapeCore<T>& B = *D.B;
-  const int sides = side_rim_pair(A.type, B.type);
-  const auto& M = D.b_in_a.R;
-  const T R[9] = {M(0, 0), M(0, 1), M(0, 2), M(1, 0), M(1, 1), M(1, 2), M(2, 0), M(2, 1), M(2, 2)};
-  const Vec3<T> t = D.b_in_a.t;
-  bool ok = false;
-  T best = dot3(x0, x0);
-  // A fit's points, kept where valid and closer than the best so far.
-  const auto offer = [&](bool valid, const Vec3<T>& a, const Vec3<T>& b) {
-    const Vec3<T> w = wsub(a, b);
-    const T ww = dot3(w, w);
-    if (valid && ww < best) best = ww, out.a = a, out.b = b, out.w = w, ok = true;
-  };
-  const Vec3<T> db((R[0] * x0.x() + R[3] * x0.y()) + R[6] * x0.z(), (R[1] * x0.x() + R[4] * x0.y()) + R[7] * x0.z(),
-                   (R[2] * x0.x() + R[5] * x0.y()) + R[8] * x0.z());
-  const Vec3<T> da(-x0.x(), -x0.y(), -x0.z());
-  const T rho_b = std::sqrt(db.x() * db.x() + db.y() * db.y()), rho_a = std::sqrt(da.x() * da.x() + da.y() * da.y());
-  const T hb_ = B.size.y(), ha_ = A.size.y();
-  const T zb = B.type == ShapeType::cone ? -hb_ : (db.z() < T(0) ? -hb_ : hb_);
-  const T za = A.type == ShapeType::cone ? -ha_ : (da.z() < T(0) ? -ha_ : ha_);
-  const Vec3<T> cb(t.x() + zb * R[2], t.y() + zb * R[5], t.z() + zb * R[8]);
-  if (sides & 1) {
-    const T rho = rho_b;
-    T cs = db.x() / rho, sn = db.y() / rho;
-    const Vec3<T> c = cb;
-    const Vec3<T> p = rim_fit(c, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), cs, sn);
-    const T rs = A.type == ShapeType::cylinder ? A.size.x() : T(0);
-    const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
-    const Vec3<T> sp(rs * (p.x() / vn), rs * (p.y() / vn), p.z());
-    const T ha = A.size.y();
-    offer(rho > T(0) && !(p.z() > ha) && !(p.z() < -ha) && vn > rs, sp, p);
-  }
-  if (sides & 2) {
-    const T rho = rho_a;
-    T cs = da.x() / rho, sn = da.y() / rho;
-    const T zr = za;
-    const Vec3<T> o(-t.x(), -t.y(), zr - t.z());
-    const Vec3<T> c((R[0] * o.x() + R[3] * o.y()) + R[6] * o.z(), (R[1] * o.x() + R[4] * o.y()) + R[7] * o.z(),
-                    (R[2] * o.x() + R[5] * o.y()) + R[8] * o.z());
-    const Vec3<T> p = rim_fit(c, Vec3<T>(R[0], R[1], R[2]), Vec3<T>(R[3], R[4], R[5]), A.size.x(), cs, sn);
-    const T rs = B.type == ShapeType::cylinder ? B.size.x() : T(0);
-    const T vn = std::sqrt(p.x() * p.x() + p.y() * p.y());
-    const Vec3<T> sb(rs * (p.x() / vn), rs * (p.y() / vn), p.z());
-    const Vec3<T> qa(A.size.x() * cs, A.size.x() * sn, zr);
-    const Vec3<T> qb(((R[0] * sb.x() + R[1] * sb.y()) + R[2] * sb.z()) + t.x(),
-                     ((R[3] * sb.x() + R[4] * sb.y()) + R[5] * sb.z()) + t.y(),
-                     ((R[6] * sb.x() + R[7] * sb.y()) + R[8] * sb.z()) + t.z());
-    const T hb = B.size.y();
-    offer(rho > T(0) && !(p.z() > hb) && !(p.z() < -hb) && vn > rs, qa, qb);
-  }
-  if (sides & 4) {
-    T ac = da.x() / rho_a, as = da.y() / rho_a, bc = db.x() / rho_b, bs = db.y() / rho_b;
-    Vec3<T> p, q;
-    rim_pair_fit(A.size.x(), za, cb, Vec3<T>(R[0], R[3], R[6]), Vec3<T>(R[1], R[4], R[7]), B.size.x(), ac, as, bc, bs,
-                 p, q);
-    offer(rho_a > T(0) && rho_b > T(0), p, q);
-  }
-  return ok;
-}
-
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -378,18 +267,6 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
 
   for (int k = 0; k < params.max_iterations; ++k) {
     r.iterations = k + 1;
-    // Side-rim pairs: the fitted side-rim point replaces the simplex where it is closer (wide_gjk.inl's side_rim()).
-    if (k + 1 == kSideRimIteration && !params.boolean_only && side_rim_pair(D.A->type, D.B->type) != 0) {
-      SupportPoint<T> p;
-      if (side_rim(D, x, p)) {
-        S.count = 1;
-        S.v[0] = p;
-        S.lambda[0] = T(1);
-        x = p.w;
-        last_s = x;
-        momentum = false;
-      }
-    }
     const T xx = norm2(x);
     const T xn = std::sqrt(xx);
     if (xn <= params.touch_tolerance) { r.status = GjkStatus::overlap; break; }
