@@ -140,4 +140,12 @@ constexpr double kNewtonSwitch = 0.5;
 /// amplified by the curvature on close pairs; 0.01 took 8.58 mean iterations on close ellipsoids, 1 took 8.99.
 constexpr double kNewtonPlainGap = 0.01;
 
+/// Cylinder / capsule pairs (at least one cylinder; capsule-capsule is a closed form) whose distance / witness lanes
+/// start from the closed-form side contact (wide_gjk.inl's side_start()).
+constexpr bool side_start_pair(ShapeType a, ShapeType b) {
+  const bool axial_a = a == ShapeType::cylinder || a == ShapeType::capsule;
+  const bool axial_b = b == ShapeType::cylinder || b == ShapeType::capsule;
+  return axial_a && axial_b && (a == ShapeType::cylinder || b == ShapeType::cylinder);
+}
+
 }  // namespace batchcol::kernels

@@ -638,7 +638,8 @@ template <class T> struct WideGjk {
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
-  AI static void start(Lanes& L) {
+  /// `side`: the run may have distance / witness lanes (side_start(); boolean runs never do).
+  AI static void start(Lanes& L, bool side) {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
@@ -648,7 +649,59 @@ template <class T> struct WideGjk {
     L.b[0] = pick(m, sb, L.b[0]);
     L.x = pick(m, sw, L.x);
     L.last_s = pick(m, sw, L.last_s);
+    if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     L.fresh = 0;
+  }
+
+  /// The start point of a cylinder / capsule pair's distance and witness lanes (`m`) in closed form, where it is
+  /// a side contact. A cylinder of radius r lies inside the capsule of its axis segment and radius r, and the two
+  /// share the side; so when the closest points of the axis segments (a capsule core's own segment) are interior
+  /// to every cylinder's axis segment, their offset is orthogonal to those axes, the capsules' witness points lie
+  /// on the cylinders' sides, and they are the cylinders' witness points. Replaces the first support point by
+  /// that point of D (and its points of A and B) where it is closer to the origin; the lane's first iteration is
+  /// then a plain step (momentum off) whose duality gap certifies it, as any GJK answer, or GJK goes on from there.
+  /// Why: on a side line GJK's support points flip between the two rims at angles that converge only linearly
+  /// (cylinder-cylinder: 55% of close pairs, ~20 iterations; bench/results/history/narrowphase-sessions.md).
+  /// A's axis is (0, 0, z), |z| <= A.s1; B's is t + z b, b = R e_z, |z| <= B.s1 (Ericson's segment-segment
+  /// order: B's parameter from the lines' closest points, clamped; A's from it, clamped; B's again if A's was).
+  /// tests/support/reference_gjk.hpp's side_start() has the same operations.
+  __attribute__((noinline)) static void side_start(Lanes& L, mask m) {
+    if (!any(m)) return;
+    const real zero = splat(T(0));
+    const real ha = L.A.s1, hb = L.B.s1;
+    const real ra = L.A.type == ShapeType::cylinder ? L.A.s0 : zero;
+    const real rb = L.B.type == ShapeType::cylinder ? L.B.s0 : zero;
+    const V3 c = {L.t[0], L.t[1], L.t[2]};
+    const V3 b = {L.R[2], L.R[5], L.R[8]};
+    const real beta = b.z, cb = dot(c, b), bb = norm2(b);
+    const real denom = bb - beta * beta;
+    const real zb1 = select(denom > zero, (beta * c.z - cb) / denom, zero);
+    const mask out_b1 = (zb1 > hb) | (zb1 < -hb);
+    const real zb1c = select(zb1 > hb, hb, select(zb1 < -hb, -hb, zb1));
+    const real za = c.z + zb1c * beta;
+    const mask out_a = (za > ha) | (za < -ha);
+    const real zac = select(za > ha, ha, select(za < -ha, -ha, za));
+    const real zb2 = (zac * beta - cb) / bb;
+    const mask out_b2 = (zb2 > hb) | (zb2 < -hb);
+    const real zb = select(out_a, select(zb2 > hb, hb, select(zb2 < -hb, -hb, zb2)), zb1c);
+    mask ok = m;
+    if (L.A.type == ShapeType::cylinder) ok &= ~out_a;
+    if (L.B.type == ShapeType::cylinder) ok &= ~select(out_a, out_b2, out_b1);
+    const V3 qa = {zero, zero, zac}, qb = add(c, scale(zb, b));
+    const V3 v = sub(qa, qb);
+    const real vn = norm(v);
+    ok &= vn > ra + rb;
+    const V3 u = divide(v, vn);
+    const V3 pa = sub(qa, scale(ra, u)), pb = add(qb, scale(rb, u));
+    const V3 x = sub(pa, pb);
+    ok &= norm2(x) < norm2(L.x);
+    if (!any(ok)) return;
+    L.w[0] = pick(ok, x, L.w[0]);
+    L.a[0] = pick(ok, pa, L.a[0]);  // slot[0] = 0 (start_lane())
+    L.b[0] = pick(ok, pb, L.b[0]);
+    L.x = pick(ok, x, L.x);
+    L.last_s = pick(ok, x, L.last_s);
+    L.momentum &= ~ok;
   }
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
@@ -1007,7 +1060,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L);
+      start(L, !Boolean);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {

@@ -88,6 +88,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   int compared = 0, spread = 0;
   long newton_steps = 0, newton_pairs = 0;  // Newton directions taken (reference): the lanes must have run them
   long feature_pairs = 0;  // ... of them, polytope-curved pairs (feature_direction())
+  long side_closed = 0;    // cylinder / capsule pairs answered from side_start()'s point in one iteration
   for (const ShapeType ta : testing::bounded_shape_types()) {
     for (const ShapeType tb : testing::bounded_shape_types()) {
       std::deque<OwnedShapeView> keep;  // the setups' cores point into it: a deque never moves its elements
@@ -100,6 +101,8 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
         newton_steps += want.back().newton_steps;
         newton_pairs += want.back().newton_steps > 0 ? 1 : 0;
         feature_pairs += want.back().newton_steps > 0 && kernels::flat_newton_side(ta, tb) != 0 ? 1 : 0;
+        side_closed += kernels::side_start_pair(ta, tb) && want.back().iterations == 1 &&
+                               want.back().status == kernels::GjkStatus::converged ? 1 : 0;
         lo = std::min(lo, want.back().iterations);
         hi = std::max(hi, want.back().iterations);
       }
@@ -127,6 +130,7 @@ template <class T> void check_all_types(Solver solver, QueryLevel level) {
   else {
     EXPECT_GT(newton_pairs, 50) << "too few pairs took Newton steps to check them lane by lane";
     EXPECT_GT(feature_pairs, 20) << "too few polytope-curved pairs took feature Newton steps";
+    EXPECT_GT(side_closed, 10) << "too few cylinder / capsule pairs started from the closed-form side contact";
   }
 }
 
@@ -141,6 +145,43 @@ TEST(WideGjk, EqualsReferenceBitwiseFloat) {
   for (const Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
     check_all_types<float>(solver, QueryLevel::witness);
     check_all_types<float>(solver, QueryLevel::boolean);
+  }
+}
+
+// Cylinder / capsule pairs whose closest points lie on the cylinders' sides (the axis segments' closest points
+// interior to every cylinder's axis): the lanes start from the closed-form point (side_start()), which the first
+// plain step certifies. Crossed axes at a known gap, the closest points placed by construction, moved by a random
+// rigid transform; GJK from the support points alone takes ~20 iterations on such pairs (side lines).
+TEST(WideGjk, CylinderSideContactsStartInClosedForm) {
+  Rng rng(2026);
+  QueryOptions opt;
+  opt.level = QueryLevel::witness;
+  opt.tolerance = 1e-8;
+  for (const bool capsule_b : {false, true}) {
+    for (int trial = 0; trial < 50; ++trial) {
+      const double ra = testing::uniform(rng, 0.02, 0.2), ha = testing::uniform(rng, 0.02, 0.3);
+      const double rb = testing::uniform(rng, 0.02, 0.2), hb = testing::uniform(rng, 0.02, 0.3);
+      const Shape a = Shape::cylinder(ra, ha), b = capsule_b ? Shape::capsule(rb, hb) : Shape::cylinder(rb, hb);
+      Eigen::Vector3d axis_b = testing::random_unit_vector(rng);
+      if (std::abs(axis_b.z()) > 0.95) axis_b = Eigen::Vector3d(1, 0, 0);
+      const Eigen::Vector3d m = Eigen::Vector3d::UnitZ().cross(axis_b).normalized();  // the common normal
+      const double za = testing::uniform(rng, -0.9, 0.9) * ha, zb = testing::uniform(rng, -0.9, 0.9) * hb;
+      const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
+      const Eigen::Vector3d pa = Eigen::Vector3d(0, 0, za) + ra * m, pb = pa + gap * m;
+      const Eigen::Vector3d cb = pb + rb * m - zb * axis_b;
+      const Eigen::Quaterniond qb = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis_b);
+      const Eigen::Quaterniond Q = testing::random_rotation(rng);
+      const Eigen::Vector3d T = testing::random_vector(rng);
+      const Pose pose_a{T, Q}, pose_b{T + Q * cb, Q * qb};
+      const auto r = testing::run_pair(a, pose_a, b, pose_b, opt);
+      SCOPED_TRACE("capsule " + std::to_string(capsule_b) + " trial " + std::to_string(trial) + " gap " +
+                   std::to_string(gap));
+      EXPECT_EQ(r.status, Status::converged);
+      EXPECT_EQ(r.iterations, 1);
+      EXPECT_NEAR(r.distance, gap, 1e-12);
+      EXPECT_LT((r.witness_a - (T + Q * pa)).norm(), 1e-12);
+      EXPECT_LT((r.witness_b - (T + Q * pb)).norm(), 1e-12);
+    }
   }
 }
 

@@ -197,6 +197,40 @@ Vec3<T> feature_direction(const MinkowskiDifference<T>& D, const Simplex<T>& S, 
   return wadd(n, delta);
 }
 
+/// The closed-form start point of a cylinder / capsule pair (wide_gjk.inl's side_start(), where
+/// the reasoning is), with its operations: true and the point of D with its points of A and B where the axis
+/// segments' closest points are a side contact.
+template <class T> bool side_start(const MinkowskiDifference<T>& D, SupportPoint<T>& p) {
+  const auto clamp = [](T z, T h) { return z > h ? h : (z < -h ? -h : z); };
+  const T ha = D.A->size.y(), hb = D.B->size.y();
+  const bool cyl_a = D.A->type == ShapeType::cylinder, cyl_b = D.B->type == ShapeType::cylinder;
+  const T ra = cyl_a ? D.A->size.x() : T(0), rb = cyl_b ? D.B->size.x() : T(0);
+  const Vec3<T> c = D.b_in_a.t;
+  const Vec3<T> b(D.b_in_a.R(0, 2), D.b_in_a.R(1, 2), D.b_in_a.R(2, 2));
+  const T beta = b.z(), cb = dot3(c, b), bb = dot3(b, b);
+  const T denom = bb - beta * beta;
+  const T zb1 = denom > T(0) ? (beta * c.z() - cb) / denom : T(0);
+  const bool out_b1 = zb1 > hb || zb1 < -hb;
+  const T zb1c = clamp(zb1, hb);
+  const T za = c.z() + zb1c * beta;
+  const bool out_a = za > ha || za < -ha;
+  const T zac = clamp(za, ha);
+  const T zb2 = (zac * beta - cb) / bb;
+  const bool out_b2 = zb2 > hb || zb2 < -hb;
+  const T zb = out_a ? clamp(zb2, hb) : zb1c;
+  if (cyl_a && out_a) return false;
+  if (cyl_b && (out_a ? out_b2 : out_b1)) return false;
+  const Vec3<T> qa(T(0), T(0), zac), qb = wadd(c, wscale(zb, b));
+  const Vec3<T> v = wsub(qa, qb);
+  const T vn = std::sqrt(dot3(v, v));
+  if (!(vn > ra + rb)) return false;
+  const Vec3<T> u = wdivide(v, vn);
+  p.a = wsub(qa, wscale(ra, u));
+  p.b = wadd(qb, wscale(rb, u));
+  p.w = wsub(p.a, p.b);
+  return true;
+}
+
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -210,6 +244,17 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
+  // Cylinder / capsule pairs: the closed-form side contact replaces the first support point where it is closer,
+  // and the first step is then a plain one (wide_gjk.inl's side_start()).
+  if (!params.boolean_only && side_start_pair(D.A->type, D.B->type)) {
+    SupportPoint<T> p;
+    if (side_start(D, p) && norm2(p.w) < norm2(x)) {
+      S.v[0] = p;
+      x = p.w;
+      last_s = x;
+      momentum = false;
+    }
+  }
   T lower_bound = -std::numeric_limits<T>::infinity();
   int stale = 0;  // consecutive iterations without real progress of the lower bound
   // Newton directions (witness / distance queries of newton_pair_type()s) until one fails to progress.
