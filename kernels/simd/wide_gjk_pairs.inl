@@ -9,6 +9,20 @@
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl and wide_pairs.inl.
 
+/// A boolean double query's float pass (WideGjkPairs<double>::run_certified()): what the float GJK answered for
+/// the pair at one position of the run's pair list, and what its double certificate needs. kind 0: no answer to
+/// certify (not run: invalid input; or ended otherwise than separated / overlapping: budget, convergence, stall),
+/// 1: separated along `direction` (the last search direction d, whose support point -d proved it), 2: the
+/// cores overlap or are within the margin, with the `count` simplex vertices being D's support points in the
+/// directions -vertex[m] (in simplex order).
+struct FloatAnswer {
+  std::uint8_t kind = 0;
+  std::uint8_t count = 0;
+  std::int32_t iterations = 0;
+  float direction[3] = {};
+  float vertex[4][3] = {};
+};
+
 template <class T> struct WideGjkPairs {
   using G = WideGjk<T>;
   using Lanes = typename G::Lanes;
@@ -51,6 +65,8 @@ template <class T> struct WideGjkPairs {
     d4 Ra[3] = {};  // A's world rotation by columns (lane 3 stays 0)
     d4 ta = {};     // only at QueryLevel::witness (the only level that writes world points)
     T radius_a, radius_b, radii, scale;
+    std::uint32_t position = 0;  // index in the run's pair list (certified runs: the float answer's slot)
+    std::int32_t float_iterations = 0;  // certified runs: the float pass's iterations, added to the double's
 
     /// dst[c][i] = component c of R v (+ t with `translate`) for v in A's frame: write_pair_output()'s
     /// mul<double>(Ra, v) (+ ta). (No d4 by value: the scalar build has no AVX, and -Wpsabi warns of the ABI.)
@@ -130,6 +146,12 @@ template <class T> struct WideGjkPairs {
     Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
     Chunk chunk;
     LanePair lane[W];  // written by load() before done() reads it
+    std::size_t base = 0;  // the chunk's slot 0 is pairs[base]
+    /// Certified boolean double runs (run_certified()): the float pass writes `record` (float Source), the double
+    /// pass reads `answers` and certifies them in `check`'s lanes before any GJK (double Source).
+    FloatAnswer* record = nullptr;
+    const FloatAnswer* answers = nullptr;
+    Lanes* check = nullptr;
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
     // would zero the chunk's ~25 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs
@@ -154,6 +176,7 @@ template <class T> struct WideGjkPairs {
     /// operations.
     void fill_chunk() {
       chunk.left = 0;
+      base = read;
       const std::size_t end = std::min(n, read + kChunk);
       const T tolerance = T(options.tolerance), margin = T(options.margin);
       for (std::size_t k = read; k < end; k += Wd) {
@@ -223,6 +246,7 @@ template <class T> struct WideGjkPairs {
       while (chunk.left == 0) {
         if (read == n) return false;
         fill_chunk();
+        if (answers) certify_chunk();
       }
       const std::size_t s = std::size_t(__builtin_ctzll(chunk.left));
       chunk.left &= chunk.left - 1;
@@ -248,6 +272,8 @@ template <class T> struct WideGjkPairs {
       lp.radius_b = c.radius_b[s];
       lp.radii = c.radii[s];
       lp.scale = c.scale[s];
+      lp.position = std::uint32_t(base + s);
+      if (answers) lp.float_iterations = answers[base + s].iterations;
       return true;
     }
     /// Slot s of one side into lane l, as load_side() takes it: the sizes of the types that have them (the
@@ -269,6 +295,17 @@ template <class T> struct WideGjkPairs {
     /// complete_pair() and write_pair_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
     /// the fallback (computed again on the scalar path).
     void done(const Lanes& L, int l, GjkStatus status) {
+      if (record) {
+        keep(L, l, status);
+        return;
+      }
+      // A certified run's double GJK (the certificate failed or there was none): its iterations plus the float
+      // pass's, the work done for the pair. (A pair this path leaves to the scalar fallback reports the scalar
+      // path's iterations alone.)
+      if (finish_pair(L, l, status) && answers) out.iterations[lane[l].pair] += lane[l].float_iterations;
+    }
+    /// Lane l's answer into the result arrays; false when the pair went to the fallback instead.
+    bool finish_pair(const Lanes& L, int l, GjkStatus status) {
       if (status == GjkStatus::separated_proven || status == GjkStatus::collision_proven) {
         // A boolean query's usual ending: complete_from_gjk() and write_pair_output() reduce to a converged pair
         // whose collide is decided, its world direction and its iterations (the same arithmetic), without a
@@ -279,15 +316,15 @@ template <class T> struct WideGjkPairs {
         out.collide[i] = status == GjkStatus::collision_proven ? 1 : 0;
         lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
         out.iterations[i] = int(L.k[l]);
-        return;
+        return true;
       }
       if (status == GjkStatus::converged || status == GjkStatus::max_iterations) {
         converged(L, l, status);
-        return;
+        return true;
       }
       if (status == GjkStatus::overlap && options.level != QueryLevel::penetration) {  // penetration: EPA below
         overlapping(L, l);
-        return;
+        return true;
       }
       GjkResult<T> g;
       G::finish(L, l, status, g, witness);
@@ -298,10 +335,153 @@ template <class T> struct WideGjkPairs {
       PairOutput<T> r;
       if (!complete_from_gjk(completion, g, options, r)) {
         fallback[fallbacks++] = lp.pair;
-        return;
+        return false;
       }
       const Eigen::Vector3d ta(lp.ta[0], lp.ta[1], lp.ta[2]);
       write_pair_output(r, lp.rotation(), ta, lp.pair, options.level, out);
+      return true;
+    }
+
+    /// The float pass of a certified run: lane l's answer into record[position] (drive_boolean_directions():
+    /// vertex m's direction is in L.a[L.slot[m]]). Separated and overlapping answers are kept for the double
+    /// certificate; any other ending (budget, convergence, stall) leaves kind 0: the double GJK decides.
+    void keep(const Lanes& L, int l, GjkStatus status) {
+      FloatAnswer& r = record[lane[l].position];
+      r.iterations = std::int32_t(L.k[l]);
+      const bool separated = status == GjkStatus::separated_proven;
+      const bool overlapping = status == GjkStatus::collision_proven || status == GjkStatus::overlap;
+      r.kind = separated ? 1 : overlapping ? 2 : 0;
+      const Vec3<T> d = G::get_lane(L.direction, l);
+      for (int c = 0; c < 3; ++c) r.direction[c] = float(d[c]);
+      if (!overlapping) return;
+      r.count = std::uint8_t(L.count[l]);
+      for (int m = 0; m < int(r.count); ++m) {
+        const Vec3<T> v = G::get_lane(L.a[int(L.slot[m][l]) & 3], l);
+        for (int c = 0; c < 3; ++c) r.vertex[m][c] = float(v[c]);
+      }
+    }
+
+    /// The certificates of the chunk's float answers, W pairs at a time in `check`'s lanes (double): a pair whose
+    /// certificate holds gets its answer here and leaves chunk.left; the others stay for the double GJK.
+    ///  - separated along d: w = D.support(-d) in double (d widened), accepted iff <w, d> / |d| > core margin,
+    ///    the double GJK's own test that ends a separated boolean pair (ends_separated);
+    ///  - overlapping: the simplex's vertices computed again in double (D.support(-v_m)), the origin projected on
+    ///    their hull with project() (the double GJK's projection), accepted iff the tetrahedron contains the
+    ///    origin or the projection's norm is <= max(core margin, touch): the double GJK's ends_contains,
+    ///    ends_collision and ends_overlap tests.
+    /// The certificate's support points are points of the double problem's Minkowski difference, so an accepted
+    /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
+    /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
+    /// the float pass's.
+    void certify_chunk() {
+      std::uint64_t todo = 0;
+      for (std::uint64_t bits = chunk.left; bits != 0; bits &= bits - 1) {
+        const int s = __builtin_ctzll(bits);
+        if (answers[base + std::size_t(s)].kind != 0) todo |= std::uint64_t(1) << s;
+      }
+      while (todo != 0) {
+        int slot[W];
+        int lanes = 0;
+        for (; lanes < W && todo != 0; todo &= todo - 1) slot[lanes++] = __builtin_ctzll(todo);
+        certify_lanes(slot, lanes);
+      }
+    }
+    /// The square root lane by lane (correctly rounded: wsqrt()'s bits). GCC 12 reports its own _mm512_sqrt_pd's
+    /// `__m512d __Y = __Y` (bug 105593) as -Wuninitialized on the vectors built lane by lane here, which
+    /// -Wno-maybe-uninitialized (kernels/CMakeLists.txt) does not cover.
+    static typename G::real root(typename G::real a) {
+      for (int l = 0; l < W; ++l) a[l] = std::sqrt(a[l]);
+      return a;
+    }
+    void certify_lanes(const int* slot, int lanes) {
+      Lanes& C = *check;
+      using V3 = typename G::V3;
+      const Chunk& c = chunk;
+      std::uint32_t live = 0, sep_bits = 0;
+      typename G::Int count[W] = {};
+      V3 v[4];
+      for (int m = 0; m < 4; ++m) v[m] = {G::splat(T(1)), G::splat(T(0)), G::splat(T(0))};
+      for (int l = 0; l < lanes; ++l) {
+        const std::size_t s = std::size_t(slot[l]);
+        const FloatAnswer& a = answers[base + s];
+        live |= 1u << l;
+        for (int e = 0; e < 9; ++e) C.R[e][l] = c.R[e][s];
+        for (int i = 0; i < 3; ++i) C.t[i][l] = c.t[i][s];
+        side(C.A, c.size_a, c.shape_a, s, l);
+        side(C.B, c.size_b, c.shape_b, s, l);
+        C.core_margin[l] = c.core_margin[s];
+        C.touch[l] = c.floor[s];
+        if (a.kind == 1) {
+          sep_bits |= 1u << l;
+          count[l] = 1;
+          G::set_lane(v[0], l, Vec3<T>(T(a.direction[0]), T(a.direction[1]), T(a.direction[2])));
+        } else {
+          count[l] = a.count;
+          for (int m = 0; m < int(a.count); ++m)
+            G::set_lane(v[m], l, Vec3<T>(T(a.vertex[m][0]), T(a.vertex[m][1]), T(a.vertex[m][2])));
+        }
+      }
+      // One vector load of the counts. (Built lane by lane into an unset vector, the scalar build (W = 1, GCC 12
+      // -O3) read counts that were not these, lane masks of them false, in the first runs of a process: the
+      // certificates of AVX2 and AVX-512 failed there. Not explained in the time this had.)
+      static_assert(sizeof(typename G::mask) == sizeof count, "one count per lane");
+      typename G::mask cnt;
+      std::memcpy(&cnt, count, sizeof cnt);
+      const typename G::mask sep = G::lanes_of(sep_bits), in = G::lanes_of(live);
+      V3 p[4], sa, sb;
+      G::minkowski(C, G::neg(v[0]), live, p[0], sa, sb);
+      // Separated: the double GJK's ends_separated test along d.
+      const typename G::real lb = G::dot(p[0], v[0]) / root(G::norm2(v[0]));
+      const typename G::mask over = in & ~sep;
+      typename G::real V[4] = {}, total{}, xn{};
+      if (any(over)) {
+        for (int m = 1; m < 4; ++m) {
+          const std::uint32_t need = lane_bits(over & (cnt > G::splat_mask(m)));
+          p[m] = p[0];
+          if (need) G::minkowski(C, G::neg(v[m]), need, p[m], sa, sb);
+        }
+        // Four vertices: tetrahedron()'s signed volumes (project()'s operations), for its containment test below.
+        V[0] = G::det3(p[1], p[2], p[3]), V[1] = -G::det3(p[0], p[2], p[3]), V[2] = G::det3(p[0], p[1], p[3]),
+        V[3] = -G::det3(p[0], p[1], p[2]);
+        total = ((V[0] + V[1]) + V[2]) + V[3];
+        // One vertex: its norm. (Two or three vertices, ended by |x| <= core margin in float, are left to the double
+        // GJK: the closest point of a segment or triangle computed here by project() gave other bits in the scalar
+        // build (W = 1, GCC 12 -O3) than in AVX2 and AVX-512 on the same inputs, and changed with unrelated code
+        // (a debug print): not explained in the time this had, so not used.)
+        const V3 x = p[0];
+        xn = root(G::norm2(x));
+      }
+      // The decision lane by lane, in plain scalars (the same tests as the double GJK's, on the same values).
+      bool ok[W] = {};
+      for (int l = 0; l < lanes; ++l) {
+        if (sep_bits >> l & 1u) {
+          ok[l] = lb[l] > C.core_margin[l];
+        } else if (count[l] == 4) {
+          // tetrahedron()'s inside: total != 0 and no volume of the opposite sign (project()'s opposite_sign()).
+          const T t = total[l];
+          bool inside = t != T(0);
+          for (int m = 0; m < 4; ++m) inside = inside && !((V[m][l] > T(0) && t < T(0)) || (V[m][l] < T(0) && t > T(0)));
+          ok[l] = inside;
+        } else if (count[l] == 1) {
+          // The double GJK's ends_collision (|x| <= core margin) and ends_overlap (|x| <= touch) tests.
+          const T cm = C.core_margin[l], touch = C.touch[l];
+          ok[l] = xn[l] <= (cm < touch ? touch : cm);
+        }
+      }
+      for (int l = 0; l < lanes; ++l) {
+        if (!ok[l]) continue;
+        const std::size_t s = std::size_t(slot[l]);
+        const FloatAnswer& a = answers[base + s];
+        const std::uint32_t i = c.pair[s];
+        LanePair lp;
+        for (int r = 0; r < 3; ++r)
+          for (int j = 0; j < 3; ++j) lp.Ra[j][r] = c.Ra[3 * r + j][s];
+        out.status[i] = Status::converged;
+        out.collide[i] = a.kind == 1 ? 0 : 1;
+        lp.put_world(out.direction, i, Vec3<T>(T(a.direction[0]), T(a.direction[1]), T(a.direction[2])), false);
+        out.iterations[i] = a.iterations;
+        chunk.left &= ~(std::uint64_t(1) << s);
+      }
     }
 
     /// A distance / witness query's usual ending (GJK converged, or its budget ran out with x away from the
@@ -368,6 +548,8 @@ template <class T> struct WideGjkPairs {
   static std::size_t run(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
                          std::size_t n, const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
     if (n == 0) return 0;
+    if constexpr (std::is_same_v<T, double>)
+      if (options.level == QueryLevel::boolean) return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
     Lanes L;
     L.A.type = type_a;
     L.B.type = type_b;
@@ -377,6 +559,54 @@ template <class T> struct WideGjkPairs {
     source.start_run(L);
     if (options.level == QueryLevel::boolean) G::drive_boolean(L, source, options.solver);  // start_run: all boolean
     else G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
+    return source.fallbacks;
+  }
+
+  /// The float pass of a certified boolean double run: every pair's float answer into answers[position]
+  /// (kind 0 where none: answers must come zeroed). Pairs the float setup rejects are listed in `rejected`
+  /// (discarded: the double pass rejects them again).
+  static void run_float_answers(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                                std::size_t n, const QueryOptions& options, const ResultView& out,
+                                std::uint32_t* rejected, FloatAnswer* answers) {
+    Lanes L;
+    L.A.type = type_a;
+    L.B.type = type_b;
+    typename G::Rows rows;
+    rows.attach(L.A, L.B);
+    Source source{in, options, type_a, type_b, pairs, n, out, rejected};
+    source.record = answers;
+    source.start_run(L);
+    G::drive_boolean_directions(L, source, options.solver);
+  }
+
+  /// A boolean double query as a floating-point filter: the float GJK (twice the lanes per register) answers every
+  /// pair, a double certificate (Source::certify_chunk()) accepts the answer or sends the pair to the double GJK
+  /// (then it has the plain double run's status, collide and direction, and the iterations of both passes).
+  /// Every answer is thus proven by a double-precision test as strong as the double GJK's own stopping test: the
+  /// collide bits are the double GJK's wherever that one's proof is not itself within rounding of touching. An
+  /// accepted answer's direction is the float pass's last search direction and its iterations the float pass's.
+  /// The same bits on every instruction set and thread count (each lane's float run, certificate and double run
+  /// are per-lane operations in a fixed order).
+  static std::size_t run_certified(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                                   std::size_t n, const QueryOptions& options, const ResultView& out,
+                                   std::uint32_t* fallback) {
+    thread_local std::vector<FloatAnswer> answers;
+    thread_local std::vector<std::uint32_t> rejected;
+    answers.assign(n, FloatAnswer{});
+    rejected.resize(n);
+    WideGjkPairs<float>::run_float_answers(in, type_a, type_b, pairs, n, options, out, rejected.data(),
+                                           answers.data());
+    Lanes L, check;
+    L.A.type = check.A.type = type_a;
+    L.B.type = check.B.type = type_b;
+    typename G::Rows rows, check_rows;
+    rows.attach(L.A, L.B);
+    check_rows.attach(check.A, check.B);
+    Source source{in, options, type_a, type_b, pairs, n, out, fallback};
+    source.answers = answers.data();
+    source.check = &check;
+    source.start_run(L);
+    G::drive_boolean(L, source, options.solver);
     return source.fallbacks;
   }
 };
