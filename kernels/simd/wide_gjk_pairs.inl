@@ -568,8 +568,12 @@ template <class T> struct WideGjkPairs {
   /// AVX-512: box-cylinder 366 -> 222 ns/pair, cone-cone 332 -> 220, convex8 301 -> 278; but capsule-box
   /// 143 -> 206 and ellipsoid-ellipsoid 194 -> 182 with +10% instructions (1184 -> 1298, callgrind AVX2): cheap
   /// supports gain little from wider lanes). Capsule, sphere and ellipsoid groups keep the double GJK.
+  /// Convex hulls are left out as well (measured at 34aca43 against main, boolean double, AVX-512, 2 threads,
+  /// ns/pair: convex8 close 103.8 -> 96.2 but overlap 96.5 -> 108.9 and distant 33 -> 61; convex250 close
+  /// 200 -> 195..220, overlap 271 -> 320: four double hull supports for an overlap certificate cost about what the
+  /// double GJK saves).
   static constexpr bool certified_pays(ShapeType t) {
-    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::convex;
+    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone;
   }
 
   /// The float pass of a certified boolean double run: every pair's float answer into answers[position]

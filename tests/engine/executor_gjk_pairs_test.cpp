@@ -163,7 +163,7 @@ PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& 
       const ShapeType type_a = s.shapes[b.shape_a[i]].type, type_b = s.shapes[b.shape_b[i]].type;
       // The types run_certified() takes (WideGjkPairs::certified_pays(), wide_gjk_pairs.inl).
       const auto pays = [](ShapeType t) {
-        return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::convex;
+        return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone;
       };
       if (certified && o.level == QueryLevel::boolean && !kernels::may_have_closed_form(type_a, type_b, o) &&
           pays(type_a) && pays(type_b)) {
