@@ -445,9 +445,12 @@ template <class T> struct WideGjkPairs {
         V[3] = -G::det3(p[0], p[1], p[2]);
         total = ((V[0] + V[1]) + V[2]) + V[3];
         // One vertex: its norm. (Two or three vertices, ended by |x| <= core margin in float, are left to the double
-        // GJK: the closest point of a segment or triangle computed here by project() gave other bits in the scalar
-        // build (W = 1, GCC 12 -O3) than in AVX2 and AVX-512 on the same inputs, and changed with unrelated code
-        // (a debug print): not explained in the time this had, so not used.)
+        // GJK: `x = pick(multi, project(p, s, cnt - 1, multi).x, x)` here left x = p[0] in the scalar build (W = 1,
+        // GCC 12, -O1 and -O3) for triangles whose project() answer is the face, on inputs bit-identical to AVX2's,
+        // deterministically (also under valgrind). memcheck (scalar and AVX2) and -fsanitize=undefined on
+        // isa_scalar.cpp (trapping) report nothing, -fno-strict-aliasing and -fno-tree-(slp-)vectorize do not
+        // change it, and a debug print of cnt and the masks before this line makes it go away. So a code-generation
+        // problem with the 1-lane vector types is suspected rather than a memory error; not reduced further.)
         const V3 x = p[0];
         xn = root(G::norm2(x));
       }
