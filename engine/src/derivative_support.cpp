@@ -6,7 +6,7 @@
 #include "kernels/support.hpp"
 #include "shape_table_access.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <emmintrin.h>  // SSE2: the x86-64 baseline this file is compiled for
 
 #include <algorithm>
 #include <cmath>
@@ -75,7 +75,84 @@ void triangle_feature(SupportJacobian& J, const std::array<Eigen::Vector3d, 3>& 
   }
 }
 
+/// Zeroes a_pq of a symmetric 3x3 by a Jacobi rotation in the (p, q) plane; r is the third index (a_rp, a_rq the
+/// entries it mixes). The smaller root t = tan(angle) of t^2 + 2 theta t - 1 = 0 (|angle| <= pi/4), overflow-safe
+/// for large theta.
+inline void jacobi_rotate(double& app, double& aqq, double& apq, double& arp, double& arq) {
+  if (apq == 0.0) return;
+  const double theta = (aqq - app) / (2.0 * apq), at = std::abs(theta);
+  const double t = std::copysign(at > 1e150 ? 0.5 / at : 1.0 / (at + std::sqrt(at * at + 1.0)), theta);
+  const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+  app -= t * apq;
+  aqq += t * apq;
+  apq = 0.0;
+  const double rp = arp, rq = arq;
+  arp = c * rp - s * rq;
+  arq = s * rp + c * rq;
+}
+
+/// The eigenvalues of symmetric A by cyclic Jacobi rotations (no eigenvectors: psd_projection() needs only the
+/// values), until the off-diagonal entries are below 1e-18 of the diagonal's (the eigenvalues then to rounding;
+/// 3x3 converges quadratically: ~3 sweeps). Only + - * / and sqrt, so the bits are the same on every machine and
+/// instruction set (libm's acos / cos of the closed-form cubic may differ by ISA variant).
+Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
+  double a00 = A(0, 0), a11 = A(1, 1), a22 = A(2, 2), a01 = A(0, 1), a02 = A(0, 2), a12 = A(1, 2);
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const double off = std::max(std::max(std::abs(a01), std::abs(a02)), std::abs(a12));
+    const double diagonal = std::max(std::max(std::abs(a00), std::abs(a11)), std::abs(a22));
+    if (!(off > 1e-18 * diagonal)) break;
+    jacobi_rotate(a00, a11, a01, a02, a12);  // (p, q, r) = (0, 1, 2)
+    jacobi_rotate(a00, a22, a02, a01, a12);  // (0, 2, 1)
+    jacobi_rotate(a11, a22, a12, a01, a02);  // (1, 2, 0)
+  }
+  return {a00, a11, a22};
+}
+
+/// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
+/// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.
+inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vector3d& d) {
+  if (!(radius > 0.0)) return;
+  const double n = d.norm();
+  if (n > 0.0) p += radius * d / n;
+}
+
 }  // namespace
+
+Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
+  // Positive definite by Sylvester's criterion (the leading minors): the projection is H itself. The common case
+  // on curved shapes at larger M, and no eigenvalues needed. Each minor must clear 1e-12 of the sum of its terms'
+  // magnitudes, far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by
+  // rounding alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+  const double a00 = H(0, 0), a11 = H(1, 1), a22 = H(2, 2), a01 = H(0, 1), a02 = H(0, 2), a12 = H(1, 2);
+  const double m2 = a00 * a11 - a01 * a01, m2_size = std::abs(a00 * a11) + a01 * a01;
+  const double c0 = a11 * a22 - a12 * a12, c1 = a01 * a22 - a12 * a02, c2 = a01 * a12 - a11 * a02;
+  const double det = a00 * c0 - a01 * c1 + a02 * c2;
+  const double det_size = std::abs(a00) * (std::abs(a11 * a22) + a12 * a12) +
+                          std::abs(a01) * (std::abs(a01 * a22) + std::abs(a12 * a02)) +
+                          std::abs(a02) * (std::abs(a01 * a12) + std::abs(a11 * a02));
+  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return H;
+  if (!H.allFinite()) return H;  // NaN in, NaN out (as the eigendecomposition did), no rotations on NaN
+  Eigen::Vector3d l = symmetric_eigenvalues(H);
+  // l0 >= l1 >= l2
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
+  if (l[2] > l[1]) std::swap(l[1], l[2]);
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
+  if (l[2] >= 0.0) return H;
+  if (l[0] <= 0.0) return Eigen::Matrix3d::Zero();
+  // With eigenvalues l_i and spectral projectors Q_i, Q_i = prod_{j != i} (H - l_j) / (l_i - l_j). One negative
+  // value: H - l2 Q2; two: l0 Q0. Both denominators are at least |the negative value| and the positive one, so an
+  // eigenvalue's rounding moves the result by about that rounding (no eigenvector, which would be ill-conditioned
+  // for close eigenvalues).
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  if (l[1] >= 0.0) {
+    const Eigen::Matrix3d Q = (H - l[0] * I) * (H - l[1] * I) / ((l[2] - l[0]) * (l[2] - l[1]));
+    Eigen::Matrix3d P = H - l[2] * Q;
+    return (0.5 * (P + P.transpose())).eval();
+  }
+  const Eigen::Matrix3d Q = (H - l[1] * I) * (H - l[2] * I) / ((l[0] - l[1]) * (l[0] - l[2]));
+  const Eigen::Matrix3d P = l[0] * Q;
+  return (0.5 * (P + P.transpose())).eval();
+}
 
 SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {
   SupportJacobian J;
@@ -255,8 +332,7 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
   const auto core = kernels::make_core<double>(view.view);
   kernels::SupportHint hint;
   Eigen::Vector3d p = kernels::support(core, u, hint);
-  const double n = u.norm();
-  if (core.radius > 0.0 && n > 0.0) p += core.radius * u / n;
+  add_swept_radius(p, core.radius, u);
   return p;
 }
 
@@ -268,49 +344,132 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d p = kernels::support(core, d, hint);
-    if (core.radius > 0.0) {  // the norm (a square root) only for a swept radius
-      const double n = d.norm();
-      if (n > 0.0) p += core.radius * d / n;
-    }
+    add_swept_radius(p, core.radius, d);
     return p;
   };
   const Eigen::Vector3d s0 = support(u);
   // gaussian_vector<4>(seed, pair, k, stream) for every antithetic pair k, drawn W at a time by the SIMD kernels
-  // (the same bits): one scalar draw cost ~375 instructions, more than the support call it feeds. Then the support
-  // points, then their sum: the support call clobbers every vector register, so a sum kept across it lived on the
-  // stack (~85 instructions per sample); each entry still adds (S_r - s0_r) z_c sample after sample.
+  // (the same bits): one scalar draw cost ~375 instructions, more than the support call it feeds. Then all the
+  // directions, then the support points, then their sums, each in its own loop: the support call clobbers every
+  // vector register, so whatever a loop around it kept (the noise, u, e, the sums) lived on the stack.
   const std::size_t draws = static_cast<std::size_t>(samples + 1) / 2;
+  const std::size_t n = static_cast<std::size_t>(samples), n4 = (n + 3) & ~std::size_t(3);
   thread_local std::vector<double> buffer;
-  if (buffer.size() < 4 * draws + 3 * static_cast<std::size_t>(samples))
-    buffer.resize(4 * draws + 3 * static_cast<std::size_t>(samples));
+  if (buffer.size() < 4 * draws + 3 * n4 + 3 * n) buffer.resize(4 * draws + 3 * n4 + 3 * n);
   double* const z[4] = {buffer.data(), buffer.data() + draws, buffer.data() + 2 * draws, buffer.data() + 3 * draws};
-  double* const q = buffer.data() + 4 * draws;  // S(u + e z_j) - s0, 3 per sample
+  double* const d[3] = {buffer.data() + 4 * draws, buffer.data() + 4 * draws + n4,
+                        buffer.data() + 4 * draws + 2 * n4};  // u + e z_j by coordinate, padded with zeros to 4
+  double* const q = buffer.data() + 4 * draws + 3 * n4;       // S(u + e z_j) - s0, 3 per sample
   kernels::simd::draw_gaussians4(isa, splitmix64(splitmix64(seed) ^ pair), stream, 0, draws, z);
-  for (int j = 0; j < samples; ++j) {
-    const std::size_t k = static_cast<std::size_t>(j / 2);
-    const double sign = j % 2 == 0 ? 1.0 : -1.0;
-    const Eigen::Vector3d zj(sign * z[0][k], sign * z[1][k], sign * z[2][k]);
-    const Eigen::Vector3d p = support(u + e * zj);
-    for (int r = 0; r < 3; ++r) q[3 * j + r] = p[r] - s0[r];
+  // Sample 2k adds e z_k, its antithetic copy 2k+1 subtracts it: u + e (-z) and u - e z are the same bits.
+  for (int c = 0; c < 3; ++c) {
+    const double uc = u[c];
+    double* dc = d[c];
+    for (std::size_t k = 0; k < draws; ++k) {  // an odd M's unused copy lands in the padding (n4 > n)
+      const double ez = e * z[c][k];
+      dc[2 * k] = uc + ez;
+      dc[2 * k + 1] = uc - ez;
+    }
+    std::fill(dc + n, dc + n4, 0.0);
   }
-  double s00 = 0, s01 = 0, s02 = 0, s10 = 0, s11 = 0, s12 = 0, s20 = 0, s21 = 0, s22 = 0;
-  for (int j = 0; j < samples; ++j) {
-    const std::size_t k = static_cast<std::size_t>(j / 2);
-    const double sign = j % 2 == 0 ? 1.0 : -1.0;
-    const double z0 = sign * z[0][k], z1 = sign * z[1][k], z2 = sign * z[2][k];
-    const double* qj = q + 3 * j;
-    s00 += qj[0] * z0, s01 += qj[0] * z1, s02 += qj[0] * z2;
-    s10 += qj[1] * z0, s11 += qj[1] * z1, s12 += qj[1] * z2;
-    s20 += qj[2] * z0, s21 += qj[2] * z1, s22 += qj[2] * z2;
+  if (shape.type == ShapeType::convex && !kernels::hull_climbs(view.hull) && view.hull.vertex_count > 0) {
+    // A scanned hull (kernels::hull_support's small-hull path): the same first maximum of the same dot products
+    // (hull_dot's expression in double), four directions at a time in two SSE2 registers instead of a call and a
+    // scalar scan per direction (~170 instructions per sample on an 8-vertex hull). max(di, best) is di > best ?
+    // di : best (best when either is NaN, as the scalar '>'). Intrinsics: GCC scalarised the vector-extension
+    // selects of this loop through the stack.
+    const double* v = view.hull.vertices;
+    const std::uint32_t count = view.hull.vertex_count;
+    // Each vertex's coordinates and index broadcast once per call (scanned hulls have < kHillClimbMinVertices = 32
+    // vertices when built by Shape::convex; a larger hull without blocks broadcasts in the loop).
+    constexpr std::uint32_t kKept = 32;
+    __m128d kept[4 * kKept];
+    const bool keep = count <= kKept;
+    if (keep) {
+      for (std::uint32_t i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) kept[4 * i + c] = _mm_set1_pd(v[3 * std::size_t(i) + c]);
+        kept[4 * i + 3] = _mm_set1_pd(double(i));
+      }
+    }
+    for (std::size_t j0 = 0; j0 < n4; j0 += 4) {
+      const __m128d x0 = _mm_loadu_pd(d[0] + j0), x1 = _mm_loadu_pd(d[0] + j0 + 2);
+      const __m128d y0 = _mm_loadu_pd(d[1] + j0), y1 = _mm_loadu_pd(d[1] + j0 + 2);
+      const __m128d w0 = _mm_loadu_pd(d[2] + j0), w1 = _mm_loadu_pd(d[2] + j0 + 2);
+      const auto dot = [&](const __m128d& px, const __m128d& py, const __m128d& pz, __m128d& a, __m128d& b) {
+        a = _mm_add_pd(_mm_add_pd(_mm_mul_pd(px, x0), _mm_mul_pd(py, y0)), _mm_mul_pd(pz, w0));
+        b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(px, x1), _mm_mul_pd(py, y1)), _mm_mul_pd(pz, w1));
+      };
+      __m128d best0, best1, index0 = _mm_setzero_pd(), index1 = _mm_setzero_pd();
+      dot(_mm_set1_pd(v[0]), _mm_set1_pd(v[1]), _mm_set1_pd(v[2]), best0, best1);
+      for (std::uint32_t i = 1; i < count; ++i) {
+        __m128d d0, d1, at;
+        if (keep) {
+          dot(kept[4 * i], kept[4 * i + 1], kept[4 * i + 2], d0, d1);
+          at = kept[4 * i + 3];
+        } else {
+          const double* p = v + 3 * std::size_t(i);
+          dot(_mm_set1_pd(p[0]), _mm_set1_pd(p[1]), _mm_set1_pd(p[2]), d0, d1);
+          at = _mm_set1_pd(double(i));
+        }
+        const __m128d above0 = _mm_cmpgt_pd(d0, best0), above1 = _mm_cmpgt_pd(d1, best1);
+        best0 = _mm_max_pd(d0, best0);
+        best1 = _mm_max_pd(d1, best1);
+        // index = above ? at : index, as index ^ (above & (index ^ at))
+        index0 = _mm_xor_pd(index0, _mm_and_pd(above0, _mm_xor_pd(index0, at)));
+        index1 = _mm_xor_pd(index1, _mm_and_pd(above1, _mm_xor_pd(index1, at)));
+      }
+      double index[4];
+      _mm_storeu_pd(index, index0);
+      _mm_storeu_pd(index + 2, index1);
+      const std::size_t lanes = std::min<std::size_t>(4, n - j0);
+      if (core.radius == 0.0) {
+        for (std::size_t l = 0; l < lanes; ++l) {
+          const double* p = v + 3 * static_cast<std::size_t>(index[l]);
+          double* qj = q + 3 * (j0 + l);
+          qj[0] = p[0] - s0[0], qj[1] = p[1] - s0[1], qj[2] = p[2] - s0[2];
+        }
+        continue;
+      }
+      for (std::size_t l = 0; l < lanes; ++l) {
+        const std::size_t j = j0 + l;
+        const double* p = v + 3 * static_cast<std::size_t>(index[l]);
+        Eigen::Vector3d point(p[0], p[1], p[2]);
+        add_swept_radius(point, core.radius, Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));  // as support()
+        for (int r = 0; r < 3; ++r) q[3 * j + r] = point[r] - s0[r];
+      }
+    }
+  } else {
+    for (std::size_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d p = support(Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));
+      for (int r = 0; r < 3; ++r) q[3 * j + r] = p[r] - s0[r];
+    }
   }
-  const double sum[3][3] = {{s00, s01, s02}, {s10, s11, s12}, {s20, s21, s22}};
+  // Each entry s_rc still adds (S_r - s0_r) z_c sample after sample, row r's three entries in one SSE2 pair and a
+  // scalar (q (-z) added is q z subtracted, exactly).
+  using V2 = double __attribute__((vector_size(16)));
+  V2 s01[3] = {}, s2v = {};
+  double s22 = 0.0;
+  const auto add = [&](const double* qj, const V2 z01, double z2v, bool minus) {
+    for (int r = 0; r < 3; ++r) {
+      const V2 t = qj[r] * z01;
+      s01[r] = minus ? s01[r] - t : s01[r] + t;
+    }
+    const V2 q01 = {qj[0], qj[1]}, t2 = q01 * z2v;
+    const double t22 = qj[2] * z2v;
+    s2v = minus ? s2v - t2 : s2v + t2;
+    s22 = minus ? s22 - t22 : s22 + t22;
+  };
+  for (std::size_t k = 0; k < draws; ++k) {
+    const V2 z01 = {z[0][k], z[1][k]};
+    add(q + 6 * k, z01, z[2][k], false);
+    if (2 * k + 1 < n) add(q + 6 * k + 3, z01, z[2][k], true);
+  }
+  const double sum[3][3] = {{s01[0][0], s01[0][1], s2v[0]}, {s01[1][0], s01[1][1], s2v[1]}, {s01[2][0], s01[2][1], s22}};
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
   H = (0.5 * (H + H.transpose())).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(H);
-  const Eigen::Vector3d clamped = eig.eigenvalues().cwiseMax(0.0);
-  return eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+  return psd_projection(H);
 }
 
 }  // namespace batchcol::detail

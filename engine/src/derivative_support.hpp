@@ -69,6 +69,11 @@ bool world_support_jacobian(const Shape& shape, const Eigen::Matrix3d& R, const 
 /// The full support point (core plus inflation radius) of `shape` at local direction u (not necessarily unit).
 Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
 
+/// The nearest symmetric positive semidefinite matrix to symmetric H (Frobenius norm): its eigenvalues clamped at
+/// 0. Computed from the eigenvalues alone (Jacobi rotations, then spectral projectors as polynomials in H), within
+/// rounding of the eigendecomposition's V max(L, 0) V^T.
+Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H);
+
 /// The smoothed support-map Jacobian at unit local direction u: 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with
 /// z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k} (the baseline S(u) cancels within a pair),
 /// symmetrised and projected onto the positive semidefinite cone (the Hessian of the smoothed convex support

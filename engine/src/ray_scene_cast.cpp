@@ -44,7 +44,9 @@ struct RayContext {
   Vec3<double> o, d, inv;  // inv: set by traverse() for the binary tree only
   double t_max, d2;  // d2 = |d|^2
   bool wide_ok;  // the float test of the wide tree is safe for this ray (else: the binary tree in double)
-  WideRay wide;
+  // The ray's entry in the caller's setup array, balls and prefetch already set (Caster::prepare()): not a copy,
+  // two copies of its 88 bytes cost ~30 instructions a ray.
+  const WideRay* wide = nullptr;
 };
 
 // Slab test of a float box (outward-rounded, so it contains the object with room to spare for this double
@@ -67,13 +69,26 @@ class Caster {
   Caster(const RaySceneIndex::State& s, const RayOptions& o)
       : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse()) {}
 
+  // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
+  // call, and on trees larger than the L2 pushed nodes are prefetched.
+  void prepare(WideRay* rays, std::size_t n) const {
+    const float* balls = s_.leaf_balls.data();
+    const bool prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
+    for (std::size_t l = 0; l < n; ++l) rays[l].balls = balls, rays[l].prefetch = prefetch;
+  }
+
   // Intersects one object; true on a hit with t <= t_max.
   bool test(const RayObject& obj, const RayContext& r, double t_max, Hit& hit, bool& capped) const {
     double ball_entry = kernels::quiet_nan<double>();
     if (ball_misses(obj, r, t_max, ball_entry)) return false;
     const Vec3<double> o = kernels::mul_transposed(obj.R, Vec3<double>(r.o - obj.t));
     const Vec3<double> d = kernels::mul_transposed(obj.R, r.d);
-    const kr::LocalHit<double> h = kr::ray_local(s_.prepared.shapes[obj.shape], o, d, t_max, gjk_, ball_entry);
+    // Uninflated hulls (the ball filter always passes them with an entry) go straight to the walk.
+    const kr::RayShape<double>& shape = s_.prepared.shapes[obj.shape];
+    const kr::LocalHit<double> h =
+        shape.core.type == ShapeType::convex && !(shape.inflation > 0.0) && ball_entry == ball_entry
+            ? kr::ray_local_hull(shape, o, d, t_max, ball_entry)
+            : kr::ray_local(shape, o, d, t_max, gjk_, ball_entry);
     capped = capped || h.status != kr::LocalStatus::converged;
     if (!h.hit) return false;
     hit = {h.t, kernels::mul(obj.R, h.normal), obj.handle};
@@ -109,10 +124,7 @@ class Caster {
         return true;
       };
       using Leaf = decltype(leaf);
-      WideRay w = r.wide;
-      w.balls = s_.leaf_balls.data();  // leaves whose ball the ray misses are skipped without a call
-      w.prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
-      wide_(s_.wide.nodes().data(), w, wide_limit(last),
+      wide_(s_.wide.nodes().data(), *r.wide, wide_limit(last),
             [](void* c, std::uint32_t k, float& lim) { return (*static_cast<Leaf*>(c))(k, lim); }, &leaf);
       return;
     }
@@ -183,7 +195,9 @@ class Caster {
     }
   }
 
-  void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found, bool& capped) const {
+  // Always inlined into the cast loops: with wide_limit() inline GCC otherwise made it a call (+80 instructions a ray).
+  [[gnu::always_inline]] void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found,
+                                             bool& capped) const {
     double limit = r.t_max;
     Hit h;
     for (const RayObject& obj : s_.halfspaces) {
@@ -368,6 +382,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
                 rows[6][l] = q.t_max;
               }
               setup(group, 0, m, wide, status);
+              caster.prepare(wide, m);
             }
             const PackedRay& p = order.ray(k);
             CastResult& res = results[k];
@@ -379,7 +394,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
             r.t_max = p.t_max;
             r.d2 = r.d.squaredNorm();
             r.wide_ok = status[lane] == kWideRaySupported;
-            if (r.wide_ok) r.wide = wide[lane];
+            r.wide = &wide[lane];
             bool capped = false;
             caster.closest_or_any(r, any, res.best, res.found, capped);
             res.status = capped ? RayStatus::max_iterations : RayStatus::ok;
@@ -405,7 +420,11 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
         for (std::size_t i = begin; i < end; ++i) {
           if (all) chunk_counts[c].push_back(0);
           const std::size_t lane = (i - begin) % kWideRaySetupLanes;
-          if (lane == 0) setup(input, i, std::min(kWideRaySetupLanes, end - i), wide, status);
+          if (lane == 0) {
+            const std::size_t m = std::min(kWideRaySetupLanes, end - i);
+            setup(input, i, m, wide, status);
+            caster.prepare(wide, m);
+          }
           if (status[lane] == kWideRayInvalid) continue;
           RayContext r;
           r.o = Vec3<double>(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]);
@@ -413,7 +432,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
           r.t_max = rays.t_max[i];
           r.d2 = r.d.squaredNorm();
           r.wide_ok = status[lane] == kWideRaySupported;
-          if (r.wide_ok) r.wide = wide[lane];
+          r.wide = &wide[lane];
           bool capped = false;
           if (all) {
             std::vector<Hit>& hits = chunk_hits[c];

@@ -110,7 +110,7 @@ void make_leaf_ball(const double c[3], double bound, float out[4]) {
   out[3] = bound > 0.0 && std::isfinite(radius) && radius < 0x1p100 ? std::max(round_up(radius), 0x1p-60f) : INFINITY;
 }
 
-float wide_limit(double t) { return round_up(t * double(kFarScale)); }
+float wide_limit_round_up(double x) { return round_up(x); }
 
 WideTraverse wide_traverse_for(int isa) {
   switch (isa) {

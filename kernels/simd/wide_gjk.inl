@@ -714,22 +714,33 @@ template <class T> struct WideGjk {
   /// Starts pair `p` in lane l: the reference's initialisation up to the first support point, which start()
   /// computes for all freshly refilled lanes at once.
   static void start_lane(Lanes& L, int l, const LaneStart& s, std::int64_t p) {
+    start_pose(L, l, s.R, s.t, s.A, s.B, p);
+    start_search(L, l, s.initial_direction, s, s.momentum, s.normalize);
+  }
+
+  /// start_lane() in two halves, also called by the smoothing samples' refill (wide_gjk_samples.inl), which has no
+  /// LaneStart to build: the pair, B's pose in A's frame and both sides; then the search from `init` (the x axis
+  /// when it is zero) with the pair's limits, `g` a LaneStart or a GjkLimits<T> (the same field names).
+  AI static void start_pose(Lanes& L, int l, const T* R, const T* t, const SideStart& A, const SideStart& B,
+                            std::int64_t p) {
     L.pair[l] = p;
-    for (int e = 0; e < 9; ++e) L.R[e][l] = s.R[e];
-    for (int i = 0; i < 3; ++i) L.t[i][l] = s.t[i];
-    load_side(L.A, s.A, l);
-    load_side(L.B, s.B, l);
-    Vec3<T> init = s.initial_direction;
+    for (int e = 0; e < 9; ++e) L.R[e][l] = R[e];
+    for (int i = 0; i < 3; ++i) L.t[i][l] = t[i];
+    load_side(L.A, A, l);
+    load_side(L.B, B, l);
+  }
+  template <class Limits>
+  AI static void start_search(Lanes& L, int l, Vec3<T> init, const Limits& g, bool momentum, bool normalize) {
     if (!(kernels::norm2(init) > T(0))) init = Vec3<T>::UnitX();
     reset_search(L, l, init);
-    L.max_iterations[l] = s.max_iterations;
-    L.momentum[l] = s.momentum ? -1 : 0;
-    L.normalize[l] = s.normalize ? -1 : 0;
-    L.boolean_only[l] = s.boolean_only ? -1 : 0;
-    L.tolerance[l] = s.tolerance;
-    L.relative[l] = s.relative;
-    L.touch[l] = s.touch;
-    L.core_margin[l] = s.core_margin;
+    L.max_iterations[l] = g.max_iterations;
+    L.momentum[l] = momentum ? -1 : 0;
+    L.normalize[l] = normalize ? -1 : 0;
+    L.boolean_only[l] = g.boolean_only ? -1 : 0;
+    L.tolerance[l] = g.tolerance;
+    L.relative[l] = g.relative;
+    L.touch[l] = g.touch;
+    L.core_margin[l] = g.core_margin;
   }
 
   /// The search state a lane starts every pair with, whatever the pair: the one-vertex simplex whose support

@@ -63,39 +63,29 @@ template <class T> struct WideGjkSamples {
     }
 
     /// setup_pair_into() and set_gjk_parameters() for the next sample (gjk_limits() from its own |t|, the warm
-    /// direction when finite and non-zero, else the centres' difference), then WideGjk's start_lane().
+    /// direction when finite and non-zero, else the centres' difference), then WideGjk::start_lane()'s two halves
+    /// straight into lane l: building a LaneStart and copying it in cost ~60 instructions per sample, a twentieth
+    /// of a warm-started sample.
     bool load(Lanes& L, int l) {
       if (next == in.samples) return false;
       const std::size_t s = next++;
       if (in.shape_a[s] != shape_a || in.shape_b[s] != shape_b) share(in.shape_a[s], in.shape_b[s]);
-      typename G::LaneStart q;
-      q.A = G::side_start(shared.core_a);
-      q.B = G::side_start(shared.core_b);
-      for (int e = 0; e < 9; ++e) q.R[e] = T(in.R[e][s]);
+      T R[9];
+      for (int e = 0; e < 9; ++e) R[e] = T(in.R[e][s]);
       const double tx = in.t[0][s], ty = in.t[1][s], tz = in.t[2][s];
-      q.t[0] = T(tx), q.t[1] = T(ty), q.t[2] = T(tz);
+      const T t[3] = {T(tx), T(ty), T(tz)};
+      G::start_pose(L, l, R, t, G::side_start(shared.core_a), G::side_start(shared.core_b), std::int64_t(s));
       const GjkLimits<T> g = gjk_limits<T>(shared.core_a.radius, shared.core_b.radius, shared.bounding_a, shared.bounding_b,
                                            std::sqrt((tx * tx + ty * ty) + tz * tz), options);
-      q.tolerance = g.tolerance;
-      q.relative = g.relative;
-      q.max_iterations = g.max_iterations;
-      q.momentum = options.solver != Solver::gjk;
-      q.normalize = normalize;
-      q.boolean_only = g.boolean_only;
-      q.core_margin = g.core_margin;
-      q.touch = g.touch;
-      const Vec3<T> warm(T(in.direction[0][s]), T(in.direction[1][s]), T(in.direction[2][s]));
-      if (warm.allFinite() && warm.squaredNorm() > T(0)) {
-        q.initial_direction = warm;
-      } else {  // MinkowskiDifference::center(): A's centre minus B's mapped into A's frame
-        const Vec3<T>& cb = shared.center_b;
-        const T* R = q.R;
-        const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + q.t[0],
-                               (R[3] * cb.x() + R[4] * cb.y()) + R[5] * cb.z() + q.t[1],
-                               (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + q.t[2]);
-        q.initial_direction = shared.center_a - b_center;
+      Vec3<T> init(T(in.direction[0][s]), T(in.direction[1][s]), T(in.direction[2][s]));
+      if (!(init.allFinite() && init.squaredNorm() > T(0))) {  // MinkowskiDifference::center(): A's centre minus B's
+        const Vec3<T>& cb = shared.center_b;                   // mapped into A's frame
+        const Vec3<T> b_center((R[0] * cb.x() + R[1] * cb.y()) + R[2] * cb.z() + t[0],
+                               (R[3] * cb.x() + R[4] * cb.y()) + R[5] * cb.z() + t[1],
+                               (R[6] * cb.x() + R[7] * cb.y()) + R[8] * cb.z() + t[2]);
+        init = shared.center_a - b_center;
       }
-      G::start_lane(L, l, q, std::int64_t(s));
+      G::start_search(L, l, init, g, options.solver != Solver::gjk, normalize);
       sample[l] = std::uint32_t(s);
       completion[l] = {shared.core_a.radius, shared.core_b.radius, g.radii, g.scale, g.floor, g.tolerance, g.core_margin};
       return true;

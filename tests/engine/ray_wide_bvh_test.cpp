@@ -302,6 +302,31 @@ TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {
   EXPECT_EQ(wide_limit(INFINITY), INFINITY);
 }
 
+// wide_limit()'s branch-free rounding for limits >= 0 (the bit pattern plus one) gives round_up()'s bits: at float
+// values and just beside them (where the conversion is exact or rounds either way), at 0, subnormals, the float
+// range's top (FLT_MAX -> +inf) and on random magnitudes; negative and NaN limits take round_up() itself.
+TEST(RayWideBvh, BranchFreeLimitGivesTheRoundUpBits) {
+  const auto bits = [](float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+  };
+  std::vector<double> limits = {0.0, -0.0, 0x1p-149, 0x1p-140, 1e-300, 1.0, 0.1, 3e38, 0x1.fffffep127, 1e39,
+                                INFINITY, -1.0, -0x1p-149};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> exponent(-150.0, 130.0), unit(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double t = std::exp2(exponent(rng)) * (1.0 + unit(rng));
+    const float f = static_cast<float>(t / double(kFarScale));
+    limits.insert(limits.end(), {t, double(f) / double(kFarScale), std::nextafter(double(f), 0.0) / double(kFarScale)});
+  }
+  for (double t : limits) {
+    const float expected = wide_limit_round_up(t * double(kFarScale));
+    ASSERT_EQ(bits(wide_limit(t)), bits(expected)) << "t = " << t;
+  }
+  EXPECT_TRUE(std::isnan(wide_limit(NAN)));
+}
+
 // The SIMD setup of 8 rays at once (WideRaySetup, used by RaySceneIndex::cast) gives every ray the status of the
 // scalar ray_is_valid() / wide_ray_supported() and, when supported, make_wide_ray()'s fields bit for bit, on every
 // instruction set and for partial groups: random rays, and the cases where the rounding or the sign decides (origins

@@ -1,0 +1,68 @@
+// smoothed1's projection of the symmetrised support Jacobian estimate on the PSD cone (psd_projection(), from
+// eigenvalues alone) against Eigen's eigendecomposition V max(L, 0) V^T, which it replaced.
+#include "derivative_support.hpp"  // engine/src
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace batchcol::testing {
+namespace {
+
+Eigen::Matrix3d reference(const Eigen::Matrix3d& H) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(H);
+  const Eigen::Vector3d clamped = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// Symmetric matrices with chosen eigenvalues (signs, repeats, zeros, spreads of 1e-12 .. 1e12) in random frames.
+TEST(DerivativesPsdProjection, MatchesTheEigendecomposition) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double pick[] = {0.0, 1.0, -1.0, 2.0, -3.0, 1e-12, -1e-12, 1e6, -1e6, 0.5, -0.5};
+  double worst = 0.0;
+  int cases = 0, negative = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    Eigen::Vector3d l;
+    for (int k = 0; k < 3; ++k)
+      l[k] = trial % 3 == 0 ? pick[rng() % (sizeof pick / sizeof pick[0])] : unit(rng) * std::pow(10.0, 3 * unit(rng));
+    const Eigen::Quaterniond q(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+    const Eigen::Matrix3d R = q.toRotationMatrix();
+    Eigen::Matrix3d H = R * l.asDiagonal() * R.transpose();
+    H = (0.5 * (H + H.transpose())).eval();
+    if (trial % 7 == 0) {  // plain random symmetric entries too
+      for (int r = 0; r < 3; ++r)
+        for (int c = r; c < 3; ++c) H(r, c) = H(c, r) = unit(rng);
+    }
+    const Eigen::Matrix3d P = detail::psd_projection(H), E = reference(H);
+    const double scale = H.norm();
+    ASSERT_TRUE(P.allFinite());
+    EXPECT_EQ(P, P.transpose());
+    const double error = scale > 0.0 ? (P - E).norm() / scale : (P - E).norm();
+    worst = std::max(worst, error);
+    EXPECT_LE(error, 1e-13) << "H =\n" << H;
+    // PSD: no eigenvalue below rounding.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> check(P);
+    EXPECT_GE(check.eigenvalues().minCoeff(), -1e-13 * scale);
+    ++cases;
+    negative += reference(H).isApprox(H, 1e-12) ? 0 : 1;
+  }
+  std::printf("psd_projection vs eigendecomposition: %d matrices (%d with a negative eigenvalue), max |P - E| / |H| "
+              "%.2e\n", cases, negative, worst);
+  EXPECT_GT(negative, cases / 4);
+}
+
+TEST(DerivativesPsdProjection, KeepsNanAndSpecialCases) {
+  EXPECT_EQ(detail::psd_projection(Eigen::Matrix3d::Zero()), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(detail::psd_projection(-Eigen::Matrix3d::Identity()), Eigen::Matrix3d::Zero());
+  const Eigen::Matrix3d D = Eigen::Vector3d(2.0, 0.0, -1.0).asDiagonal();
+  EXPECT_EQ(detail::psd_projection(D), Eigen::Matrix3d(Eigen::Vector3d(2.0, 0.0, 0.0).asDiagonal()));
+  Eigen::Matrix3d N = Eigen::Matrix3d::Identity();
+  N(0, 1) = N(1, 0) = std::nan("");
+  EXPECT_TRUE(detail::psd_projection(N).hasNaN());
+}
+
+}  // namespace
+}  // namespace batchcol::testing
