@@ -9,20 +9,6 @@
 //
 // No include guard: included once per instruction set by isa_body.inl, after wide_gjk.inl and wide_pairs.inl.
 
-/// A boolean double query's float pass (WideGjkPairs<double>::run_certified()): what the float GJK answered for
-/// the pair at one position of the run's pair list, and what its double certificate needs. kind 0: no answer to
-/// certify (not run: invalid input; or ended otherwise than separated / overlapping: budget, convergence, stall),
-/// 1: separated along `direction` (the last search direction d, whose support point -d proved it), 2: the
-/// cores overlap or are within the margin, with the `count` simplex vertices being D's support points in the
-/// directions -vertex[m] (in simplex order).
-struct FloatAnswer {
-  std::uint8_t kind = 0;
-  std::uint8_t count = 0;
-  std::int32_t iterations = 0;
-  float direction[3] = {};
-  float vertex[4][3] = {};
-};
-
 template <class T> struct WideGjkPairs {
   using G = WideGjk<T>;
   using Lanes = typename G::Lanes;
@@ -39,17 +25,20 @@ template <class T> struct WideGjkPairs {
   /// row of copies instead of per-pair scalar arithmetic (the setup was a third of a boolean ellipsoid pair's
   /// instructions). Slots of invalid pairs are computed too (their lanes read shape 0) but never loaded: `left`
   /// holds the valid slots not yet loaded. Written before read: fill_chunk() writes slots [0, count).
-  struct Chunk {
-    static_assert(kChunk % std::size_t(Wd) == 0 && kChunk <= 64, "whole registers per chunk, one bit per slot");
+  template <std::size_t N> struct Slots {
+    static_assert(N % std::size_t(Wd) == 0 && N % 64 == 0, "whole registers per array, whole words of bits");
     // B's pose in A's frame (R row-major, rounded to T as start_lane() took them), A's world pose for the output.
-    T R[9][kChunk], t[3][kChunk];
-    double Ra[9][kChunk], ta[3][kChunk];
-    std::uint32_t pair[kChunk];
-    std::int64_t shape_a[kChunk], shape_b[kChunk];  // for the hull views
+    T R[9][N], t[3][N];
+    double Ra[9][N], ta[3][N];
+    std::uint32_t pair[N];
+    std::int64_t shape_a[N], shape_b[N];  // for the hull views
     // make_core()'s parameters, gjk_limits(), the first direction.
-    T size_a[3][kChunk], size_b[3][kChunk], radius_a[kChunk], radius_b[kChunk];
-    T radii[kChunk], scale[kChunk], floor[kChunk], tolerance[kChunk], core_margin[kChunk];
-    T init[3][kChunk];
+    T size_a[3][N], size_b[3][N], radius_a[N], radius_b[N];
+    T radii[N], scale[N], floor[N], tolerance[N], core_margin[N];
+    T init[3][N];
+  };
+  struct Chunk : Slots<kChunk> {
+    static_assert(kChunk <= 64, "one bit per slot");
     std::uint64_t left = 0;
   };
 
@@ -65,8 +54,6 @@ template <class T> struct WideGjkPairs {
     d4 Ra[3] = {};  // A's world rotation by columns (lane 3 stays 0)
     d4 ta = {};     // only at QueryLevel::witness (the only level that writes world points)
     T radius_a, radius_b, radii, scale;
-    std::uint32_t position = 0;  // index in the run's pair list (certified runs: the float answer's slot)
-    std::int32_t float_iterations = 0;  // certified runs: the float pass's iterations, added to the double's
 
     /// dst[c][i] = component c of R v (+ t with `translate`) for v in A's frame: write_pair_output()'s
     /// mul<double>(Ra, v) (+ ta). (No d4 by value: the scalar build has no AVX, and -Wpsabi warns of the ABI.)
@@ -146,12 +133,6 @@ template <class T> struct WideGjkPairs {
     Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
     Chunk chunk;
     LanePair lane[W];  // written by load() before done() reads it
-    std::size_t base = 0;  // the chunk's slot 0 is pairs[base]
-    /// Certified boolean double runs (run_certified()): the float pass writes `record` (float Source), the double
-    /// pass reads `answers` and certifies them in `check`'s lanes before any GJK (double Source).
-    FloatAnswer* record = nullptr;
-    const FloatAnswer* answers = nullptr;
-    Lanes* check = nullptr;
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
     // would zero the chunk's ~25 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs
@@ -176,12 +157,19 @@ template <class T> struct WideGjkPairs {
     /// operations.
     void fill_chunk() {
       chunk.left = 0;
-      base = read;
       const std::size_t end = std::min(n, read + kChunk);
+      fill_slots(chunk, read, end, [&](std::size_t s, std::uint32_t valid) { chunk.left |= std::uint64_t(valid) << s; });
+      read = end;
+    }
+    /// fill_chunk()'s values of pairs[first .. end) into slots [0, end - first) of `chunk` (end - first <= N), Wd
+    /// slots per register (the last register's lanes past `end` repeat the last pair). mark(s, bits): the valid
+    /// pairs of the register at slot s; invalid pairs go to the fallback.
+    template <std::size_t N, class Mark>
+    void fill_slots(Slots<N>& chunk, std::size_t first, std::size_t end, const Mark& mark) {
       const T tolerance = T(options.tolerance), margin = T(options.margin);
-      for (std::size_t k = read; k < end; k += Wd) {
-        const std::size_t s = k - read;  // a multiple of Wd: whole registers stay inside the chunk
-        const auto b = P::block(pairs + read, end - read, s);
+      for (std::size_t k = first; k < end; k += Wd) {
+        const std::size_t s = k - first;  // a multiple of Wd: whole registers stay inside the slots
+        const auto b = P::block(pairs + first, end - first, s);
         P::Pose pa = load(b, true), pb = load(b, false);
         P::normalize(pa);
         P::normalize(pb);
@@ -229,11 +217,10 @@ template <class T> struct WideGjkPairs {
         put(chunk.init[2] + s, nonzero ? init[2] : splat_t(T(0)));
 
         const std::uint32_t valid = lane_bits(pa.valid & pb.valid) & b.live;
-        chunk.left |= std::uint64_t(valid) << s;
+        mark(s, valid);
         for (std::uint32_t bad = b.live & ~valid; bad != 0; bad &= bad - 1)
           fallback[fallbacks++] = b.idx[__builtin_ctz(bad)];
       }
-      read = end;
     }
     P::Pose load(const typename P::Block& b, bool side_a) const {
       return P::load_pose(in, side_a ? in.shape_a : in.shape_b, side_a ? in.translation_a : in.translation_b,
@@ -246,7 +233,6 @@ template <class T> struct WideGjkPairs {
       while (chunk.left == 0) {
         if (read == n) return false;
         fill_chunk();
-        if (answers) certify_chunk();
       }
       const std::size_t s = std::size_t(__builtin_ctzll(chunk.left));
       chunk.left &= chunk.left - 1;
@@ -272,13 +258,12 @@ template <class T> struct WideGjkPairs {
       lp.radius_b = c.radius_b[s];
       lp.radii = c.radii[s];
       lp.scale = c.scale[s];
-      lp.position = std::uint32_t(base + s);
-      if (answers) lp.float_iterations = answers[base + s].iterations;
       return true;
     }
     /// Slot s of one side into lane l, as load_side() takes it: the sizes of the types that have them (the
     /// support of the others reads none), the hull of a convex core. (No triangle: its pairs are not run here.)
-    void side(typename G::Side& side, const T (&size)[3][kChunk], const std::int64_t* shape, std::size_t s,
+    template <std::size_t N>
+    void side(typename G::Side& side, const T (&size)[3][N], const std::int64_t* shape, std::size_t s,
               int l) const {
       switch (side.type) {
         case ShapeType::sphere: return;
@@ -295,17 +280,6 @@ template <class T> struct WideGjkPairs {
     /// complete_pair() and write_pair_output() for lane l's pair; a pair complete_from_gjk() cannot finish goes to
     /// the fallback (computed again on the scalar path).
     void done(const Lanes& L, int l, GjkStatus status) {
-      if (record) {
-        keep(L, l, status);
-        return;
-      }
-      // A certified run's double GJK (the certificate failed or there was none): its iterations plus the float
-      // pass's, the work done for the pair. (A pair this path leaves to the scalar fallback reports the scalar
-      // path's iterations alone.)
-      if (finish_pair(L, l, status) && answers) out.iterations[lane[l].pair] += lane[l].float_iterations;
-    }
-    /// Lane l's answer into the result arrays; false when the pair went to the fallback instead.
-    bool finish_pair(const Lanes& L, int l, GjkStatus status) {
       if (status == GjkStatus::separated_proven || status == GjkStatus::collision_proven) {
         // A boolean query's usual ending: complete_from_gjk() and write_pair_output() reduce to a converged pair
         // whose collide is decided, its world direction and its iterations (the same arithmetic), without a
@@ -316,15 +290,15 @@ template <class T> struct WideGjkPairs {
         out.collide[i] = status == GjkStatus::collision_proven ? 1 : 0;
         lp.put_world(out.direction, i, G::get_lane(L.direction, l), false);
         out.iterations[i] = int(L.k[l]);
-        return true;
+        return;
       }
       if (status == GjkStatus::converged || status == GjkStatus::max_iterations) {
         converged(L, l, status);
-        return true;
+        return;
       }
       if (status == GjkStatus::overlap && options.level != QueryLevel::penetration) {  // penetration: EPA below
         overlapping(L, l);
-        return true;
+        return;
       }
       GjkResult<T> g;
       G::finish(L, l, status, g, witness);
@@ -335,156 +309,10 @@ template <class T> struct WideGjkPairs {
       PairOutput<T> r;
       if (!complete_from_gjk(completion, g, options, r)) {
         fallback[fallbacks++] = lp.pair;
-        return false;
+        return;
       }
       const Eigen::Vector3d ta(lp.ta[0], lp.ta[1], lp.ta[2]);
       write_pair_output(r, lp.rotation(), ta, lp.pair, options.level, out);
-      return true;
-    }
-
-    /// The float pass of a certified run: lane l's answer into record[position] (drive_boolean_directions():
-    /// vertex m's direction is in L.a[L.slot[m]]). Separated and overlapping answers are kept for the double
-    /// certificate; any other ending (budget, convergence, stall) leaves kind 0: the double GJK decides.
-    void keep(const Lanes& L, int l, GjkStatus status) {
-      FloatAnswer& r = record[lane[l].position];
-      r.iterations = std::int32_t(L.k[l]);
-      const bool separated = status == GjkStatus::separated_proven;
-      const bool overlapping = status == GjkStatus::collision_proven || status == GjkStatus::overlap;
-      r.kind = separated ? 1 : overlapping ? 2 : 0;
-      const Vec3<T> d = G::get_lane(L.direction, l);
-      for (int c = 0; c < 3; ++c) r.direction[c] = float(d[c]);
-      if (!overlapping) return;
-      r.count = std::uint8_t(L.count[l]);
-      for (int m = 0; m < int(r.count); ++m) {
-        const Vec3<T> v = G::get_lane(L.a[int(L.slot[m][l]) & 3], l);
-        for (int c = 0; c < 3; ++c) r.vertex[m][c] = float(v[c]);
-      }
-    }
-
-    /// The certificates of the chunk's float answers, W pairs at a time in `check`'s lanes (double): a pair whose
-    /// certificate holds gets its answer here and leaves chunk.left; the others stay for the double GJK.
-    ///  - separated along d: w = D.support(-d) in double (d widened), accepted iff <w, d> / |d| > core margin,
-    ///    the double GJK's own test that ends a separated boolean pair (ends_separated);
-    ///  - overlapping: the simplex's vertices computed again in double (D.support(-v_m)), the origin projected on
-    ///    their hull with project() (the double GJK's projection), accepted iff the tetrahedron contains the
-    ///    origin or the projection's norm is <= max(core margin, touch): the double GJK's ends_contains,
-    ///    ends_collision and ends_overlap tests.
-    /// The certificate's support points are points of the double problem's Minkowski difference, so an accepted
-    /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
-    /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
-    /// the float pass's.
-    void certify_chunk() {
-      std::uint64_t todo = 0;
-      for (std::uint64_t bits = chunk.left; bits != 0; bits &= bits - 1) {
-        const int s = __builtin_ctzll(bits);
-        if (answers[base + std::size_t(s)].kind != 0) todo |= std::uint64_t(1) << s;
-      }
-      while (todo != 0) {
-        int slot[W];
-        int lanes = 0;
-        for (; lanes < W && todo != 0; todo &= todo - 1) slot[lanes++] = __builtin_ctzll(todo);
-        certify_lanes(slot, lanes);
-      }
-    }
-    /// The square root lane by lane (correctly rounded: wsqrt()'s bits). GCC 12 reports its own _mm512_sqrt_pd's
-    /// `__m512d __Y = __Y` (bug 105593) as -Wuninitialized on the vectors built lane by lane here, which
-    /// -Wno-maybe-uninitialized (kernels/CMakeLists.txt) does not cover.
-    static typename G::real root(typename G::real a) {
-      for (int l = 0; l < W; ++l) a[l] = std::sqrt(a[l]);
-      return a;
-    }
-    void certify_lanes(const int* slot, int lanes) {
-      Lanes& C = *check;
-      using V3 = typename G::V3;
-      const Chunk& c = chunk;
-      std::uint32_t live = 0, sep_bits = 0;
-      typename G::Int count[W] = {};
-      V3 v[4];
-      for (int m = 0; m < 4; ++m) v[m] = {G::splat(T(1)), G::splat(T(0)), G::splat(T(0))};
-      for (int l = 0; l < lanes; ++l) {
-        const std::size_t s = std::size_t(slot[l]);
-        const FloatAnswer& a = answers[base + s];
-        live |= 1u << l;
-        for (int e = 0; e < 9; ++e) C.R[e][l] = c.R[e][s];
-        for (int i = 0; i < 3; ++i) C.t[i][l] = c.t[i][s];
-        side(C.A, c.size_a, c.shape_a, s, l);
-        side(C.B, c.size_b, c.shape_b, s, l);
-        C.core_margin[l] = c.core_margin[s];
-        C.touch[l] = c.floor[s];
-        if (a.kind == 1) {
-          sep_bits |= 1u << l;
-          count[l] = 1;
-          G::set_lane(v[0], l, Vec3<T>(T(a.direction[0]), T(a.direction[1]), T(a.direction[2])));
-        } else {
-          count[l] = a.count;
-          for (int m = 0; m < int(a.count); ++m)
-            G::set_lane(v[m], l, Vec3<T>(T(a.vertex[m][0]), T(a.vertex[m][1]), T(a.vertex[m][2])));
-        }
-      }
-      // One vector load of the counts. (Built lane by lane into an unset vector, the scalar build (W = 1, GCC 12
-      // -O3) read counts that were not these, lane masks of them false, in the first runs of a process: the
-      // certificates of AVX2 and AVX-512 failed there. Not explained in the time this had.)
-      static_assert(sizeof(typename G::mask) == sizeof count, "one count per lane");
-      typename G::mask cnt;
-      std::memcpy(&cnt, count, sizeof cnt);
-      const typename G::mask sep = G::lanes_of(sep_bits), in = G::lanes_of(live);
-      V3 p[4], sa, sb;
-      G::minkowski(C, G::neg(v[0]), live, p[0], sa, sb);
-      // Separated: the double GJK's ends_separated test along d.
-      const typename G::real lb = G::dot(p[0], v[0]) / root(G::norm2(v[0]));
-      const typename G::mask over = in & ~sep;
-      typename G::real V[4] = {}, total{}, xn{};
-      if (any(over)) {
-        for (int m = 1; m < 4; ++m) {
-          const std::uint32_t need = lane_bits(over & (cnt > G::splat_mask(m)));
-          p[m] = p[0];
-          if (need) G::minkowski(C, G::neg(v[m]), need, p[m], sa, sb);
-        }
-        // Four vertices: tetrahedron()'s signed volumes (project()'s operations), for its containment test below.
-        V[0] = G::det3(p[1], p[2], p[3]), V[1] = -G::det3(p[0], p[2], p[3]), V[2] = G::det3(p[0], p[1], p[3]),
-        V[3] = -G::det3(p[0], p[1], p[2]);
-        total = ((V[0] + V[1]) + V[2]) + V[3];
-        // One vertex: its norm. (Two or three vertices, ended by |x| <= core margin in float, are left to the double
-        // GJK: `x = pick(multi, project(p, s, cnt - 1, multi).x, x)` here left x = p[0] in the scalar build (W = 1,
-        // GCC 12, -O1 and -O3) for triangles whose project() answer is the face, on inputs bit-identical to AVX2's,
-        // deterministically (also under valgrind). memcheck (scalar and AVX2) and -fsanitize=undefined on
-        // isa_scalar.cpp (trapping) report nothing, -fno-strict-aliasing and -fno-tree-(slp-)vectorize do not
-        // change it, and a debug print of cnt and the masks before this line makes it go away. So a code-generation
-        // problem with the 1-lane vector types is suspected rather than a memory error; not reduced further.)
-        const V3 x = p[0];
-        xn = root(G::norm2(x));
-      }
-      // The decision lane by lane, in plain scalars (the same tests as the double GJK's, on the same values).
-      bool ok[W] = {};
-      for (int l = 0; l < lanes; ++l) {
-        if (sep_bits >> l & 1u) {
-          ok[l] = lb[l] > C.core_margin[l];
-        } else if (count[l] == 4) {
-          // tetrahedron()'s inside: total != 0 and no volume of the opposite sign (project()'s opposite_sign()).
-          const T t = total[l];
-          bool inside = t != T(0);
-          for (int m = 0; m < 4; ++m) inside = inside && !((V[m][l] > T(0) && t < T(0)) || (V[m][l] < T(0) && t > T(0)));
-          ok[l] = inside;
-        } else if (count[l] == 1) {
-          // The double GJK's ends_collision (|x| <= core margin) and ends_overlap (|x| <= touch) tests.
-          const T cm = C.core_margin[l], touch = C.touch[l];
-          ok[l] = xn[l] <= (cm < touch ? touch : cm);
-        }
-      }
-      for (int l = 0; l < lanes; ++l) {
-        if (!ok[l]) continue;
-        const std::size_t s = std::size_t(slot[l]);
-        const FloatAnswer& a = answers[base + s];
-        const std::uint32_t i = c.pair[s];
-        LanePair lp;
-        for (int r = 0; r < 3; ++r)
-          for (int j = 0; j < 3; ++j) lp.Ra[j][r] = c.Ra[3 * r + j][s];
-        out.status[i] = Status::converged;
-        out.collide[i] = a.kind == 1 ? 0 : 1;
-        lp.put_world(out.direction, i, Vec3<T>(T(a.direction[0]), T(a.direction[1]), T(a.direction[2])), false);
-        out.iterations[i] = a.iterations;
-        chunk.left &= ~(std::uint64_t(1) << s);
-      }
     }
 
     /// A distance / witness query's usual ending (GJK converged, or its budget ran out with x away from the
@@ -554,6 +382,13 @@ template <class T> struct WideGjkPairs {
     if constexpr (std::is_same_v<T, double>)
       if (options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b))
         return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
+    return run_plain(in, type_a, type_b, pairs, n, options, out, fallback);
+  }
+  /// Every pair through the GJK of precision T (a certified run's refused pairs too).
+  static std::size_t run_plain(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                               std::size_t n, const QueryOptions& options, const ResultView& out,
+                               std::uint32_t* fallback) {
+    if (n == 0) return 0;
     Lanes L;
     L.A.type = type_a;
     L.B.type = type_b;
@@ -566,64 +401,268 @@ template <class T> struct WideGjkPairs {
     return source.fallbacks;
   }
 
+  // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
+
   /// The types whose boolean double groups run_certified() answers: those whose float GJK saves more than the
-  /// certificate and the second setup cost (measured, boolean close double, 2 threads, same runs with Coal,
-  /// AVX-512: box-cylinder 366 -> 222 ns/pair, cone-cone 332 -> 220, convex8 301 -> 278; but capsule-box
-  /// 143 -> 206 and ellipsoid-ellipsoid 194 -> 182 with +10% instructions (1184 -> 1298, callgrind AVX2): cheap
-  /// supports gain little from wider lanes). Capsule, sphere and ellipsoid groups keep the double GJK.
-  /// Convex hulls are left out as well (measured at 34aca43 against main, boolean double, AVX-512, 2 threads,
-  /// ns/pair: convex8 close 103.8 -> 96.2 but overlap 96.5 -> 108.9 and distant 33 -> 61; convex250 close
-  /// 200 -> 195..220, overlap 271 -> 320: four double hull supports for an overlap certificate cost about what the
-  /// double GJK saves).
+  /// certificate costs (measured on fdbl, boolean close double, 2 threads, same runs with Coal, AVX-512:
+  /// box-cylinder 366 -> 222 ns/pair, cone-cone 332 -> 220; but capsule-box 143 -> 206 and ellipsoid-ellipsoid
+  /// 194 -> 182 with +10% instructions: cheap supports gain little from wider lanes; convex8 overlap 96.5 -> 108.9
+  /// and convex250 overlap 271 -> 320: four double hull supports per overlap certificate). Their cores are centred
+  /// at the origin (no hull centroid): FloatFeed::load() relies on it.
   static constexpr bool certified_pays(ShapeType t) {
     return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone;
   }
 
-  /// The float pass of a certified boolean double run: every pair's float answer into answers[position]
-  /// (kind 0 where none: answers must come zeroed). Pairs the float setup rejects are listed in `rejected`
-  /// (discarded: the double pass rejects them again).
-  static void run_float_answers(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
-                                std::size_t n, const QueryOptions& options, const ResultView& out,
-                                std::uint32_t* rejected, FloatAnswer* answers) {
-    Lanes L;
-    L.A.type = type_a;
-    L.B.type = type_b;
-    typename G::Rows rows;
-    rows.attach(L.A, L.B);
-    Source source{in, options, type_a, type_b, pairs, n, out, rejected};
-    source.record = answers;
-    source.start_run(L);
-    G::drive_boolean_directions(L, source, options.solver);
+  /// The pairs of a certified run go through its stages a block at a time: one double setup (fill_slots()) that
+  /// the gate, the float pass (converted) and the certificate all read, instead of a float and a double setup per
+  /// pair (fdbl: ~140 instructions each, AVX2). 256 pairs: ~110 KB (L2); the float lanes drain at a block's end.
+  static constexpr std::size_t kBlock = 256;
+  struct Block : Slots<kBlock> {
+    std::uint64_t valid[kBlock / 64];  // fill_slots()'s valid pairs, bit s = slot s
+    std::uint64_t alive[kBlock / 64];  // the gate's survivors, bit s = slot s
+    std::uint16_t list[kBlock];        // the same, by slot
+    /// The float pass's answer of each survivor, by slot. kind 0: none to certify (ended otherwise than
+    /// separated / overlapping: budget, convergence, stall), 1: separated along `direction` (the last search
+    /// direction d, whose support point -d proved it), 2: the cores overlap or are within the margin, with the
+    /// `count` simplex vertices being D's support points in the directions -vertex[m] (in simplex order).
+    std::uint8_t kind[kBlock], count[kBlock];
+    std::int32_t iterations[kBlock];
+    float direction[3][kBlock], vertex[4][3][kBlock];
+  };
+
+  typedef T unaligned_real __attribute__((vector_size(sizeof(T) * W), aligned(alignof(T))));
+  static typename G::real lanes_at(const T* p) { return *reinterpret_cast<const unaligned_real*>(p); }
+
+  /// Writes a certified run's own answers for the lanes `bits` of the register at slot s: converged, collide
+  /// (`collide` lanes), the direction d (in A's frame) mapped to the world as LanePair::put_world() maps it (the
+  /// same operations), the iterations.
+  static void answer(const Block& c, std::size_t s, std::uint32_t bits, std::uint32_t collide,
+                     const typename G::V3& d, const std::int32_t* iterations, const ResultView& out) {
+    typename G::real world[3];
+    for (int r = 0; r < 3; ++r)
+      world[r] = (lanes_at(c.Ra[3 * r] + s) * d.x + lanes_at(c.Ra[3 * r + 1] + s) * d.y) +
+                 lanes_at(c.Ra[3 * r + 2] + s) * d.z;
+    for (; bits != 0; bits &= bits - 1) {
+      const int l = __builtin_ctz(bits);
+      const std::uint32_t i = c.pair[s + std::size_t(l)];
+      out.status[i] = Status::converged;
+      out.collide[i] = std::uint8_t(collide >> l & 1u);
+      for (int r = 0; r < 3; ++r) out.direction[r][i] = world[r][l];
+      out.iterations[i] = iterations[l];
+    }
   }
 
-  /// A boolean double query as a floating-point filter: the float GJK (twice the lanes per register) answers every
-  /// pair, a double certificate (Source::certify_chunk()) accepts the answer or sends the pair to the double GJK
-  /// (then it has the plain double run's status, collide and direction, and the iterations of both passes).
-  /// Every answer is thus proven by a double-precision test as strong as the double GJK's own stopping test: the
-  /// collide bits are the double GJK's wherever that one's proof is not itself within rounding of touching. An
-  /// accepted answer's direction is the float pass's last search direction and its iterations the float pass's.
-  /// The same bits on every instruction set and thread count (each lane's float run, certificate and double run
-  /// are per-lane operations in a fixed order).
+  /// The gate, W pairs per register straight from the block's double setups: w = D.support(-d0) along the first
+  /// direction d0 (the centres' offset, start_lane()'s), and the double loop's own separation test on it,
+  /// <w, d0> / |d0| > core margin (ends_separated, the same operations). A pair that passes is separated, proven
+  /// in double like any separated answer of the double GJK: it is answered here (collide 0, direction d0, one
+  /// iteration) and runs neither GJK; the others are listed for the float pass. Distant pairs end here: one
+  /// Minkowski support per pair instead of the GJK's loop (box-cylinder distant: 511 -> 232 instructions a pair,
+  /// AVX2).
+  static std::size_t gate(Block& c, std::size_t count, Lanes& g, const ResultView& out) {
+    using V3 = typename G::V3;
+    std::size_t survivors = 0;
+    for (std::size_t s = 0; s < count; s += std::size_t(W)) {
+      const std::uint32_t bits = std::uint32_t(c.valid[s / 64] >> (s % 64)) & ((2u << (W - 1)) - 1u);
+      if (bits == 0) continue;
+      for (int e = 0; e < 9; ++e) g.R[e] = lanes_at(c.R[e] + s);
+      for (int i = 0; i < 3; ++i) g.t[i] = lanes_at(c.t[i] + s);
+      g.A.s0 = lanes_at(c.size_a[0] + s), g.A.s1 = lanes_at(c.size_a[1] + s), g.A.s2 = lanes_at(c.size_a[2] + s);
+      g.B.s0 = lanes_at(c.size_b[0] + s), g.B.s1 = lanes_at(c.size_b[1] + s), g.B.s2 = lanes_at(c.size_b[2] + s);
+      const V3 d = {lanes_at(c.init[0] + s), lanes_at(c.init[1] + s), lanes_at(c.init[2] + s)};
+      V3 w, sa, sb;
+      G::minkowski(g, G::neg(d), bits, w, sa, sb);
+      const typename G::real lb = G::dot(w, d) / G::norm(d);
+      const std::uint32_t separated = lane_bits(lb > lanes_at(c.core_margin + s)) & bits;
+      if (separated != 0) {
+        std::int32_t iterations[W];
+        for (int l = 0; l < W; ++l) iterations[l] = 1;
+        answer(c, s, separated, 0, d, iterations, out);
+      }
+      c.alive[s / 64] |= std::uint64_t(bits & ~separated) << (s % 64);
+      for (std::uint32_t k = bits & ~separated; k != 0; k &= k - 1)
+        c.list[survivors++] = std::uint16_t(s + std::size_t(__builtin_ctz(k)));
+    }
+    return survivors;
+  }
+
+  /// The float pass's pairs (WideGjk<float>'s Source): the gate's survivors of a block, each lane's float setup
+  /// converted from the block's double one, answers kept in the block by slot. The float setup's values are the
+  /// float fill_slots()'s bits: R, t, the sizes, the inflations and the scale are computed in double there too and
+  /// rounded once; the floor, tolerance, core margin and the zero test of the first direction are the same float
+  /// operations on them; and the first direction, -t in either precision for cores centred at the origin
+  /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
+  struct FloatFeed {
+    using F = WideGjk<float>;
+    Block& c;
+    std::size_t count;
+    float tolerance, margin;
+    typename F::Int momentum;
+    std::size_t next = 0;
+
+    bool load(typename F::Lanes& L, int l) {
+      if (next == count) return false;
+      const std::size_t s = c.list[next++];
+      L.pair[l] = std::int64_t(s);
+      for (int e = 0; e < 9; ++e) L.R[e][l] = float(c.R[e][s]);
+      for (int i = 0; i < 3; ++i) L.t[i][l] = float(c.t[i][s]);
+      L.A.s0[l] = float(c.size_a[0][s]), L.A.s1[l] = float(c.size_a[1][s]), L.A.s2[l] = float(c.size_a[2][s]);
+      L.B.s0[l] = float(c.size_b[0][s]), L.B.s1[l] = float(c.size_b[1][s]), L.B.s2[l] = float(c.size_b[2][s]);
+      Vec3<float> init(float(c.init[0][s]), float(c.init[1][s]), float(c.init[2][s]));
+      if (!((init.x() * init.x() + init.y() * init.y()) + init.z() * init.z() > 0.0f)) init = Vec3<float>::UnitX();
+      F::reset_search(L, l, init);
+      L.momentum[l] = momentum;
+      const float floor = (16.0f * machine_epsilon<float>()) * float(c.scale[s]);  // tolerance_floor(scale)
+      L.tolerance[l] = tolerance < floor ? floor : tolerance;
+      L.touch[l] = floor;
+      L.core_margin[l] = margin + (float(c.radius_a[s]) + float(c.radius_b[s]));
+      return true;
+    }
+    /// drive_boolean_directions(): vertex m's direction is in L.a[L.slot[m]]. Separated and overlapping answers
+    /// are kept for the certificate; any other ending (budget, convergence, stall) leaves kind 0.
+    void done(const typename F::Lanes& L, int l, GjkStatus status) {
+      const std::size_t s = std::size_t(L.pair[l]);
+      c.iterations[s] = std::int32_t(L.k[l]);
+      const bool separated = status == GjkStatus::separated_proven;
+      const bool overlapping = status == GjkStatus::collision_proven || status == GjkStatus::overlap;
+      c.kind[s] = separated ? 1 : overlapping ? 2 : 0;
+      c.direction[0][s] = L.direction.x[l], c.direction[1][s] = L.direction.y[l], c.direction[2][s] = L.direction.z[l];
+      c.count[s] = overlapping ? std::uint8_t(L.count[l]) : 0;
+      for (int m = 0; m < int(c.count[s]); ++m) {
+        const int q = int(L.slot[m][l]) & 3;
+        c.vertex[m][0][s] = L.a[q].x[l], c.vertex[m][1][s] = L.a[q].y[l], c.vertex[m][2][s] = L.a[q].z[l];
+      }
+    }
+  };
+
+  /// The certificates of the float answers of the survivors `bits` of the register at slot s, W pairs at a time in
+  /// C's double lanes, read straight from the block (vector loads; the float answers widened): an accepted answer
+  /// is written; a refused one (or kind 0) is appended to `refused` with its float iterations.
+  ///  - separated along d: w = D.support(-d) in double (d widened), accepted iff <w, d> / |d| > core margin,
+  ///    the double GJK's own test that ends a separated boolean pair (ends_separated);
+  ///  - overlapping with 4 vertices: the vertices computed again in double (D.support(-v_m)), accepted iff
+  ///    tetrahedron()'s signed volumes say it contains the origin (ends_contains); with one vertex: accepted iff
+  ///    its norm is <= max(core margin, touch) (ends_collision, ends_overlap). Two or three vertices are refused:
+  ///    on fdbl, their certificate through project() gave different bits in the scalar build (W = 1, GCC 12) than
+  ///    in AVX2 / AVX-512 on identical inputs (memcheck and -fsanitize=undefined found nothing; not root caused),
+  ///    so that form is not used.
+  /// The certificate's support points are points of the double problem's Minkowski difference, so an accepted
+  /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
+  /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
+  /// the float pass's.
+  static void certify(const Block& c, std::size_t s, std::uint32_t bits, Lanes& C, const ResultView& out,
+                      std::uint32_t* refused, std::int32_t* refused_iterations, std::size_t& refusals) {
+    using V3 = typename G::V3;
+    using real = typename G::real;
+    using mask = typename G::mask;
+    typedef float floats __attribute__((vector_size(sizeof(float) * W), aligned(alignof(float))));
+    const auto widened = [&](const float* p) { return __builtin_convertvector(*reinterpret_cast<const floats*>(p + s), real); };
+    std::uint32_t sep_bits = 0, four_bits = 0, one_bits = 0;
+    for (std::uint32_t k = bits; k != 0; k &= k - 1) {
+      const int l = __builtin_ctz(k);
+      const std::size_t q = s + std::size_t(l);
+      const std::uint32_t bit = 1u << l;
+      if (c.kind[q] == 1) sep_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 4) four_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 1) one_bits |= bit;
+    }
+    const std::uint32_t live = sep_bits | four_bits | one_bits;
+    std::uint32_t ok_bits = 0;
+    const V3 dir = {widened(c.direction[0]), widened(c.direction[1]), widened(c.direction[2])};
+    if (live != 0) {
+      for (int e = 0; e < 9; ++e) C.R[e] = lanes_at(c.R[e] + s);
+      for (int i = 0; i < 3; ++i) C.t[i] = lanes_at(c.t[i] + s);
+      C.A.s0 = lanes_at(c.size_a[0] + s), C.A.s1 = lanes_at(c.size_a[1] + s), C.A.s2 = lanes_at(c.size_a[2] + s);
+      C.B.s0 = lanes_at(c.size_b[0] + s), C.B.s1 = lanes_at(c.size_b[1] + s), C.B.s2 = lanes_at(c.size_b[2] + s);
+      const real cm = lanes_at(c.core_margin + s), touch = lanes_at(c.floor + s);
+      V3 v[4];
+      for (int m = 0; m < 4; ++m)
+        v[m] = {widened(c.vertex[m][0]), widened(c.vertex[m][1]), widened(c.vertex[m][2])};
+      const mask sep = G::lanes_of(sep_bits);
+      const V3 v0 = G::pick(sep, dir, v[0]);
+      V3 p[4], sa, sb;
+      G::minkowski(C, G::neg(v0), live, p[0], sa, sb);
+      // Separated: the double GJK's ends_separated test along d.
+      const real lb = G::dot(p[0], v0) / G::norm(v0);
+      ok_bits = lane_bits(lb > cm) & sep_bits;
+      if (one_bits != 0) {
+        // The double GJK's ends_collision (|x| <= core margin) and ends_overlap (|x| <= touch) tests.
+        ok_bits |= lane_bits(G::norm(p[0]) <= wmax(cm, touch)) & one_bits;
+      }
+      if (four_bits != 0) {
+        for (int m = 1; m < 4; ++m) G::minkowski(C, G::neg(v[m]), four_bits, p[m], sa, sb);
+        // tetrahedron()'s signed volumes (project()'s operations) and its inside test: total != 0 and no volume
+        // of the opposite sign (project()'s opposite_sign()).
+        const real V[4] = {G::det3(p[1], p[2], p[3]), -G::det3(p[0], p[2], p[3]), G::det3(p[0], p[1], p[3]),
+                           -G::det3(p[0], p[1], p[2])};
+        const real total = ((V[0] + V[1]) + V[2]) + V[3];
+        const real zero = G::splat(T(0));
+        mask inside = total != zero;
+        for (int m = 0; m < 4; ++m) inside &= ~(((V[m] > zero) & (total < zero)) | ((V[m] < zero) & (total > zero)));
+        ok_bits |= lane_bits(inside) & four_bits;
+      }
+      if (ok_bits != 0) answer(c, s, ok_bits, ok_bits & ~sep_bits, dir, c.iterations + s, out);
+    }
+    for (std::uint32_t k = bits & ~ok_bits; k != 0; k &= k - 1) {
+      const std::size_t q = s + std::size_t(__builtin_ctz(k));
+      refused[refusals] = c.pair[q];
+      refused_iterations[refusals++] = c.iterations[q];
+    }
+  }
+
+  /// A boolean double query as a floating-point filter, a block of pairs at a time: their double setups
+  /// (fill_slots()), the gate (gate(): pairs separated along their first direction are answered there), the float
+  /// GJK (twice the lanes per register) on the others, and the double certificate of each float answer
+  /// (certify()). Pairs whose float answer is refused, or that have none, run the double GJK (run_plain()) and
+  /// have its status, collide and direction with the iterations of both passes. Every accepted answer is proven
+  /// by a double-precision test as strong as the double GJK's own stopping test: the collide bits are the double
+  /// GJK's wherever that one's proof is not itself within rounding of touching. The same bits on every
+  /// instruction set and thread count (each pair's gate, float run, certificate and double run are per-lane
+  /// operations in a fixed order).
   static std::size_t run_certified(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
                                    std::size_t n, const QueryOptions& options, const ResultView& out,
                                    std::uint32_t* fallback) {
-    thread_local std::vector<FloatAnswer> answers;
-    thread_local std::vector<std::uint32_t> rejected;
-    answers.assign(n, FloatAnswer{});
-    rejected.resize(n);
-    WideGjkPairs<float>::run_float_answers(in, type_a, type_b, pairs, n, options, out, rejected.data(),
-                                           answers.data());
-    Lanes L, check;
-    L.A.type = check.A.type = type_a;
-    L.B.type = check.B.type = type_b;
-    typename G::Rows rows, check_rows;
-    rows.attach(L.A, L.B);
-    check_rows.attach(check.A, check.B);
-    Source source{in, options, type_a, type_b, pairs, n, out, fallback};
-    source.answers = answers.data();
-    source.check = &check;
-    source.start_run(L);
-    G::drive_boolean(L, source, options.solver);
-    return source.fallbacks;
+    using F = WideGjk<float>;
+    thread_local Block block;
+    thread_local std::vector<std::uint32_t> refused;
+    thread_local std::vector<std::int32_t> refused_iterations;
+    refused.resize(n);
+    refused_iterations.resize(n);
+    std::size_t refusals = 0;
+    Source setup{in, options, type_a, type_b, pairs, n, out, fallback};
+    Lanes check;  // the gate's and the certificate's lanes (R, t, the sizes, the margins)
+    check.A.type = type_a;
+    check.B.type = type_b;
+    typename F::Lanes L;
+    L.A.type = type_a;
+    L.B.type = type_b;
+    L.max_iterations = F::splat_mask(typename F::Int(options.max_iterations));
+    L.relative = F::splat(float(options.relative_tolerance));
+    L.normalize = F::truth(true);  // not both ellipsoids (certified_pays())
+    L.boolean_only = F::truth(true);
+    FloatFeed feed{block, 0, float(options.tolerance), float(options.margin),
+                   typename F::Int(options.solver != Solver::gjk ? -1 : 0)};
+    for (std::size_t first = 0; first < n; first += kBlock) {
+      const std::size_t end = std::min(n, first + kBlock), count = end - first;
+      for (std::size_t w = 0; w < kBlock / 64; ++w) block.valid[w] = block.alive[w] = 0;
+      setup.fill_slots(block, first, end,
+                       [&](std::size_t s, std::uint32_t v) { block.valid[s / 64] |= std::uint64_t(v) << (s % 64); });
+      const std::size_t survivors = gate(block, count, check, out);
+      if (survivors == 0) continue;
+      feed.count = survivors;
+      feed.next = 0;
+      F::drive_boolean_directions(L, feed, options.solver);
+      for (std::size_t k = 0; k < count; k += std::size_t(W))
+        if (const std::uint32_t bits = std::uint32_t(block.alive[k / 64] >> (k % 64)) & ((2u << (W - 1)) - 1u))
+          certify(block, k, bits, check, out, refused.data(), refused_iterations.data(), refusals);
+    }
+    std::size_t fallbacks = setup.fallbacks;
+    if (refusals == 0) return fallbacks;
+    // Iterations start from 0 so that the float pass's can be added whichever way the double GJK ends (a pair
+    // it leaves to the scalar fallback gets the scalar path's own there).
+    for (std::size_t k = 0; k < refusals; ++k) out.iterations[refused[k]] = 0;
+    fallbacks += run_plain(in, type_a, type_b, refused.data(), refusals, options, out, fallback + fallbacks);
+    for (std::size_t k = 0; k < refusals; ++k) out.iterations[refused[k]] += refused_iterations[k];
+    return fallbacks;
   }
 };

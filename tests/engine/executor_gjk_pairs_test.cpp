@@ -82,9 +82,11 @@ bool simd_closed_form(ShapeType a, ShapeType b, const QueryOptions& o) {
 double at(const std::vector<double>& v, std::size_t i) { return v.empty() ? kNan : v[i]; }
 Eigen::Vector3d at(const Vec3Array& v, std::size_t i) { return {at(v.x, i), at(v.y, i), at(v.z, i)}; }
 
-/// A boolean double pair of the batch-array GJK (kernels::simd::gjk_pairs: the float pass and its double
-/// certificate, wide_gjk_pairs.inl run_certified()), given r[i] = the double GJK's answer: the float GJK answers
-/// (solve_pair<float>, whose bits the float pass has), then
+/// A boolean double pair of the batch-array GJK (kernels::simd::gjk_pairs: the gate, the float pass and its double
+/// certificate, wide_gjk_pairs.inl run_certified()), given r[i] = the double GJK's answer:
+///  - the gate: w0 = D.support(-d0) in double along the setup's first direction d0; if <w0, d0> / |d0| > the core
+///    margin, the gate's answer (converged, collide 0, d0 mapped to the world, 1 iteration);
+///  - else the float GJK answers (solve_pair<float>, whose bits the float pass has), then
 ///  - float separated (collide 0): the certificate, D.support(-v) in double for the float direction v widened, is
 ///    computed here; accepted iff <w, v> / |v| > the double setup's core margin: the float answer (converged,
 ///    collide 0, v mapped to the world, the float iterations);
@@ -96,17 +98,28 @@ Eigen::Vector3d at(const Vec3Array& v, std::size_t i) { return {at(v.x, i), at(v
 void certified_reference(const OwnedShapeView& va, const OwnedShapeView& vb, const kernels::RelativePose& X,
                          const QueryOptions& o, const Eigen::Matrix3d& Ra, const PairResults& got, std::size_t i,
                          PairResults& r) {
+  const kernels::PairSetup<double> setup =
+      kernels::setup_pair<double>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
+  const kernels::MinkowskiDifference<double> D{&setup.A, &setup.B, setup.X, {}, {}};
+  const auto lower_bound = [&](const Eigen::Vector3d& v) {
+    const Eigen::Vector3d w = D.support(-v).w;
+    return ((w.x() * v.x() + w.y() * v.y()) + w.z() * v.z()) / std::sqrt((v.x() * v.x() + v.y() * v.y()) + v.z() * v.z());
+  };
+  Eigen::Vector3d d0 = setup.initial_direction;
+  if (!((d0.x() * d0.x() + d0.y() * d0.y()) + d0.z() * d0.z() > 0.0)) d0 = Eigen::Vector3d::UnitX();
+  if (lower_bound(d0) > setup.params.core_margin) {
+    r.status[i] = Status::converged;
+    r.collide[i] = 0;
+    r.iterations[i] = 1;
+    r.direction.set(i, kernels::mul<double>(Ra, d0));
+    return;
+  }
   const kernels::PairOutput<float> f =
       kernels::solve_pair<float>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
   const Eigen::Vector3d v = f.direction.cast<double>();
   bool take_float = false;
   if (f.status == Status::converged && !f.collide) {
-    const kernels::PairSetup<double> setup =
-        kernels::setup_pair<double>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
-    const kernels::MinkowskiDifference<double> D{&setup.A, &setup.B, setup.X, {}, {}};
-    const Eigen::Vector3d w = D.support(-v).w;
-    const double lb = ((w.x() * v.x() + w.y() * v.y()) + w.z() * v.z()) / std::sqrt((v.x() * v.x() + v.y() * v.y()) + v.z() * v.z());
-    take_float = lb > setup.params.core_margin;
+    take_float = lower_bound(v) > setup.params.core_margin;
   } else if (f.status == Status::converged && f.collide) {
     take_float = got.iterations[i] == f.iterations;
   }
