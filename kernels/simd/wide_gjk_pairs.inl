@@ -403,14 +403,23 @@ template <class T> struct WideGjkPairs {
 
   // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
 
-  /// The types whose boolean double groups run_certified() answers: those whose float GJK saves more than the
-  /// certificate costs (measured on fdbl, boolean close double, 2 threads, same runs with Coal, AVX-512:
-  /// box-cylinder 366 -> 222 ns/pair, cone-cone 332 -> 220; but capsule-box 143 -> 206 and ellipsoid-ellipsoid
-  /// 194 -> 182 with +10% instructions: cheap supports gain little from wider lanes; convex8 overlap 96.5 -> 108.9
-  /// and convex250 overlap 271 -> 320: four double hull supports per overlap certificate). Their cores are centred
-  /// at the origin (no hull centroid): FloatFeed::load() relies on it.
+  /// The types whose boolean double groups run_certified() answers. Their cores are centred at the origin (no hull
+  /// centroid): FloatFeed::load() relies on it. Measured (callgrind AVX2, instructions per pair, main -> this,
+  /// distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755. Left out:
+  /// capsules and spheres (capsule-box 497 -> 231, 1107 -> 951, but overlap 964 -> 1700: their cores end within
+  /// the margin, the radius, on a segment or triangle, which this certificate refuses, so the double GJK runs
+  /// after the float one), and convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
+  /// four double hull supports per overlap certificate; and a hull's centroid makes the float first direction
+  /// differ from the double one rounded).
   static constexpr bool certified_pays(ShapeType t) {
-    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone;
+    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
+  }
+  /// make_core()'s swept radius in float, T(inflation) (+ T(radius) for spheres and capsules) as side_lanes()
+  /// rounds and adds it, from the shape table (the block keeps the double sum).
+  static float float_radius(const PairView& in, ShapeType type, std::int64_t shape) {
+    float r = float(in.shape_inflation[shape]);
+    if (type == ShapeType::sphere || type == ShapeType::capsule) r += float(in.shape_size[0][shape]);
+    return r;
   }
 
   /// The pairs of a certified run go through its stages a block at a time: one double setup (fill_slots()) that
@@ -459,7 +468,7 @@ template <class T> struct WideGjkPairs {
   /// iteration) and runs neither GJK; the others are listed for the float pass. Distant pairs end here: one
   /// Minkowski support per pair instead of the GJK's loop (box-cylinder distant: 511 -> 232 instructions a pair,
   /// AVX2).
-  static std::size_t gate(Block& c, std::size_t count, Lanes& g, const ResultView& out) {
+  static std::size_t gate(Block& c, std::size_t count, bool on, Lanes& g, const ResultView& out) {
     using V3 = typename G::V3;
     std::size_t survivors = 0;
     for (std::size_t s = 0; s < count; s += std::size_t(W)) {
@@ -473,7 +482,7 @@ template <class T> struct WideGjkPairs {
       V3 w, sa, sb;
       G::minkowski(g, G::neg(d), bits, w, sa, sb);
       const typename G::real lb = G::dot(w, d) / G::norm(d);
-      const std::uint32_t separated = lane_bits(lb > lanes_at(c.core_margin + s)) & bits;
+      const std::uint32_t separated = on ? lane_bits(lb > lanes_at(c.core_margin + s)) & bits : 0u;
       if (separated != 0) {
         std::int32_t iterations[W];
         for (int l = 0; l < W; ++l) iterations[l] = 1;
@@ -494,6 +503,7 @@ template <class T> struct WideGjkPairs {
   /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
   struct FloatFeed {
     using F = WideGjk<float>;
+    const PairView& in;
     Block& c;
     std::size_t count;
     float tolerance, margin;
@@ -515,7 +525,7 @@ template <class T> struct WideGjkPairs {
       const float floor = (16.0f * machine_epsilon<float>()) * float(c.scale[s]);  // tolerance_floor(scale)
       L.tolerance[l] = tolerance < floor ? floor : tolerance;
       L.touch[l] = floor;
-      L.core_margin[l] = margin + (float(c.radius_a[s]) + float(c.radius_b[s]));
+      L.core_margin[l] = margin + (float_radius(in, L.A.type, c.shape_a[s]) + float_radius(in, L.B.type, c.shape_b[s]));
       return true;
     }
     /// drive_boolean_directions(): vertex m's direction is in L.a[L.slot[m]]. Separated and overlapping answers
@@ -638,16 +648,17 @@ template <class T> struct WideGjkPairs {
     L.B.type = type_b;
     L.max_iterations = F::splat_mask(typename F::Int(options.max_iterations));
     L.relative = F::splat(float(options.relative_tolerance));
-    L.normalize = F::truth(true);  // not both ellipsoids (certified_pays())
+    L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
     L.boolean_only = F::truth(true);
-    FloatFeed feed{block, 0, float(options.tolerance), float(options.margin),
+    FloatFeed feed{in, block, 0, float(options.tolerance), float(options.margin),
                    typename F::Int(options.solver != Solver::gjk ? -1 : 0)};
     for (std::size_t first = 0; first < n; first += kBlock) {
       const std::size_t end = std::min(n, first + kBlock), count = end - first;
       for (std::size_t w = 0; w < kBlock / 64; ++w) block.valid[w] = block.alive[w] = 0;
       setup.fill_slots(block, first, end,
                        [&](std::size_t s, std::uint32_t v) { block.valid[s / 64] |= std::uint64_t(v) << (s % 64); });
-      const std::size_t survivors = gate(block, count, check, out);
+      // No gate when the budget allows no iteration: the double GJK would end at its budget, undecided.
+      const std::size_t survivors = gate(block, count, options.max_iterations >= 1, check, out);
       if (survivors == 0) continue;
       feed.count = survivors;
       feed.next = 0;

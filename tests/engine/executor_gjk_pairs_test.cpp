@@ -107,7 +107,7 @@ void certified_reference(const OwnedShapeView& va, const OwnedShapeView& vb, con
   };
   Eigen::Vector3d d0 = setup.initial_direction;
   if (!((d0.x() * d0.x() + d0.y() * d0.y()) + d0.z() * d0.z() > 0.0)) d0 = Eigen::Vector3d::UnitX();
-  if (lower_bound(d0) > setup.params.core_margin) {
+  if (o.max_iterations >= 1 && lower_bound(d0) > setup.params.core_margin) {
     r.status[i] = Status::converged;
     r.collide[i] = 0;
     r.iterations[i] = 1;
@@ -176,7 +176,7 @@ PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& 
       const ShapeType type_a = s.shapes[b.shape_a[i]].type, type_b = s.shapes[b.shape_b[i]].type;
       // The types run_certified() takes (WideGjkPairs::certified_pays(), wide_gjk_pairs.inl).
       const auto pays = [](ShapeType t) {
-        return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone;
+        return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
       };
       if (certified && o.level == QueryLevel::boolean && !kernels::may_have_closed_form(type_a, type_b, o) &&
           pays(type_a) && pays(type_b)) {
