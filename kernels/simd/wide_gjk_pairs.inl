@@ -408,7 +408,8 @@ template <class T> struct WideGjkPairs {
   /// distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755. Left out:
   /// capsules and spheres (capsule-box 497 -> 231, 1107 -> 951, but overlap 964 -> 1700: their cores end within
   /// the margin, the radius, on a segment or triangle, which this certificate refuses, so the double GJK runs
-  /// after the float one), and convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
+  /// after the float one; a segment / triangle certificate in plain arithmetic made it 230 / 968 / 1016 and cost
+  /// the other rows 1-2%, narrowphase-sessions.md), and convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
   /// four double hull supports per overlap certificate; and a hull's centroid makes the float first direction
   /// differ from the double one rounded).
   static constexpr bool certified_pays(ShapeType t) {
