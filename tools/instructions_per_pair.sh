@@ -3,7 +3,7 @@
 # --runs RUNS and --runs 5 on one thread (one call per run: --min-run-ms 0) and the difference is divided by
 # (RUNS - 5) x PAIRS (pair generation, the reference and the warm-up cancel out). Wall time on a shared 2-core VM is
 # too noisy to compare kernels; this is not.
-# usage: [PAIRS=20000] [RUNS=45] tools/instructions_per_pair.sh BATCHCOL_BINARY CASE [QUERY=boolean] [PRECISION=double]
+# usage: [PAIRS=20000] [RUNS=45] [REGIME=close] tools/instructions_per_pair.sh BATCHCOL_BINARY CASE [QUERY=boolean] [PRECISION=double]
 #        [ISA=auto]      (PAIRS=4000 RUNS=15: ~10x faster, box-cylinder boolean double 2208 vs 2222 with the defaults)
 set -euo pipefail
 bin=$1; case_name=$2; query=${3:-boolean}; precision=${4:-double}; isa=${5:-auto}; pairs=${PAIRS:-20000}; high=${RUNS:-45}
@@ -11,7 +11,7 @@ command -v valgrind >/dev/null || { echo "needs valgrind (apt-get install valgri
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 (( high > 5 )) || { echo "RUNS must be > 5" >&2; exit 2; }
 for runs in 5 $high; do
-  valgrind --tool=callgrind --callgrind-out-file="$work/cg$runs" "$bin" bench --case "$case_name" --regime close \
+  valgrind --tool=callgrind --callgrind-out-file="$work/cg$runs" "$bin" bench --case "$case_name" --regime "${REGIME:-close}" \
     --query "$query" --precision "$precision" --pairs $pairs --threads 1 --no-peers --isa "$isa" --runs $runs --min-run-ms 0 \
     >/dev/null 2>&1
   callgrind_annotate --inclusive=no --auto=no "$work/cg$runs" 2>/dev/null | grep -E "^ *[0-9,]+ \(" |

@@ -639,13 +639,14 @@ template <class T> struct WideGjk {
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
   /// `side`: the run may have distance / witness lanes (side_start(); boolean runs never do).
-  AI static void start(Lanes& L, bool side) {
+  /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
+  AI static void start(Lanes& L, bool side, bool dirs = false) {
     if (L.fresh == 0) return;
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
     const mask m = lanes_of(L.fresh);
     L.w[0] = pick(m, sw, L.w[0]);
-    L.a[0] = pick(m, sa, L.a[0]);  // start_lane() set slot[0] = 0
+    L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
     L.b[0] = pick(m, sb, L.b[0]);
     L.x = pick(m, sw, L.x);
     L.last_s = pick(m, sw, L.last_s);
@@ -1039,8 +1040,16 @@ template <class T> struct WideGjk {
   template <class Source> static void drive_boolean(Lanes& L, Source& source, Solver solver) {
     loop<true>(L, source, solver, false);
   }
+  /// drive_boolean() that also keeps, for every simplex vertex, the direction d whose support point -d it is
+  /// (D.support(-d)): in L.a[L.slot[m]] for vertex m (L.b unused), so that the vertices can be computed again in
+  /// another precision (the float pass of a certified boolean double query, wide_gjk_pairs.inl). The same
+  /// operations as drive_boolean() on every other value: the same answers, iterations and directions.
+  template <class Source> static void drive_boolean_directions(Lanes& L, Source& source, Solver solver) {
+    loop<true, true>(L, source, solver, false);
+  }
 
-  template <bool Boolean, class Source> static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
+  template <bool Boolean, bool Dirs = false, class Source>
+  static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     // Lanes holding a pair, kept as bits beside L.pair (rebuilding them from L.pair and the live mask from them
     // lane by lane cost ~55 instructions per demo pair, AVX2).
     std::uint32_t active = 0;
@@ -1060,7 +1069,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L, !Boolean);
+      start(L, !Boolean, Dirs);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
@@ -1150,7 +1159,7 @@ template <class T> struct WideGjk {
         // `count` first (a pick per slot per iteration); the compaction below reads it as vertex 3.
         mask pslot[4];
         // feature_direction() reads the flat side's points of the simplex: tracked for its lanes without `points`.
-        const bool track = points || (flat_run && newton_live);
+        const bool track = Dirs || points || (flat_run && newton_live);
         if (track) {
           // The new vertex's a and b go to the lowest slot no current vertex uses (count <= 3 here: one is free).
           mask used[4];
@@ -1162,8 +1171,8 @@ template <class T> struct WideGjk {
                                    select(~used[1], splat_mask(1), select(~used[2], splat_mask(2), splat_mask(3))));
           for (int q = 0; q < 4; ++q) {
             const mask here = live & (free == splat_mask(q));
-            L.a[q] = pick(here, sa, L.a[q]);
-            L.b[q] = pick(here, sb, L.b[q]);
+            L.a[q] = pick(here, Dirs ? d : sa, L.a[q]);
+            if (!Dirs) L.b[q] = pick(here, sb, L.b[q]);
           }
           for (int m = 0; m < 3; ++m) pslot[m] = L.slot[m];
           pslot[3] = free;  // s's slot, at s's index

@@ -25,17 +25,20 @@ template <class T> struct WideGjkPairs {
   /// row of copies instead of per-pair scalar arithmetic (the setup was a third of a boolean ellipsoid pair's
   /// instructions). Slots of invalid pairs are computed too (their lanes read shape 0) but never loaded: `left`
   /// holds the valid slots not yet loaded. Written before read: fill_chunk() writes slots [0, count).
-  struct Chunk {
-    static_assert(kChunk % std::size_t(Wd) == 0 && kChunk <= 64, "whole registers per chunk, one bit per slot");
+  template <std::size_t N> struct Slots {
+    static_assert(N % std::size_t(Wd) == 0 && N % 64 == 0, "whole registers per array, whole words of bits");
     // B's pose in A's frame (R row-major, rounded to T as start_lane() took them), A's world pose for the output.
-    T R[9][kChunk], t[3][kChunk];
-    double Ra[9][kChunk], ta[3][kChunk];
-    std::uint32_t pair[kChunk];
-    std::int64_t shape_a[kChunk], shape_b[kChunk];  // for the hull views
+    T R[9][N], t[3][N];
+    double Ra[9][N], ta[3][N];
+    std::uint32_t pair[N];
+    std::int64_t shape_a[N], shape_b[N];  // for the hull views
     // make_core()'s parameters, gjk_limits(), the first direction.
-    T size_a[3][kChunk], size_b[3][kChunk], radius_a[kChunk], radius_b[kChunk];
-    T radii[kChunk], scale[kChunk], floor[kChunk], tolerance[kChunk], core_margin[kChunk];
-    T init[3][kChunk];
+    T size_a[3][N], size_b[3][N], radius_a[N], radius_b[N];
+    T radii[N], scale[N], floor[N], tolerance[N], core_margin[N];
+    T init[3][N];
+  };
+  struct Chunk : Slots<kChunk> {
+    static_assert(kChunk <= 64, "one bit per slot");
     std::uint64_t left = 0;
   };
 
@@ -155,10 +158,18 @@ template <class T> struct WideGjkPairs {
     void fill_chunk() {
       chunk.left = 0;
       const std::size_t end = std::min(n, read + kChunk);
+      fill_slots(chunk, read, end, [&](std::size_t s, std::uint32_t valid) { chunk.left |= std::uint64_t(valid) << s; });
+      read = end;
+    }
+    /// fill_chunk()'s values of pairs[first .. end) into slots [0, end - first) of `chunk` (end - first <= N), Wd
+    /// slots per register (the last register's lanes past `end` repeat the last pair). mark(s, bits): the valid
+    /// pairs of the register at slot s; invalid pairs go to the fallback.
+    template <std::size_t N, class Mark>
+    void fill_slots(Slots<N>& chunk, std::size_t first, std::size_t end, const Mark& mark) {
       const T tolerance = T(options.tolerance), margin = T(options.margin);
-      for (std::size_t k = read; k < end; k += Wd) {
-        const std::size_t s = k - read;  // a multiple of Wd: whole registers stay inside the chunk
-        const auto b = P::block(pairs + read, end - read, s);
+      for (std::size_t k = first; k < end; k += Wd) {
+        const std::size_t s = k - first;  // a multiple of Wd: whole registers stay inside the slots
+        const auto b = P::block(pairs + first, end - first, s);
         P::Pose pa = load(b, true), pb = load(b, false);
         P::normalize(pa);
         P::normalize(pb);
@@ -206,11 +217,10 @@ template <class T> struct WideGjkPairs {
         put(chunk.init[2] + s, nonzero ? init[2] : splat_t(T(0)));
 
         const std::uint32_t valid = lane_bits(pa.valid & pb.valid) & b.live;
-        chunk.left |= std::uint64_t(valid) << s;
+        mark(s, valid);
         for (std::uint32_t bad = b.live & ~valid; bad != 0; bad &= bad - 1)
           fallback[fallbacks++] = b.idx[__builtin_ctz(bad)];
       }
-      read = end;
     }
     P::Pose load(const typename P::Block& b, bool side_a) const {
       return P::load_pose(in, side_a ? in.shape_a : in.shape_b, side_a ? in.translation_a : in.translation_b,
@@ -252,7 +262,8 @@ template <class T> struct WideGjkPairs {
     }
     /// Slot s of one side into lane l, as load_side() takes it: the sizes of the types that have them (the
     /// support of the others reads none), the hull of a convex core. (No triangle: its pairs are not run here.)
-    void side(typename G::Side& side, const T (&size)[3][kChunk], const std::int64_t* shape, std::size_t s,
+    template <std::size_t N>
+    void side(typename G::Side& side, const T (&size)[3][N], const std::int64_t* shape, std::size_t s,
               int l) const {
       switch (side.type) {
         case ShapeType::sphere: return;
@@ -368,6 +379,16 @@ template <class T> struct WideGjkPairs {
   static std::size_t run(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
                          std::size_t n, const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
     if (n == 0) return 0;
+    if constexpr (std::is_same_v<T, double>)
+      if (options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b))
+        return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
+    return run_plain(in, type_a, type_b, pairs, n, options, out, fallback);
+  }
+  /// Every pair through the GJK of precision T (a certified run's refused pairs too).
+  static std::size_t run_plain(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                               std::size_t n, const QueryOptions& options, const ResultView& out,
+                               std::uint32_t* fallback) {
+    if (n == 0) return 0;
     Lanes L;
     L.A.type = type_a;
     L.B.type = type_b;
@@ -378,5 +399,282 @@ template <class T> struct WideGjkPairs {
     if (options.level == QueryLevel::boolean) G::drive_boolean(L, source, options.solver);  // start_run: all boolean
     else G::drive(L, source, options.solver, options.level >= QueryLevel::witness);
     return source.fallbacks;
+  }
+
+  // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
+
+  /// The types whose boolean double groups run_certified() answers. Their cores are centred at the origin (no hull
+  /// centroid): FloatFeed::load() relies on it. Measured (callgrind AVX2, instructions per pair, main -> this,
+  /// distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755. Left out:
+  /// capsules and spheres (capsule-box 497 -> 231, 1107 -> 951, but overlap 964 -> 1700: their cores end within
+  /// the margin, the radius, on a segment or triangle, which this certificate refuses, so the double GJK runs
+  /// after the float one; a segment / triangle certificate in plain arithmetic made it 230 / 968 / 1016 and cost
+  /// the other rows 1-2%, narrowphase-sessions.md), and convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
+  /// four double hull supports per overlap certificate; and a hull's centroid makes the float first direction
+  /// differ from the double one rounded).
+  static constexpr bool certified_pays(ShapeType t) {
+    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
+  }
+  /// make_core()'s swept radius in float, T(inflation) (+ T(radius) for spheres and capsules) as side_lanes()
+  /// rounds and adds it, from the shape table (the block keeps the double sum).
+  static float float_radius(const PairView& in, ShapeType type, std::int64_t shape) {
+    float r = float(in.shape_inflation[shape]);
+    if (type == ShapeType::sphere || type == ShapeType::capsule) r += float(in.shape_size[0][shape]);
+    return r;
+  }
+
+  /// The pairs of a certified run go through its stages a block at a time: one double setup (fill_slots()) that
+  /// the gate, the float pass (converted) and the certificate all read, instead of a float and a double setup per
+  /// pair (fdbl: ~140 instructions each, AVX2). 256 pairs: ~110 KB (L2); the float lanes drain at a block's end.
+  static constexpr std::size_t kBlock = 256;
+  struct Block : Slots<kBlock> {
+    std::uint64_t valid[kBlock / 64];  // fill_slots()'s valid pairs, bit s = slot s
+    std::uint64_t alive[kBlock / 64];  // the gate's survivors, bit s = slot s
+    std::uint16_t list[kBlock];        // the same, by slot
+    /// The float pass's answer of each survivor, by slot. kind 0: none to certify (ended otherwise than
+    /// separated / overlapping: budget, convergence, stall), 1: separated along `direction` (the last search
+    /// direction d, whose support point -d proved it), 2: the cores overlap or are within the margin, with the
+    /// `count` simplex vertices being D's support points in the directions -vertex[m] (in simplex order).
+    std::uint8_t kind[kBlock], count[kBlock];
+    std::int32_t iterations[kBlock];
+    float direction[3][kBlock], vertex[4][3][kBlock];
+  };
+
+  typedef T unaligned_real __attribute__((vector_size(sizeof(T) * W), aligned(alignof(T))));
+  static typename G::real lanes_at(const T* p) { return *reinterpret_cast<const unaligned_real*>(p); }
+
+  /// Writes a certified run's own answers for the lanes `bits` of the register at slot s: converged, collide
+  /// (`collide` lanes), the direction d (in A's frame) mapped to the world as LanePair::put_world() maps it (the
+  /// same operations), the iterations.
+  static void answer(const Block& c, std::size_t s, std::uint32_t bits, std::uint32_t collide,
+                     const typename G::V3& d, const std::int32_t* iterations, const ResultView& out) {
+    typename G::real world[3];
+    for (int r = 0; r < 3; ++r)
+      world[r] = (lanes_at(c.Ra[3 * r] + s) * d.x + lanes_at(c.Ra[3 * r + 1] + s) * d.y) +
+                 lanes_at(c.Ra[3 * r + 2] + s) * d.z;
+    for (; bits != 0; bits &= bits - 1) {
+      const int l = __builtin_ctz(bits);
+      const std::uint32_t i = c.pair[s + std::size_t(l)];
+      out.status[i] = Status::converged;
+      out.collide[i] = std::uint8_t(collide >> l & 1u);
+      for (int r = 0; r < 3; ++r) out.direction[r][i] = world[r][l];
+      out.iterations[i] = iterations[l];
+    }
+  }
+
+  /// The gate, W pairs per register straight from the block's double setups: w = D.support(-d0) along the first
+  /// direction d0 (the centres' offset, start_lane()'s), and the double loop's own separation test on it,
+  /// <w, d0> / |d0| > core margin (ends_separated, the same operations). A pair that passes is separated, proven
+  /// in double like any separated answer of the double GJK: it is answered here (collide 0, direction d0, one
+  /// iteration) and runs neither GJK; the others are listed for the float pass. Distant pairs end here: one
+  /// Minkowski support per pair instead of the GJK's loop (box-cylinder distant: 511 -> 232 instructions a pair,
+  /// AVX2).
+  static std::size_t gate(Block& c, std::size_t count, bool on, Lanes& g, const ResultView& out) {
+    using V3 = typename G::V3;
+    std::size_t survivors = 0;
+    for (std::size_t s = 0; s < count; s += std::size_t(W)) {
+      const std::uint32_t bits = std::uint32_t(c.valid[s / 64] >> (s % 64)) & ((2u << (W - 1)) - 1u);
+      if (bits == 0) continue;
+      for (int e = 0; e < 9; ++e) g.R[e] = lanes_at(c.R[e] + s);
+      for (int i = 0; i < 3; ++i) g.t[i] = lanes_at(c.t[i] + s);
+      g.A.s0 = lanes_at(c.size_a[0] + s), g.A.s1 = lanes_at(c.size_a[1] + s), g.A.s2 = lanes_at(c.size_a[2] + s);
+      g.B.s0 = lanes_at(c.size_b[0] + s), g.B.s1 = lanes_at(c.size_b[1] + s), g.B.s2 = lanes_at(c.size_b[2] + s);
+      const V3 d = {lanes_at(c.init[0] + s), lanes_at(c.init[1] + s), lanes_at(c.init[2] + s)};
+      V3 w, sa, sb;
+      G::minkowski(g, G::neg(d), bits, w, sa, sb);
+      const typename G::real lb = G::dot(w, d) / G::norm(d);
+      const std::uint32_t separated = on ? lane_bits(lb > lanes_at(c.core_margin + s)) & bits : 0u;
+      if (separated != 0) {
+        std::int32_t iterations[W];
+        for (int l = 0; l < W; ++l) iterations[l] = 1;
+        answer(c, s, separated, 0, d, iterations, out);
+      }
+      c.alive[s / 64] |= std::uint64_t(bits & ~separated) << (s % 64);
+      for (std::uint32_t k = bits & ~separated; k != 0; k &= k - 1)
+        c.list[survivors++] = std::uint16_t(s + std::size_t(__builtin_ctz(k)));
+    }
+    return survivors;
+  }
+
+  /// The float pass's pairs (WideGjk<float>'s Source): the gate's survivors of a block, each lane's float setup
+  /// converted from the block's double one, answers kept in the block by slot. The float setup's values are the
+  /// float fill_slots()'s bits: R, t, the sizes, the inflations and the scale are computed in double there too and
+  /// rounded once; the floor, tolerance, core margin and the zero test of the first direction are the same float
+  /// operations on them; and the first direction, -t in either precision for cores centred at the origin
+  /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
+  struct FloatFeed {
+    using F = WideGjk<float>;
+    const PairView& in;
+    Block& c;
+    std::size_t count;
+    float tolerance, margin;
+    typename F::Int momentum;
+    std::size_t next = 0;
+
+    bool load(typename F::Lanes& L, int l) {
+      if (next == count) return false;
+      const std::size_t s = c.list[next++];
+      L.pair[l] = std::int64_t(s);
+      for (int e = 0; e < 9; ++e) L.R[e][l] = float(c.R[e][s]);
+      for (int i = 0; i < 3; ++i) L.t[i][l] = float(c.t[i][s]);
+      L.A.s0[l] = float(c.size_a[0][s]), L.A.s1[l] = float(c.size_a[1][s]), L.A.s2[l] = float(c.size_a[2][s]);
+      L.B.s0[l] = float(c.size_b[0][s]), L.B.s1[l] = float(c.size_b[1][s]), L.B.s2[l] = float(c.size_b[2][s]);
+      Vec3<float> init(float(c.init[0][s]), float(c.init[1][s]), float(c.init[2][s]));
+      if (!((init.x() * init.x() + init.y() * init.y()) + init.z() * init.z() > 0.0f)) init = Vec3<float>::UnitX();
+      F::reset_search(L, l, init);
+      L.momentum[l] = momentum;
+      const float floor = (16.0f * machine_epsilon<float>()) * float(c.scale[s]);  // tolerance_floor(scale)
+      L.tolerance[l] = tolerance < floor ? floor : tolerance;
+      L.touch[l] = floor;
+      L.core_margin[l] = margin + (float_radius(in, L.A.type, c.shape_a[s]) + float_radius(in, L.B.type, c.shape_b[s]));
+      return true;
+    }
+    /// drive_boolean_directions(): vertex m's direction is in L.a[L.slot[m]]. Separated and overlapping answers
+    /// are kept for the certificate; any other ending (budget, convergence, stall) leaves kind 0.
+    void done(const typename F::Lanes& L, int l, GjkStatus status) {
+      const std::size_t s = std::size_t(L.pair[l]);
+      c.iterations[s] = std::int32_t(L.k[l]);
+      const bool separated = status == GjkStatus::separated_proven;
+      const bool overlapping = status == GjkStatus::collision_proven || status == GjkStatus::overlap;
+      c.kind[s] = separated ? 1 : overlapping ? 2 : 0;
+      c.direction[0][s] = L.direction.x[l], c.direction[1][s] = L.direction.y[l], c.direction[2][s] = L.direction.z[l];
+      c.count[s] = overlapping ? std::uint8_t(L.count[l]) : 0;
+      for (int m = 0; m < int(c.count[s]); ++m) {
+        const int q = int(L.slot[m][l]) & 3;
+        c.vertex[m][0][s] = L.a[q].x[l], c.vertex[m][1][s] = L.a[q].y[l], c.vertex[m][2][s] = L.a[q].z[l];
+      }
+    }
+  };
+
+  /// The certificates of the float answers of the survivors `bits` of the register at slot s, W pairs at a time in
+  /// C's double lanes, read straight from the block (vector loads; the float answers widened): an accepted answer
+  /// is written; a refused one (or kind 0) is appended to `refused` with its float iterations.
+  ///  - separated along d: w = D.support(-d) in double (d widened), accepted iff <w, d> / |d| > core margin,
+  ///    the double GJK's own test that ends a separated boolean pair (ends_separated);
+  ///  - overlapping with 4 vertices: the vertices computed again in double (D.support(-v_m)), accepted iff
+  ///    tetrahedron()'s signed volumes say it contains the origin (ends_contains); with one vertex: accepted iff
+  ///    its norm is <= max(core margin, touch) (ends_collision, ends_overlap). Two or three vertices are refused:
+  ///    on fdbl, their certificate through project() gave different bits in the scalar build (W = 1, GCC 12) than
+  ///    in AVX2 / AVX-512 on identical inputs (memcheck and -fsanitize=undefined found nothing; not root caused),
+  ///    so that form is not used.
+  /// The certificate's support points are points of the double problem's Minkowski difference, so an accepted
+  /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
+  /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
+  /// the float pass's.
+  static void certify(const Block& c, std::size_t s, std::uint32_t bits, Lanes& C, const ResultView& out,
+                      std::uint32_t* refused, std::int32_t* refused_iterations, std::size_t& refusals) {
+    using V3 = typename G::V3;
+    using real = typename G::real;
+    using mask = typename G::mask;
+    typedef float floats __attribute__((vector_size(sizeof(float) * W), aligned(alignof(float))));
+    const auto widened = [&](const float* p) { return __builtin_convertvector(*reinterpret_cast<const floats*>(p + s), real); };
+    std::uint32_t sep_bits = 0, four_bits = 0, one_bits = 0;
+    for (std::uint32_t k = bits; k != 0; k &= k - 1) {
+      const int l = __builtin_ctz(k);
+      const std::size_t q = s + std::size_t(l);
+      const std::uint32_t bit = 1u << l;
+      if (c.kind[q] == 1) sep_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 4) four_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 1) one_bits |= bit;
+    }
+    const std::uint32_t live = sep_bits | four_bits | one_bits;
+    std::uint32_t ok_bits = 0;
+    const V3 dir = {widened(c.direction[0]), widened(c.direction[1]), widened(c.direction[2])};
+    if (live != 0) {
+      for (int e = 0; e < 9; ++e) C.R[e] = lanes_at(c.R[e] + s);
+      for (int i = 0; i < 3; ++i) C.t[i] = lanes_at(c.t[i] + s);
+      C.A.s0 = lanes_at(c.size_a[0] + s), C.A.s1 = lanes_at(c.size_a[1] + s), C.A.s2 = lanes_at(c.size_a[2] + s);
+      C.B.s0 = lanes_at(c.size_b[0] + s), C.B.s1 = lanes_at(c.size_b[1] + s), C.B.s2 = lanes_at(c.size_b[2] + s);
+      const real cm = lanes_at(c.core_margin + s), touch = lanes_at(c.floor + s);
+      V3 v[4];
+      for (int m = 0; m < 4; ++m)
+        v[m] = {widened(c.vertex[m][0]), widened(c.vertex[m][1]), widened(c.vertex[m][2])};
+      const mask sep = G::lanes_of(sep_bits);
+      const V3 v0 = G::pick(sep, dir, v[0]);
+      V3 p[4], sa, sb;
+      G::minkowski(C, G::neg(v0), live, p[0], sa, sb);
+      // Separated: the double GJK's ends_separated test along d.
+      const real lb = G::dot(p[0], v0) / G::norm(v0);
+      ok_bits = lane_bits(lb > cm) & sep_bits;
+      if (one_bits != 0) {
+        // The double GJK's ends_collision (|x| <= core margin) and ends_overlap (|x| <= touch) tests.
+        ok_bits |= lane_bits(G::norm(p[0]) <= wmax(cm, touch)) & one_bits;
+      }
+      if (four_bits != 0) {
+        for (int m = 1; m < 4; ++m) G::minkowski(C, G::neg(v[m]), four_bits, p[m], sa, sb);
+        // tetrahedron()'s signed volumes (project()'s operations) and its inside test: total != 0 and no volume
+        // of the opposite sign (project()'s opposite_sign()).
+        const real V[4] = {G::det3(p[1], p[2], p[3]), -G::det3(p[0], p[2], p[3]), G::det3(p[0], p[1], p[3]),
+                           -G::det3(p[0], p[1], p[2])};
+        const real total = ((V[0] + V[1]) + V[2]) + V[3];
+        const real zero = G::splat(T(0));
+        mask inside = total != zero;
+        for (int m = 0; m < 4; ++m) inside &= ~(((V[m] > zero) & (total < zero)) | ((V[m] < zero) & (total > zero)));
+        ok_bits |= lane_bits(inside) & four_bits;
+      }
+      if (ok_bits != 0) answer(c, s, ok_bits, ok_bits & ~sep_bits, dir, c.iterations + s, out);
+    }
+    for (std::uint32_t k = bits & ~ok_bits; k != 0; k &= k - 1) {
+      const std::size_t q = s + std::size_t(__builtin_ctz(k));
+      refused[refusals] = c.pair[q];
+      refused_iterations[refusals++] = c.iterations[q];
+    }
+  }
+
+  /// A boolean double query as a floating-point filter, a block of pairs at a time: their double setups
+  /// (fill_slots()), the gate (gate(): pairs separated along their first direction are answered there), the float
+  /// GJK (twice the lanes per register) on the others, and the double certificate of each float answer
+  /// (certify()). Pairs whose float answer is refused, or that have none, run the double GJK (run_plain()) and
+  /// have its status, collide and direction with the iterations of both passes. Every accepted answer is proven
+  /// by a double-precision test as strong as the double GJK's own stopping test: the collide bits are the double
+  /// GJK's wherever that one's proof is not itself within rounding of touching. The same bits on every
+  /// instruction set and thread count (each pair's gate, float run, certificate and double run are per-lane
+  /// operations in a fixed order).
+  static std::size_t run_certified(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
+                                   std::size_t n, const QueryOptions& options, const ResultView& out,
+                                   std::uint32_t* fallback) {
+    using F = WideGjk<float>;
+    thread_local Block block;
+    thread_local std::vector<std::uint32_t> refused;
+    thread_local std::vector<std::int32_t> refused_iterations;
+    refused.resize(n);
+    refused_iterations.resize(n);
+    std::size_t refusals = 0;
+    Source setup{in, options, type_a, type_b, pairs, n, out, fallback};
+    Lanes check;  // the gate's and the certificate's lanes (R, t, the sizes, the margins)
+    check.A.type = type_a;
+    check.B.type = type_b;
+    typename F::Lanes L;
+    L.A.type = type_a;
+    L.B.type = type_b;
+    L.max_iterations = F::splat_mask(typename F::Int(options.max_iterations));
+    L.relative = F::splat(float(options.relative_tolerance));
+    L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
+    L.boolean_only = F::truth(true);
+    FloatFeed feed{in, block, 0, float(options.tolerance), float(options.margin),
+                   typename F::Int(options.solver != Solver::gjk ? -1 : 0)};
+    for (std::size_t first = 0; first < n; first += kBlock) {
+      const std::size_t end = std::min(n, first + kBlock), count = end - first;
+      for (std::size_t w = 0; w < kBlock / 64; ++w) block.valid[w] = block.alive[w] = 0;
+      setup.fill_slots(block, first, end,
+                       [&](std::size_t s, std::uint32_t v) { block.valid[s / 64] |= std::uint64_t(v) << (s % 64); });
+      // No gate when the budget allows no iteration: the double GJK would end at its budget, undecided.
+      const std::size_t survivors = gate(block, count, options.max_iterations >= 1, check, out);
+      if (survivors == 0) continue;
+      feed.count = survivors;
+      feed.next = 0;
+      F::drive_boolean_directions(L, feed, options.solver);
+      for (std::size_t k = 0; k < count; k += std::size_t(W))
+        if (const std::uint32_t bits = std::uint32_t(block.alive[k / 64] >> (k % 64)) & ((2u << (W - 1)) - 1u))
+          certify(block, k, bits, check, out, refused.data(), refused_iterations.data(), refusals);
+    }
+    std::size_t fallbacks = setup.fallbacks;
+    if (refusals == 0) return fallbacks;
+    // Iterations start from 0 so that the float pass's can be added whichever way the double GJK ends (a pair
+    // it leaves to the scalar fallback gets the scalar path's own there).
+    for (std::size_t k = 0; k < refusals; ++k) out.iterations[refused[k]] = 0;
+    fallbacks += run_plain(in, type_a, type_b, refused.data(), refusals, options, out, fallback + fallbacks);
+    for (std::size_t k = 0; k < refusals; ++k) out.iterations[refused[k]] += refused_iterations[k];
+    return fallbacks;
   }
 };

@@ -3,6 +3,7 @@
 // mapped to the world frame. Invalid pairs get invalid_input and NaN / 0 everywhere else.
 #include "kernel_views.hpp"  // engine/src: pair_view, result_view
 #include "kernels/math.hpp"
+#include "kernels/minkowski.hpp"
 #include "kernels/narrowphase.hpp"
 #include "kernels/simd/wide_closed_forms.hpp"
 #include "kernels/simd/wide_gjk.hpp"
@@ -14,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -80,9 +82,63 @@ bool simd_closed_form(ShapeType a, ShapeType b, const QueryOptions& o) {
 double at(const std::vector<double>& v, std::size_t i) { return v.empty() ? kNan : v[i]; }
 Eigen::Vector3d at(const Vec3Array& v, std::size_t i) { return {at(v.x, i), at(v.y, i), at(v.z, i)}; }
 
+/// A boolean double pair of the batch-array GJK (kernels::simd::gjk_pairs: the gate, the float pass and its double
+/// certificate, wide_gjk_pairs.inl run_certified()), given r[i] = the double GJK's answer:
+///  - the gate: w0 = D.support(-d0) in double along the setup's first direction d0; if <w0, d0> / |d0| > the core
+///    margin, the gate's answer (converged, collide 0, d0 mapped to the world, 1 iteration);
+///  - else the float GJK answers (solve_pair<float>, whose bits the float pass has), then
+///  - float separated (collide 0): the certificate, D.support(-v) in double for the float direction v widened, is
+///    computed here; accepted iff <w, v> / |v| > the double setup's core margin: the float answer (converged,
+///    collide 0, v mapped to the world, the float iterations);
+///  - float colliding: the certificate needs the float simplex's directions, which solve_pair() does not give, so
+///    either answer is accepted: the float one (converged, collide 1, the float direction and iterations) or the
+///    double GJK's with the iterations of both passes (told apart by the iterations);
+///  - else the double GJK's answer with the iterations of both passes.
+/// Whichever it is, collide must be the double GJK's (checked by expect_same_results on every pair).
+void certified_reference(const OwnedShapeView& va, const OwnedShapeView& vb, const kernels::RelativePose& X,
+                         const QueryOptions& o, const Eigen::Matrix3d& Ra, const PairResults& got, std::size_t i,
+                         PairResults& r) {
+  const kernels::PairSetup<double> setup =
+      kernels::setup_pair<double>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
+  const kernels::MinkowskiDifference<double> D{&setup.A, &setup.B, setup.X, {}, {}};
+  const auto lower_bound = [&](const Eigen::Vector3d& v) {
+    const Eigen::Vector3d w = D.support(-v).w;
+    return ((w.x() * v.x() + w.y() * v.y()) + w.z() * v.z()) / std::sqrt((v.x() * v.x() + v.y() * v.y()) + v.z() * v.z());
+  };
+  Eigen::Vector3d d0 = setup.initial_direction;
+  if (!((d0.x() * d0.x() + d0.y() * d0.y()) + d0.z() * d0.z() > 0.0)) d0 = Eigen::Vector3d::UnitX();
+  if (o.max_iterations >= 1 && lower_bound(d0) > setup.params.core_margin) {
+    r.status[i] = Status::converged;
+    r.collide[i] = 0;
+    r.iterations[i] = 1;
+    r.direction.set(i, kernels::mul<double>(Ra, d0));
+    return;
+  }
+  const kernels::PairOutput<float> f =
+      kernels::solve_pair<float>(va.view, vb.view, X, Eigen::Vector3d::Constant(kNan), o);
+  const Eigen::Vector3d v = f.direction.cast<double>();
+  bool take_float = false;
+  if (f.status == Status::converged && !f.collide) {
+    take_float = lower_bound(v) > setup.params.core_margin;
+  } else if (f.status == Status::converged && f.collide) {
+    take_float = got.iterations[i] == f.iterations;
+  }
+  if (take_float) {
+    r.status[i] = Status::converged;
+    r.collide[i] = f.collide ? 1 : 0;
+    r.iterations[i] = f.iterations;
+    r.direction.set(i, kernels::mul<double>(Ra, v));
+  } else {
+    r.iterations[i] += f.iterations;  // the double GJK's status, collide and direction (set by the caller)
+  }
+}
+
 /// The scalar reference of every pair (every array full: NaN where the level computes nothing); pairs answered by a SIMD closed form take `got`'s values (they are not what
 /// this test is about, and every other pair, sphere-box closed forms included, must match).
-template <class T> PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& got) {
+/// `certified` false: boolean double pairs get the plain double GJK's answer (status, collide, iterations,
+/// direction) instead of certified_reference()'s.
+template <class T>
+PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& got, bool certified = true) {
   PairResults r;
   const std::size_t n = s.batch.size();
   r.status.assign(n, Status::invalid_input);
@@ -116,6 +172,19 @@ template <class T> PairResults reference(const Scene& s, const QueryOptions& o, 
     r.status[i] = p.status;
     r.collide[i] = p.collide ? 1 : 0;
     r.iterations[i] = p.iterations;
+    if constexpr (std::is_same_v<T, double>) {
+      const ShapeType type_a = s.shapes[b.shape_a[i]].type, type_b = s.shapes[b.shape_b[i]].type;
+      // The types run_certified() takes (WideGjkPairs::certified_pays(), wide_gjk_pairs.inl).
+      const auto pays = [](ShapeType t) {
+        return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
+      };
+      if (certified && o.level == QueryLevel::boolean && !kernels::may_have_closed_form(type_a, type_b, o) &&
+          pays(type_a) && pays(type_b)) {
+        r.direction.set(i, kernels::mul<double>(Ra, p.direction));
+        certified_reference(va, vb, X, o, Ra, got, i, r);
+        continue;
+      }
+    }
     if (o.level >= QueryLevel::distance) r.distance[i] = double(p.distance);
     if (o.level >= QueryLevel::witness) {
       r.witness_a.set(i, kernels::mul<double>(Ra, p.witness_a.template cast<double>()) + ta);
@@ -226,16 +295,133 @@ TEST(ExecutorGjkPairs, KernelAnswersEveryValidPairOfManyChunksAndLargeHulls) {
     }
 }
 
+/// Boolean double queries are answered by the float GJK plus a double certificate (wide_gjk_pairs.inl
+/// run_certified()). Pairs placed within float error of touching, gaps and overlaps of 1e-12 .. 1e-4 times the
+/// shapes' scale (1e-3 .. 1e3 m, extreme aspect ratios included), every GJK type pair of box, cylinder, cone,
+/// 8-vertex hull, capsule and ellipsoid: every answer must be the double GJK's (collide, and the certified
+/// reference's other bits), while the float GJK alone must get many of them wrong (the test fails if the
+/// certificate is removed, or accepts an answer the double test would not).
+TEST(ExecutorGjkPairs, BooleanDoubleNearTouchingPairsHaveTheDoubleAnswer) {
+  Rng rng(77);
+  Scene s;
+  std::vector<double> scale_of;
+  for (double scale : {1e-3, 1.0, 1e3})
+    for (int aspect = 0; aspect < 2; ++aspect) {
+      const double thin = aspect == 0 ? 0.5 : 1e-3;  // second set: plates, discs and needles
+      std::vector<Eigen::Vector3d> points;
+      for (int k = 0; k < 8; ++k)
+        points.push_back(testing::random_unit_vector(rng).cwiseProduct(Eigen::Vector3d(1.0, 0.7, thin)) * scale);
+      for (const Shape& shape : {Shape::box(scale, 0.6 * scale, thin * scale), Shape::cylinder(scale, thin * scale),
+                                 Shape::cone(thin * scale, scale), Shape::convex(points),
+                                 Shape::capsule(thin * scale, scale), Shape::ellipsoid(scale, 0.5 * scale, thin * scale)}) {
+        s.shapes.add(shape);
+        scale_of.push_back(scale);
+      }
+    }
+  // Each pair is first placed apart (B beside A along a random u), its double witness query gives the distance d
+  // and the normal n, and B is moved by (d - g) along n: the distance becomes the signed gap g exactly for g >= 0
+  // (the witness points stay closest, the separating plane moves with B) and the cores overlap for g < 0.
+  const std::uint32_t per_set = 6;
+  PairBatch apart;
+  std::vector<double> gaps;
+  for (std::uint32_t set = 0; set < s.shapes.size() / per_set; ++set)
+    for (std::uint32_t a = 0; a < per_set; ++a)
+      for (std::uint32_t b = 0; b < per_set; ++b)
+        for (double gap : {1e-12, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4})
+          for (double sign : {1.0, -1.0})
+            for (int k = 0; k < 2; ++k) {
+              const std::uint32_t ia = set * per_set + a, ib = set * per_set + b;
+              const Eigen::Vector3d u = testing::random_unit_vector(rng), at = testing::random_vector(rng);
+              apart.add(ia, Pose{at, testing::random_rotation(rng)}, ib,
+                        Pose{at + 3.0 * scale_of[ia] * u, testing::random_rotation(rng)});
+              gaps.push_back(sign * gap * scale_of[ia]);
+            }
+  QueryOptions w;
+  w.level = QueryLevel::witness;
+  w.tolerance = 1e-15;
+  w.max_iterations = 1000;
+  w.closed_forms = false;
+  PairResults placed;
+  collide(s.shapes, apart, w, placed);
+  std::vector<double> gap_of;  // the signed gap of s.batch's pair i
+  for (std::size_t i = 0; i < apart.size(); ++i) {
+    const Eigen::Vector3d n = placed.normal[i];
+    if (placed.status[i] != Status::converged || placed.collide[i] || !n.allFinite()) continue;
+    const double move = placed.distance[i] - gaps[i];
+    Pose pb = apart.pose_b(i);
+    pb.translation -= move * n;  // n points from A to B (wb - wa = d n)
+    s.batch.add(apart.shape_a[i], apart.pose_a(i), apart.shape_b[i], pb);
+    gap_of.push_back(gaps[i]);
+  }
+  ASSERT_GT(s.batch.size(), apart.size() * 9 / 10);
+  QueryOptions o;
+  o.level = QueryLevel::boolean;
+  o.precision = Precision::float64;
+  o.solver = resolve_solver(o.solver, o.level);
+  o.threads = 2;
+  PairResults got;
+  collide(s.shapes, s.batch, o, got);
+  // The double GJK's own answers (scalar path, solve_pair<double>): every collide must be theirs. (The other
+  // bits are the certified path's, compared with certified_reference() in EveryPairHasTheScalarReferenceBits*;
+  // near touching, pairs the double GJK cannot finish in the batch-array kernel go to the scalar path, whose
+  // iterations certified_reference() does not model.)
+  const PairResults want = reference<double>(s, o, got, false);
+  std::size_t disagree = 0;
+  // Allowed: a pair within 1e-8 of touching (relative) where the double GJK stopped at its tolerance (status
+  // converged, collide 1 from its lower bound) and the certificate proved the constructed sign (measured: one
+  // capsule-cone pair at gap +1e-9 m, separated by construction, which the double GJK calls colliding).
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    const bool close_call = std::abs(gap_of[i]) <= 1e-8 * scale_of[s.batch.shape_a[i]] &&
+                            got.collide[i] == (gap_of[i] < 0 ? 1 : 0);
+    if (!close_call) { EXPECT_EQ(want.collide[i], got.collide[i]) << i; }
+    EXPECT_EQ(want.status[i], got.status[i]) << i;
+    if (want.collide[i] != got.collide[i])
+      std::printf("[measured] pair %zu %s-%s: double GJK %s collide %d (%d iterations), certified %s collide %d, gap %g, scale %g\n", i,
+                  to_string(s.shapes[s.batch.shape_a[i]].type), to_string(s.shapes[s.batch.shape_b[i]].type),
+                  to_string(want.status[i]), want.collide[i], want.iterations[i], to_string(got.status[i]),
+                  got.collide[i], gap_of[i], scale_of[s.batch.shape_a[i]]);
+    disagree += want.collide[i] != got.collide[i];
+  }
+  // The same query in float: a pair whose boolean double answer took more iterations than the float GJK's is one
+  // whose float answer the certificate refused (or had none): near touching there must be many, else the
+  // certificate would not be doing its job (accepting every float answer fails the comparison above too).
+  QueryOptions of = o;
+  of.precision = Precision::float32;
+  PairResults in_float;
+  collide(s.shapes, s.batch, of, in_float);
+  std::size_t refused = 0, gjk_pairs = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    if (simd_closed_form(s.shapes[s.batch.shape_a[i]].type, s.shapes[s.batch.shape_b[i]].type, o)) continue;
+    ++gjk_pairs;
+    refused += got.iterations[i] != in_float.iterations[i];
+  }
+  std::printf("[measured] near-touching boolean double pairs through GJK: %zu, float answers refused: %zu, collide "
+              "different from the double GJK's: %zu\n", gjk_pairs, refused, disagree);
+  EXPECT_GT(refused, gjk_pairs / 20);
+}
+
 TEST(ExecutorGjkPairs, EveryInstructionSetGivesTheSameBits) {
   const Scene s = gjk_scene(3000, 13);
+  // Boolean: a double query runs the float GJK and its double certificate (W float lanes per register, twice
+  // double's), which must give the same bits as well, whatever the thread count.
+  for (QueryLevel level : {QueryLevel::boolean, QueryLevel::witness}) {
+    QueryOptions o;
+    o.level = level;
+    o.isa = InstructionSet::scalar;
+    o.threads = 1;
+    PairResults scalar, best, two;
+    collide(s.shapes, s.batch, o, scalar);
+    o.isa = resolve_instruction_set(InstructionSet::automatic);
+    collide(s.shapes, s.batch, o, best);
+    o.threads = 2;
+    collide(s.shapes, s.batch, o, two);
+    testing::expect_same_results(scalar, best, std::string("scalar vs this CPU's best, ") + to_string(level));
+    testing::expect_same_results(best, two, std::string("1 vs 2 threads, ") + to_string(level));
+  }
   QueryOptions o;
   o.level = QueryLevel::witness;
-  o.isa = InstructionSet::scalar;
-  PairResults scalar, best;
-  collide(s.shapes, s.batch, o, scalar);
-  o.isa = resolve_instruction_set(InstructionSet::automatic);
+  PairResults best;
   collide(s.shapes, s.batch, o, best);
-  testing::expect_same_results(scalar, best, "scalar vs this CPU's best");
   for (std::size_t i = 0; i < best.size(); ++i) {
     const std::size_t r = i % 97;
     const bool made_invalid = r == 5 || r == 17 || r == 29 || r == 41;
