@@ -858,6 +858,20 @@ template <class T> struct WideGjk {
     r.lower_bound = L.lower[l];
   }
 
+  /// GjkResult::witness_a() / witness_b() of lane l without building the GjkResult: the sum of lambda[m] times
+  /// the vertex's points, from zero, in m order (the cores' witness points; the lane must track its points). The
+  /// completions straight from the lane (wide_gjk_pairs.inl's converged(), the smoothing samples' done()) share it.
+  AI static void lane_witnesses(const Lanes& L, int l, Vec3<T>& pa, Vec3<T>& pb) {
+    pa = Vec3<T>::Zero(), pb = Vec3<T>::Zero();
+    const int count = int(L.count[l]);
+    for (int m = 0; m < count; ++m) {
+      const int q = int(L.slot[m][l]) & 3;
+      const T lambda = L.lambda[m][l];
+      pa += lambda * get_lane(L.a[q], l);
+      pb += lambda * get_lane(L.b[q], l);
+    }
+  }
+
   /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp's MinkowskiDifference::support).
   AI static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
     a = support(L.A, dir, live);

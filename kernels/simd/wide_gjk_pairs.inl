@@ -334,15 +334,8 @@ template <class T> struct WideGjkPairs {
       if (level >= QueryLevel::distance) out.distance[i] = static_cast<double>(xn - lp.radii);
       if (level >= QueryLevel::witness) {
         const Vec3<T> n = -x / xn;
-        // GjkResult::witness_a() / witness_b(): sum of lambda[m] times the vertex's point, from zero, in m order.
-        Vec3<T> pa = Vec3<T>::Zero(), pb = Vec3<T>::Zero();
-        const int count = int(L.count[l]);
-        for (int m = 0; m < count; ++m) {
-          const int q = int(L.slot[m][l]) & 3;
-          const T lambda = L.lambda[m][l];
-          pa += lambda * G::get_lane(L.a[q], l);
-          pb += lambda * G::get_lane(L.b[q], l);
-        }
+        Vec3<T> pa, pb;
+        G::lane_witnesses(L, l, pa, pb);
         lp.put_world(out.witness_a, i, pa + lp.radius_a * n, true);
         lp.put_world(out.witness_b, i, pb - lp.radius_b * n, true);
         lp.put_world(out.normal, i, n, false);

@@ -98,23 +98,16 @@ template <class T> struct WideGjkSamples {
     /// complete_from_gjk() for lane l's sample, written in A's frame; what it cannot finish goes to the fallback.
     __attribute__((always_inline)) void done(const Lanes& L, int l, GjkStatus status) {
       if (status == GjkStatus::converged && witness_level) [[likely]] {
-        // complete_from_gjk()'s converged case straight from the lane, in its operations and order (|x| as below;
-        // n = -x / |x|; the cores' witness points as GjkResult::witness_a() combines them from zero): the
-        // GjkResult copy (four simplex vertices), the call and the PairOutput cost ~70 instructions per sample.
+        // complete_from_gjk()'s converged case straight from the lane, in its operations and order (|x| as
+        // g.x.norm(), n = -x / |x|, the cores' witness points as GjkResult::witness_a() combines them, the same
+        // steps as wide_gjk_pairs.inl's converged()): the GjkResult copy (four simplex vertices), the call and the
+        // PairOutput cost ~70 instructions per sample.
         const GjkCompletion<T>& c = completion[l];
-        const T x[3] = {L.x.x[l], L.x.y[l], L.x.z[l]};
-        // Eigen's Vec3 norm: a 2-lane packet plus the last square in double, a halving unroll in float.
-        const T xx = x[0] * x[0], yy = x[1] * x[1], zz = x[2] * x[2];
-        const T xn = std::sqrt(std::is_same_v<T, double> ? (xx + yy) + zz : xx + (yy + zz));
-        T n[3], pa[3] = {T(0), T(0), T(0)}, pb[3] = {T(0), T(0), T(0)};
-        for (int i = 0; i < 3; ++i) n[i] = -x[i] / xn;
-        const int count = int(L.count[l]);
-        for (int m = 0; m < count; ++m) {
-          const int q = int(L.slot[m][l]) & 3;
-          const T lambda = L.lambda[m][l];
-          pa[0] += lambda * L.a[q].x[l], pa[1] += lambda * L.a[q].y[l], pa[2] += lambda * L.a[q].z[l];
-          pb[0] += lambda * L.b[q].x[l], pb[1] += lambda * L.b[q].y[l], pb[2] += lambda * L.b[q].z[l];
-        }
+        const Vec3<T> x = G::get_lane(L.x, l);
+        const T xn = x.norm();  // Eigen's reduction order, which differs between float and double (converged())
+        const Vec3<T> n = -x / xn;
+        Vec3<T> pa, pb;
+        G::lane_witnesses(L, l, pa, pb);
         const std::uint32_t s = sample[l];
         out.status[s] = Status::converged;
         const std::size_t k = s * out.stride;
