@@ -397,7 +397,8 @@ template <class T> struct WideGjkPairs {
   // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
 
   /// The types whose boolean double groups run_certified() answers. Their cores are centred at the origin (no hull
-  /// centroid): FloatFeed::load() relies on it. Measured (callgrind AVX2, instructions per pair, main -> this,
+  /// centroid) and their swept radius is the inflation alone (no sphere or capsule radius): FloatFeed::load()
+  /// relies on both. Measured (callgrind AVX2, instructions per pair, main -> this,
   /// distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755. Left out:
   /// capsules and spheres (capsule-box 497 -> 231, 1107 -> 951, but overlap 964 -> 1700: their cores end within
   /// the margin, the radius, on a segment or triangle, which this certificate refuses, so the double GJK runs
@@ -408,14 +409,6 @@ template <class T> struct WideGjkPairs {
   static constexpr bool certified_pays(ShapeType t) {
     return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
   }
-  /// make_core()'s swept radius in float, T(inflation) (+ T(radius) for spheres and capsules) as side_lanes()
-  /// rounds and adds it, from the shape table (the block keeps the double sum).
-  static float float_radius(const PairView& in, ShapeType type, std::int64_t shape) {
-    float r = float(in.shape_inflation[shape]);
-    if (type == ShapeType::sphere || type == ShapeType::capsule) r += float(in.shape_size[0][shape]);
-    return r;
-  }
-
   /// The pairs of a certified run go through its stages a block at a time: one double setup (fill_slots()) that
   /// the gate, the float pass (converted) and the certificate all read, instead of a float and a double setup per
   /// pair (fdbl: ~140 instructions each, AVX2). 256 pairs: ~110 KB (L2); the float lanes drain at a block's end.
@@ -497,7 +490,6 @@ template <class T> struct WideGjkPairs {
   /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
   struct FloatFeed {
     using F = WideGjk<float>;
-    const PairView& in;
     Block& c;
     std::size_t count;
     float tolerance, margin;
@@ -519,7 +511,9 @@ template <class T> struct WideGjkPairs {
       const float floor = (16.0f * machine_epsilon<float>()) * float(c.scale[s]);  // tolerance_floor(scale)
       L.tolerance[l] = tolerance < floor ? floor : tolerance;
       L.touch[l] = floor;
-      L.core_margin[l] = margin + (float_radius(in, L.A.type, c.shape_a[s]) + float_radius(in, L.B.type, c.shape_b[s]));
+      // The float swept radii: for these types make_core()'s radius is the inflation alone, so the block's double
+      // radius is the inflation exactly and rounds to the float fill's T(inflation).
+      L.core_margin[l] = margin + (float(c.radius_a[s]) + float(c.radius_b[s]));
       return true;
     }
     /// drive_boolean_directions(): vertex m's direction is in L.a[L.slot[m]]. Separated and overlapping answers
@@ -644,7 +638,7 @@ template <class T> struct WideGjkPairs {
     L.relative = F::splat(float(options.relative_tolerance));
     L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
     L.boolean_only = F::truth(true);
-    FloatFeed feed{in, block, 0, float(options.tolerance), float(options.margin),
+    FloatFeed feed{block, 0, float(options.tolerance), float(options.margin),
                    typename F::Int(options.solver != Solver::gjk ? -1 : 0)};
     for (std::size_t first = 0; first < n; first += kBlock) {
       const std::size_t end = std::min(n, first + kBlock), count = end - first;
