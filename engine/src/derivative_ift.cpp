@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 namespace batchcol::detail {
 namespace {
@@ -35,24 +36,24 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 6; ++j) {
       const std::size_t e = 6 * i + j;
-      s[(12 + e) * st] = wa[i][j];    // witness_a_a
-      s[(30 + e) * st] = -wa[i][j];   // witness_a_b, plus x_a's rigid motion below
-      s[(48 + e) * st] = wb[i][j];    // witness_b_a
-      s[(66 + e) * st] = -wb[i][j];   // witness_b_b, plus x_b's
-      s[(84 + e) * st] = dn[i][j];    // normal_a
-      s[(102 + e) * st] = -dn[i][j];  // normal_b, plus the normal's
+      s[(store_at::witness_a_a + e) * st] = wa[i][j];
+      s[(store_at::witness_a_b + e) * st] = -wa[i][j];  // plus x_a's rigid motion below
+      s[(store_at::witness_b_a + e) * st] = wb[i][j];
+      s[(store_at::witness_b_b + e) * st] = -wb[i][j];  // plus x_b's
+      s[(store_at::normal_a + e) * st] = dn[i][j];
+      s[(store_at::normal_b + e) * st] = -dn[i][j];  // plus the normal's
     }
-  // The rigid motions [I, -[x]x] of x_a (block 30), x_b (66) and [0, -[n]x] of the normal (102): -[x]x has x_2 at
-  // (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+  // The rigid motions [I, -[x]x] of x_a (witness_a_b), x_b (witness_b_b) and [0, -[n]x] of the normal (normal_b):
+  // -[x]x has x_2 at (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
   const auto add_rigid = [&](std::size_t block, const double* x, bool point) {
     if (point)
       for (std::size_t i = 0; i < 3; ++i) s[(block + 7 * i) * st] += 1.0;
     s[(block + 4) * st] += x[2], s[(block + 5) * st] -= x[1], s[(block + 9) * st] -= x[2];
     s[(block + 11) * st] += x[0], s[(block + 15) * st] += x[1], s[(block + 16) * st] -= x[0];
   };
-  add_rigid(30, xa, true);
-  add_rigid(66, xb, true);
-  add_rigid(102, n, false);
+  add_rigid(store_at::witness_a_b, xa, true);
+  add_rigid(store_at::witness_b_b, xb, true);
+  add_rigid(store_at::normal_b, n, false);
 }
 
 // Two lanes per register (the SSE2 width every x86-64 has; this file is compiled for the baseline set), written
@@ -74,13 +75,13 @@ template <std::size_t N> void load3(const double (&rows)[3][N], std::size_t l, V
 // theorem from n, x_a, x_b, and for each entry (i, j) of the 3x6 derivatives with respect to the twist of a, given
 // by entry(i, j, wa, wb, dn) (dx_a/dxi_a, dx_b/dxi_a, dn/dxi_a), those and the twist of b's by the rigid-motion
 // identity (write_from_twist_a()'s order and formulas).
-// kNormalB: only normal_wrt_b (entries 102-119), the smoothed0 samples' first-order start (dn/dxi_b); the other
-// entries are neither computed nor written.
+// kNormalB: only normal_wrt_b (the 18 entries from store_at::normal_b), the smoothed0 samples' first-order start
+// (dn/dxi_b); the other entries are neither computed nor written.
 template <bool kNormalB = false, class Put, class Entry>
 void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
   // put() for the entries kNormalB keeps: after unrolling, e is a constant and the test folds away.
   const auto keep = [&](int e, const V& v) {
-    if (!kNormalB || e >= 102) put(e, v);
+    if (!kNormalB || e >= store_at::normal_b) put(e, v);
   };
   keep(0, -n[0]), keep(1, -n[1]), keep(2, -n[2]);
   keep(3, n[1] * xa[2] - n[2] * xa[1]), keep(4, n[2] * xa[0] - n[0] * xa[2]), keep(5, n[0] * xa[1] - n[1] * xa[0]);
@@ -95,22 +96,26 @@ void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb
       const int e = 6 * i + j;
       V wa, wb, dn;
       entry(i, j, wa, wb, dn);
-      keep(12 + e, wa);  // witness_a_a
-      keep(48 + e, wb);  // witness_b_a
-      keep(84 + e, dn);  // normal_a
+      keep(store_at::witness_a_a + e, wa);
+      keep(store_at::witness_b_a + e, wb);
+      keep(store_at::normal_a + e, dn);
       // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
       if (j < 3) {
         const double one = i == j ? 1.0 : 0.0;
-        keep(30 + e, one - wa), keep(66 + e, one - wb), keep(102 + e, 0.0 - dn);
+        keep(store_at::witness_a_b + e, one - wa), keep(store_at::witness_b_b + e, one - wb);
+        keep(store_at::normal_b + e, 0.0 - dn);
       } else if (j - 3 == i) {
-        keep(30 + e, 0.0 - wa), keep(66 + e, 0.0 - wb), keep(102 + e, 0.0 - dn);
+        keep(store_at::witness_a_b + e, 0.0 - wa), keep(store_at::witness_b_b + e, 0.0 - wb);
+        keep(store_at::normal_b + e, 0.0 - dn);
       } else {
         const int k = j - 3, other = 3 - i - k;
         // -[x]x(i, k) = eps(i, k, other) x_other
         if ((i + 1) % 3 == k) {
-          keep(30 + e, xa[other] - wa), keep(66 + e, xb[other] - wb), keep(102 + e, n[other] - dn);
+          keep(store_at::witness_a_b + e, xa[other] - wa), keep(store_at::witness_b_b + e, xb[other] - wb);
+          keep(store_at::normal_b + e, n[other] - dn);
         } else {
-          keep(30 + e, -xa[other] - wa), keep(66 + e, -xb[other] - wb), keep(102 + e, -n[other] - dn);
+          keep(store_at::witness_a_b + e, -xa[other] - wa), keep(store_at::witness_b_b + e, -xb[other] - wb);
+          keep(store_at::normal_b + e, -n[other] - dn);
         }
       }
     }
@@ -405,13 +410,16 @@ void write_polytope(const PairGeometry& g, const Mat36& y, const Mat36& wa, cons
 
 void write_jacobians(const PairJacobians& J, double* s, std::size_t stride) {
   for (int k = 0; k < 6; ++k) {
-    s[k * stride] = J.distance_a(k);
-    s[(6 + k) * stride] = J.distance_b(k);
+    s[(store_at::distance_a + k) * stride] = J.distance_a(k);
+    s[(store_at::distance_b + k) * stride] = J.distance_b(k);
   }
-  std::size_t e = 12;
-  for (const Mat36* m : {&J.witness_a_a, &J.witness_a_b, &J.witness_b_a, &J.witness_b_b, &J.normal_a, &J.normal_b})
+  const std::pair<int, const Mat36*> blocks[] = {
+      {store_at::witness_a_a, &J.witness_a_a}, {store_at::witness_a_b, &J.witness_a_b},
+      {store_at::witness_b_a, &J.witness_b_a}, {store_at::witness_b_b, &J.witness_b_b},
+      {store_at::normal_a, &J.normal_a},       {store_at::normal_b, &J.normal_b}};
+  for (const auto& [e0, m] : blocks)
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 6; ++c) s[(e++) * stride] = (*m)(r, c);
+      for (int c = 0; c < 6; ++c) s[(e0 + 6 * r + c) * stride] = (*m)(r, c);
 }
 
 IftFlags implicit_jacobians(const PairGeometry& g, double* slot, std::size_t stride) {

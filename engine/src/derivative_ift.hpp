@@ -71,8 +71,22 @@ inline void distance_gradients(const PairGeometry& g, Row6& grad_a, Row6& grad_b
   grad_b << g.normal.transpose(), g.witness_b.cross(g.normal).transpose();
 }
 
+/// Where each output starts among a pair's entries (StoreBlock's slots, write_jacobians(), the smoothed0 mapping):
+/// the distance gradients of a and b (6 each), then the six 3x6 Jacobians (18 each, row-major) in
+/// DerivativeResults' order. The one spelling of that layout.
+namespace store_at {
+constexpr int distance_a = 0, distance_b = 6, witness_a_a = 12, witness_a_b = 30, witness_b_a = 48, witness_b_b = 66,
+              normal_a = 84, normal_b = 102;
+}
 /// Entries per pair of the derivative outputs (2 x 6 + 6 x 18).
-constexpr int StoreEntries = 120;
+constexpr int StoreEntries = store_at::normal_b + 18;
+// The blocks follow each other in this order: StoreBlock::flush() walks the output arrays in it, and the gradients'
+// writers index entries 0-11 directly.
+static_assert(store_at::distance_a == 0 && store_at::distance_b == 6 && store_at::witness_a_a == 12 &&
+              store_at::witness_a_b == store_at::witness_a_a + 18 &&
+              store_at::witness_b_a == store_at::witness_a_b + 18 &&
+              store_at::witness_b_b == store_at::witness_b_a + 18 && store_at::normal_a == store_at::witness_b_b + 18 &&
+              store_at::normal_b == store_at::normal_a + 18);
 
 /// A sphere's or an ellipsoid's support-map Jacobian left to SmoothLanes to compute (world_support_jacobian()'s
 /// formula): the shape's rotation, its squared radii (zero for a sphere) and its round radius (sphere radius plus

@@ -294,11 +294,10 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
   double xa[3], xb[3], n[3];
   world(1, xa), world(4, xb), world(7, n);
   for (int q = 0; q < 3; ++q) xa[q] += p.ta[q], xb[q] += p.ta[q];
-  // write_jacobians()'s order: distance_a, distance_b, then witness_a_a, witness_a_b, witness_b_a, witness_b_b,
-  // normal_a, normal_b (3x6, row-major).
   double* slot = out.slot(i);
   constexpr std::size_t kS = StoreBlock::kStride;
-  for (int e = 0; e < 6; ++e) slot[e * kS] = -GT[e][0], slot[(6 + e) * kS] = GT[e][0];
+  for (int e = 0; e < 6; ++e)
+    slot[(store_at::distance_a + e) * kS] = -GT[e][0], slot[(store_at::distance_b + e) * kS] = GT[e][0];
   // The a-twist blocks: [I, -[x]x] - the b-twist block (rigid_motion(); [0, -[n]x] for the normal), -[x]x with
   // rigid_motion()'s -0.0 diagonal.
   const auto a_block = [&](std::size_t e0, const double* x, double identity, int r0) {
@@ -313,9 +312,9 @@ void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlo
     for (int r = 0; r < 3; ++r)
       for (int q = 0; q < 6; ++q) slot[(e0 + 6 * r + q) * kS] = GT[q][r0 + r];
   };
-  a_block(12, xa, 1.0, 1), b_block(30, 1);
-  a_block(48, xb, 1.0, 4), b_block(66, 4);
-  a_block(84, n, 0.0, 7), b_block(102, 7);
+  a_block(store_at::witness_a_a, xa, 1.0, 1), b_block(store_at::witness_a_b, 1);
+  a_block(store_at::witness_b_a, xb, 1.0, 4), b_block(store_at::witness_b_b, 4);
+  a_block(store_at::normal_a, n, 0.0, 7), b_block(store_at::normal_b, 7);
   d.smoothed_distance[i] = mean[0];
   d.smoothed_witness_a.set(i, Eigen::Vector3d(xa[0], xa[1], xa[2]));
   d.smoothed_witness_b.set(i, Eigen::Vector3d(xb[0], xb[1], xb[2]));
