@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace batchcol {
@@ -72,10 +73,30 @@ void validate_shapes_for(const ShapeTable& shapes, const QueryOptions& options) 
 }
 
 void refuse_beyond_float_limits(const PairBatchView& batch, std::size_t begin, std::size_t end, PairResults& results) {
-  for (std::size_t i = begin; i < end; ++i) {
-    const Eigen::Vector3d t = batch.translation_b[i] - batch.translation_a[i];
-    if (!((std::abs(t.x()) + std::abs(t.y())) + std::abs(t.z()) <= kMaxLengthFloat)) fill_pair_defaults(results, i);
+  const double *ax = batch.translation_a.x.data(), *ay = batch.translation_a.y.data();
+  const double *az = batch.translation_a.z.data(), *bx = batch.translation_b.x.data();
+  const double *by = batch.translation_b.y.data(), *bz = batch.translation_b.z.data();
+  const auto beyond = [&](std::size_t i) {  // NaN is beyond too
+    return !((std::abs(bx[i] - ax[i]) + std::abs(by[i] - ay[i])) + std::abs(bz[i] - az[i]) <= kMaxLengthFloat);
+  };
+  // Almost no batch has such a pair: a branch-free pass two pairs per SSE2 register (GCC's vector extension; the
+  // plain loop did not vectorise) decides whether the per-pair pass runs at all. The per-pair test with its rare
+  // store cost ~26 instructions a pair, 2-3% of a float boolean query (callgrind, AVX2 kernels).
+  using V2 = double __attribute__((vector_size(16)));
+  using M2 = long long __attribute__((vector_size(16)));
+  const auto ld = [](const double* p) { V2 v; std::memcpy(&v, p, sizeof v); return v; };
+  const auto abs2 = [](V2 v) { return V2(M2(v) & M2{~(1LL << 63), ~(1LL << 63)}); };
+  M2 any2 = {0, 0};
+  std::size_t i = begin;
+  for (; i + 2 <= end; i += 2) {
+    const V2 s = (abs2(ld(bx + i) - ld(ax + i)) + abs2(ld(by + i) - ld(ay + i))) + abs2(ld(bz + i) - ld(az + i));
+    any2 |= ~(s <= V2{kMaxLengthFloat, kMaxLengthFloat});
   }
+  bool any = (any2[0] | any2[1]) != 0;
+  for (; i < end; ++i) any |= beyond(i);
+  if (!any) return;
+  for (i = begin; i < end; ++i)
+    if (beyond(i)) fill_pair_defaults(results, i);
 }
 
 std::optional<Eigen::Quaterniond> unit_quaternion(const Eigen::Quaterniond& q) {

@@ -158,6 +158,36 @@ TEST(ScaleLimits, FarApartPosesAreRefusedOrAnsweredCorrectly) {
       }
 }
 
+// The float path refuses a pair whose translations are more than kMaxLengthFloat apart, whatever its place in the
+// batch: the check runs two pairs per register with a scalar tail, so the far pair is put at every index of batches
+// of odd and even sizes (a one-pair batch only reaches the tail).
+TEST(ScaleLimits, FloatRefusesEachFarPairWhereverItIsInTheBatch) {
+  ShapeTable table;
+  table.add(Shape::sphere(1.0));
+  table.add(Shape::box(Eigen::Vector3d(1, 1, 1)));
+  for (std::size_t n : {2, 3, 5, 8}) {
+    for (std::size_t far = 0; far < n; ++far) {
+      PairBatch batch;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double x = i == far ? 2.0 * kMaxLengthFloat : 5.0 + double(i);
+        batch.add(0, Pose::identity(), 1, Pose{Eigen::Vector3d(x, 0, 0), Eigen::Quaterniond::Identity()});
+      }
+      PairResults out;
+      collide(table, batch, options(Precision::float32), out);
+      for (std::size_t i = 0; i < n; ++i) {
+        SCOPED_TRACE("batch of " + std::to_string(n) + ", far pair " + std::to_string(far) + ", pair " +
+                     std::to_string(i));
+        if (i == far) {
+          EXPECT_EQ(out.status[i], Status::invalid_input);
+        } else {
+          EXPECT_EQ(out.status[i], Status::converged);
+          EXPECT_NEAR(out.distance[i], 5.0 + double(i) - 2.0, 1e-5);
+        }
+      }
+    }
+  }
+}
+
 TEST(ScaleLimits, HalfspaceNormalsOfAnyMagnitudeGiveTheUnitNormal) {
   for (int e = -300; e <= 300; e += 10) {
     const double k = std::pow(10.0, e);
