@@ -29,7 +29,6 @@ struct SupportJacobian {
   int flats = 0;      // 0: no tie; 1: an edge, a capsule's or cylinder's side line, a cone's generator; 2: a face
   bool zero = false;  // S is locally constant at u (a vertex of a non-inflated core)
   bool unsupported = false;  // halfspace: no support map
-  bool approximate = false;  // a cone's side: the curvature across a generator varies along it (the rim's is used)
 };
 
 /// Exact support-map Jacobian of `shape` at the unit local direction u, the witness being `witness` (local frame,

@@ -212,7 +212,7 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     const bool exact_normal = g.distance > 0.0 && plain_polytope(a) && plain_polytope(b);
     const auto side = [&](const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& witness,
                           const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H, int& flats,
-                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, bool& approximate, CurvedSide& curved) {
+                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, CurvedSide& curved) {
       if (s.type == ShapeType::sphere || s.type == ShapeType::ellipsoid) {
         curved.R = &R;
         if (s.type == ShapeType::ellipsoid) curved.radii2 = s.size.cwiseProduct(s.size);
@@ -231,19 +231,12 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
       flats = J.flats;
       if (flats > 0) flat = R * J.flat;
       zero = J.zero;
-      approximate = J.approximate;
     };
-    bool zero_a = false, zero_b = false, approximate_a = false, approximate_b = false;
+    bool zero_a = false, zero_b = false;
     CurvedSide curved_a, curved_b;
-    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, approximate_a,
-         curved_a);
-    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, approximate_b,
-         curved_b);
-    if (approximate_a || approximate_b) {
-      status = DerivativeStatus::nonsmooth;
-    } else if (zero_a || zero_b) {
-      status = DerivativeStatus::zero_curvature;
-    }
+    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, curved_a);
+    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, curved_b);
+    if (zero_a || zero_b) status = DerivativeStatus::zero_curvature;
     // Polytopes without inflation (no curvature) go to PolytopeLanes below.
     if (smooth_pair(g) && (curved_a.R || curved_b.R || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
       out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace batchcol::testing {
 namespace {
@@ -76,6 +77,214 @@ bool sphere_against_solid(const Shape& a, const Pose& pa, const Shape& b, const 
   return false;
 }
 
+
+// ---- Feature-locked exact witness points (feature_witness()) ----
+
+// The round radius swept around a feature: a sphere's or capsule's radius plus the inflation (an ellipsoid's is in
+// its support map).
+double swept_radius(const Shape& s) {
+  double r = s.inflation;
+  if (s.type == ShapeType::sphere || s.type == ShapeType::capsule) r += s.size.x();
+  return r;
+}
+
+// A box feature's index: (s0 + 1) + 3 (s1 + 1) + 9 (s2 + 1), s_k in {-1, 0, 1} (0: free along axis k).
+int box_sign(int index, int k) { return (k == 0 ? index : k == 1 ? index / 3 : index / 9) % 3 - 1; }
+
+// The closest point to x (local frame) of feature f of the core, the feature extended beyond its extent (a line,
+// a plane, an infinite cylinder or cone: smooth in x), and in `outside` how far beyond its extent that point is
+// (<= 0: on the feature itself).
+Eigen::Vector3d feature_point(const Shape& s, const Feature& f, const Eigen::Vector3d& x, double& outside) {
+  outside = 0.0;
+  const double R = s.size.x(), h = s.size.y();
+  const double rho = std::hypot(x.x(), x.y());
+  switch (s.type) {
+    case ShapeType::sphere: return Eigen::Vector3d::Zero();
+    case ShapeType::capsule:
+      if (f.kind == Feature::point) return {0.0, 0.0, f.index ? h : -h};
+      outside = std::abs(x.z()) - h;
+      return {0.0, 0.0, x.z()};
+    case ShapeType::box: {
+      Eigen::Vector3d p;
+      outside = -1e300;
+      for (int k = 0; k < 3; ++k) {
+        const int sign = box_sign(f.index, k);
+        p(k) = sign ? sign * s.size(k) : x(k);
+        if (!sign) outside = std::max(outside, std::abs(x(k)) - s.size(k));
+      }
+      outside = std::max(outside, 0.0);
+      return p;
+    }
+    case ShapeType::cylinder: {
+      const double z = f.index ? h : -h;
+      if (f.kind == Feature::plane) {
+        outside = rho - R;
+        return {x.x(), x.y(), z};
+      }
+      const double c = R / rho;
+      if (f.kind == Feature::circle) return {c * x.x(), c * x.y(), z};
+      outside = std::abs(x.z()) - h;  // the side
+      return {c * x.x(), c * x.y(), x.z()};
+    }
+    case ShapeType::cone: {
+      if (f.kind == Feature::point) return {0.0, 0.0, h};
+      if (f.kind == Feature::plane) {
+        outside = rho - R;
+        return {x.x(), x.y(), -h};
+      }
+      if (f.kind == Feature::circle) return {R / rho * x.x(), R / rho * x.y(), -h};
+      // The side: the generator through x, in the (rho, z) half-plane from the apex (0, h) to the rim (R, -h).
+      const double L = std::hypot(R, 2.0 * h), gr = R / L, gz = -2.0 * h / L;
+      const double t = rho * gr + (x.z() - h) * gz;
+      outside = std::max(-t, t - L);
+      const double c = t * gr / rho;
+      return {c * x.x(), c * x.y(), h + t * gz};
+    }
+    case ShapeType::convex: {
+      const ConvexHull& hull = *s.hull;
+      if (f.kind == Feature::point) return hull.vertices[static_cast<std::size_t>(f.index)];
+      if (f.kind == Feature::line) {
+        const Eigen::Vector3d& a = hull.vertices[static_cast<std::size_t>(f.index >> 16)];
+        const Eigen::Vector3d e = hull.vertices[static_cast<std::size_t>(f.index & 0xffff)] - a;
+        const double t = e.dot(x - a) / e.squaredNorm();
+        outside = std::max(-t, t - 1.0) * e.norm();
+        return a + t * e;
+      }
+      const std::size_t face = static_cast<std::size_t>(f.index);
+      const Eigen::Vector3d& n = hull.face_normals[face];
+      const Eigen::Vector3d p = x - n.dot(x - hull.vertices[hull.faces[face][0]]) * n;
+      outside = -1e300;  // inside every face plane (the face's own and coplanar ones give ~0)
+      for (std::size_t g = 0; g < hull.faces.size(); ++g)
+        outside = std::max(outside, hull.face_normals[g].dot(p - hull.vertices[hull.faces[g][0]]));
+      return p;
+    }
+    default: outside = 1e300; return x;
+  }
+}
+
+std::vector<Feature> all_features(const Shape& s) {
+  std::vector<Feature> out;
+  switch (s.type) {
+    case ShapeType::sphere: out.push_back({Feature::point, 0}); break;
+    case ShapeType::ellipsoid: out.push_back({Feature::smooth, 0}); break;
+    case ShapeType::capsule: out = {{Feature::point, 0}, {Feature::point, 1}, {Feature::line, 0}}; break;
+    case ShapeType::box:
+      for (int i = 0; i < 27; ++i) {
+        const int free = (box_sign(i, 0) == 0) + (box_sign(i, 1) == 0) + (box_sign(i, 2) == 0);
+        if (free < 3) out.push_back({free == 0 ? Feature::point : free == 1 ? Feature::line : Feature::plane, i});
+      }
+      break;
+    case ShapeType::cylinder:
+      out = {{Feature::plane, 0}, {Feature::plane, 1}, {Feature::circle, 0}, {Feature::circle, 1},
+             {Feature::cylinder_side, 0}};
+      break;
+    case ShapeType::cone:
+      out = {{Feature::point, 0}, {Feature::plane, 0}, {Feature::circle, 0}, {Feature::cone_side, 0}};
+      break;
+    case ShapeType::convex: {
+      const ConvexHull& hull = *s.hull;
+      for (std::size_t v = 0; v < hull.vertices.size(); ++v) {
+        out.push_back({Feature::point, static_cast<int>(v)});
+        for (std::uint32_t k = hull.neighbor_offsets[v]; k < hull.neighbor_offsets[v + 1]; ++k)
+          if (hull.neighbors[k] > v) out.push_back({Feature::line, static_cast<int>((v << 16) | hull.neighbors[k])});
+      }
+      for (std::size_t f = 0; f < hull.faces.size(); ++f) out.push_back({Feature::plane, static_cast<int>(f)});
+      break;
+    }
+    default: break;
+  }
+  return out;
+}
+
+// One side of a pair on a locked feature, in the world frame.
+struct Side {
+  const Shape* shape;
+  Pose pose;
+  Eigen::Matrix3d R;
+  Feature f;
+  double radius;  // swept
+  Side(const Shape& s, const Pose& p, const Feature& feature)
+      : shape(&s), pose(p), R(p.rotation.toRotationMatrix()), f(feature), radius(swept_radius(s)) {}
+  bool smooth() const { return f.kind == Feature::smooth; }
+  // The closest point to x of the swept (extended) feature; `outside` as feature_point().
+  Eigen::Vector3d project(const Eigen::Vector3d& x, double& outside) const {
+    Eigen::Vector3d p = R * feature_point(*shape, f, R.transpose() * (x - pose.translation), outside) + pose.translation;
+    if (radius > 0.0) p += radius * (x - p).normalized();
+    return p;
+  }
+  Eigen::Vector3d project(const Eigen::Vector3d& x) const {
+    double outside;
+    return project(x, outside);
+  }
+  Eigen::Vector3d support(const Eigen::Vector3d& u) const { return world_support(*shape, pose, u); }
+};
+
+// Newton on F(v) = 0 from v with a forward-difference Jacobian (step 1e-7 scale): the Jacobian's error only slows
+// the convergence, the root is F's. Returns the iterate of smallest residual.
+template <class F> Eigen::Vector3d newton(const F& f, Eigen::Vector3d v, double scale) {
+  Eigen::Vector3d best = v;
+  double best_norm = std::numeric_limits<double>::infinity();
+  int stalls = 0;
+  for (int it = 0; it < 40 && stalls < 3; ++it) {
+    const Eigen::Vector3d r = f(v);
+    const double norm = r.norm();
+    if (!std::isfinite(norm)) break;
+    if (norm < best_norm) {
+      best_norm = norm;
+      best = v;
+      stalls = 0;
+    } else {
+      ++stalls;
+    }
+    if (norm == 0.0) break;
+    Eigen::Matrix3d J;
+    const double step = 1e-7 * scale;
+    for (int k = 0; k < 3; ++k) J.col(k) = (f(v + step * Eigen::Vector3d::Unit(k)) - r) / step;
+    v -= J.lu().solve(r);
+  }
+  return best;
+}
+
+// The witness points of two locked features from the starting points xa, xb (both moved to the solution).
+void solve_features(const Side& a, const Side& b, Eigen::Vector3d& xa, Eigen::Vector3d& xb, double scale) {
+  if (a.smooth() && b.smooth()) {
+    polish(*a.shape, a.pose, *b.shape, b.pose, xa, xb);
+  } else if (a.smooth()) {  // z = x_b - x_a with x_a = S_a(z), x_b = P_b(x_a)
+    const auto f = [&](const Eigen::Vector3d& z) {
+      const Eigen::Vector3d p = a.support(z);
+      return Eigen::Vector3d(z + p - b.project(p));
+    };
+    const Eigen::Vector3d z = newton(f, xb - xa, (xb - xa).norm());
+    xa = a.support(z);
+    xb = b.project(xa);
+  } else if (b.smooth()) {  // x_b = S_b(-z), x_a = P_a(x_b)
+    const auto f = [&](const Eigen::Vector3d& z) {
+      const Eigen::Vector3d p = b.support(-z);
+      return Eigen::Vector3d(z - p + a.project(p));
+    };
+    const Eigen::Vector3d z = newton(f, xb - xa, (xb - xa).norm());
+    xb = b.support(-z);
+    xa = a.project(xb);
+  } else {  // x_a a fixed point of P_a o P_b
+    const auto f = [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(a.project(b.project(x)) - x); };
+    const Eigen::Vector3d x = newton(f, xa, scale);
+    xa = a.project(b.project(x));
+    xb = b.project(xa);
+  }
+}
+
+// Certifies that (xa, xb) is the closest pair: each point on its feature's extent, and a support point of its
+// whole shape along the normal (so the two parallel planes through them separate the shapes), to 1e-12 scale.
+bool certified(const Side& a, const Side& b, const Eigen::Vector3d& xa, const Eigen::Vector3d& xb, double scale) {
+  const double tol = 1e-12 * scale;
+  const Eigen::Vector3d d = xb - xa;
+  if (!d.allFinite() || !(d.norm() > 0.0)) return false;
+  const Eigen::Vector3d n = d.normalized();
+  double outside = 0.0;
+  if (!a.smooth() && ((a.project(xa, outside) - xa).norm() > tol || !(outside <= tol))) return false;
+  if (!b.smooth() && ((b.project(xb, outside) - xb).norm() > tol || !(outside <= tol))) return false;
+  return n.dot(a.support(n) - xa) <= tol && n.dot(xb - b.support(-n)) <= tol;
+}
 }  // namespace
 
 Pose twisted(const Pose& pose, const Eigen::Matrix<double, 6, 1>& xi, double h) {
@@ -180,6 +389,111 @@ PairBatch random_separated_pairs(Rng& rng, ShapeTable& shapes, const std::vector
     }
   }
   return batch;
+}
+
+}  // namespace batchcol::testing
+
+namespace batchcol::testing {
+
+std::string feature_name(const Shape& shape, const Feature& f) {
+  static const char* const kinds[] = {"none", "surface", "vertex", "edge", "face", "rim", "side", "side"};
+  std::string kind = kinds[f.kind];
+  if (shape.type == ShapeType::capsule) kind = f.kind == Feature::point ? "end" : f.kind == Feature::line ? "side" : kind;
+  if (shape.type == ShapeType::cylinder && f.kind == Feature::plane) kind = "cap";
+  if (shape.type == ShapeType::cone) kind = f.kind == Feature::point ? "apex" : f.kind == Feature::plane ? "base" : kind;
+  return std::string(to_string(shape.type)) + " " + kind;
+}
+
+FeatureReference feature_witness(const ShapeTable& shapes, const PairBatch& batch) {
+  FeatureReference out;
+  collide(shapes, batch, tight_query(), out.exact);
+  PairResults& r = out.exact;
+  const std::vector<double>& radii = detail::ShapeTableAccess::bounding_radii(shapes);
+  const std::size_t n = batch.size();
+  out.feature_a.assign(n, Feature{});
+  out.feature_b.assign(n, Feature{});
+  out.certified.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (r.status[i] != Status::converged || !(r.distance[i] > 0.0)) continue;
+    const Shape& sa = shapes[batch.shape_a[i]];
+    const Shape& sb = shapes[batch.shape_b[i]];
+    const double scale = radii[batch.shape_a[i]] + radii[batch.shape_b[i]];
+    // The candidates: the features within 1e-7 bounding radii of GJK's witness (its error on curved shapes is
+    // ~sqrt(2 R 1e-15) ~ 5e-8 R).
+    const auto candidates = [&](const Shape& s, const Pose& pose, const Eigen::Vector3d& x, double radius) {
+      std::vector<Feature> out_features;
+      for (const Feature& f : all_features(s)) {
+        const Side side(s, pose, f);
+        double outside = 0.0;
+        if (side.smooth() ||
+            ((side.project(x, outside) - x).norm() <= 1e-7 * radius && outside <= 1e-7 * radius))
+          out_features.push_back(f);
+      }
+      return out_features;
+    };
+    const Eigen::Vector3d xa0 = r.witness_a[i], xb0 = r.witness_b[i];
+    double best = std::numeric_limits<double>::infinity();
+    for (const Feature& fa : candidates(sa, batch.pose_a(i), xa0, radii[batch.shape_a[i]]))
+      for (const Feature& fb : candidates(sb, batch.pose_b(i), xb0, radii[batch.shape_b[i]])) {
+        const Side a(sa, batch.pose_a(i), fa), b(sb, batch.pose_b(i), fb);
+        Eigen::Vector3d xa = xa0, xb = xb0;
+        solve_features(a, b, xa, xb, scale);
+        const double d = (xb - xa).norm();
+        if (!(d < best) || !certified(a, b, xa, xb, scale)) continue;
+        best = d;
+        out.feature_a[i] = fa;
+        out.feature_b[i] = fb;
+        out.certified[i] = 1;
+        r.witness_a.set(i, xa);
+        r.witness_b.set(i, xb);
+        r.normal.set(i, (xb - xa) / d);
+        r.distance[i] = d;
+      }
+  }
+  return out;
+}
+
+FeatureDifferences feature_finite_differences(const ShapeTable& shapes, const PairBatch& batch,
+                                              const FeatureReference& nominal, const std::vector<double>& h) {
+  const std::vector<double>& radii = detail::ShapeTableAccess::bounding_radii(shapes);
+  const std::size_t n = batch.size();
+  FeatureDifferences fd;
+  for (auto* v : {&fd.distance_a, &fd.distance_b}) v->assign(n, Row6::Constant(std::nan("")));
+  for (auto* m : {&fd.witness_a_a, &fd.witness_a_b, &fd.witness_b_a, &fd.witness_b_b, &fd.normal_a, &fd.normal_b})
+    m->assign(n, Mat36::Constant(std::nan("")));
+  fd.same_features.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!nominal.certified[i]) continue;
+    const Shape& sa = shapes[batch.shape_a[i]];
+    const Shape& sb = shapes[batch.shape_b[i]];
+    const double scale = radii[batch.shape_a[i]] + radii[batch.shape_b[i]];
+    bool same = true;
+    for (int body = 0; body < 2 && same; ++body)
+      for (int k = 0; k < 6 && same; ++k) {
+        Eigen::Vector3d xa[2], xb[2];
+        for (int s = 0; s < 2 && same; ++s) {
+          Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
+          xi(k) = k < 3 ? 1.0 : 1.0 / scale;
+          Pose pa = batch.pose_a(i), pb = batch.pose_b(i);
+          (body == 0 ? pa : pb) = twisted(body == 0 ? pa : pb, xi, (2 * s - 1) * h[i]);
+          const Side a(sa, pa, nominal.feature_a[i]), b(sb, pb, nominal.feature_b[i]);
+          xa[s] = nominal.exact.witness_a[i];
+          xb[s] = nominal.exact.witness_b[i];
+          solve_features(a, b, xa[s], xb[s], scale);
+          same = certified(a, b, xa[s], xb[s], scale);
+        }
+        if (!same) break;
+        const double step = 2.0 * h[i] * (k < 3 ? 1.0 : 1.0 / scale);
+        const double d_minus = (xb[0] - xa[0]).norm(), d_plus = (xb[1] - xa[1]).norm();
+        (body == 0 ? fd.distance_a : fd.distance_b)[i](k) = (d_plus - d_minus) / step;
+        (body == 0 ? fd.witness_a_a : fd.witness_a_b)[i].col(k) = (xa[1] - xa[0]) / step;
+        (body == 0 ? fd.witness_b_a : fd.witness_b_b)[i].col(k) = (xb[1] - xb[0]) / step;
+        (body == 0 ? fd.normal_a : fd.normal_b)[i].col(k) =
+            ((xb[1] - xa[1]) / d_plus - (xb[0] - xa[0]) / d_minus) / step;
+      }
+    fd.same_features[i] = same ? 1 : 0;
+  }
+  return fd;
 }
 
 }  // namespace batchcol::testing

@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace batchcol::testing {
@@ -51,5 +53,45 @@ template <class M> double relative_error(const M& a, const M& b) {
 /// `count` separated pairs between shapes drawn from `types` (each pair: two random types), centre distance
 /// (bounding radii sum) x [0.8, 2]; pairs whose tight distance is below 2% of that sum are dropped.
 PairBatch random_separated_pairs(Rng& rng, ShapeTable& shapes, const std::vector<ShapeType>& types, int count);
+
+}  // namespace batchcol::testing
+
+namespace batchcol::testing {
+
+/// The feature of a shape a witness lies on, by kind and index (see feature_name()). `smooth`: a sphere's or an
+/// ellipsoid's whole surface; the others are a face, edge or vertex of a polytope, a capsule's segment or end, a
+/// cylinder's cap, rim or side, a cone's base, rim, side or apex (each swept by the shape's round radius).
+struct Feature {
+  enum Kind { none, smooth, point, line, plane, circle, cylinder_side, cone_side } kind = none;
+  int index = 0;
+  bool operator==(const Feature& o) const { return kind == o.kind && index == o.index; }
+};
+
+/// "cylinder rim", "hull face", ...: for reports.
+std::string feature_name(const Shape& shape, const Feature& f);
+
+/// Witness points solved to machine precision for separated pairs of spheres, ellipsoids, capsules, cylinders,
+/// cones, boxes and hulls (any inflation), by locking each witness on its feature: the tight GJK witness names the
+/// candidate features (those within 1e-7 bounding radii of it), every candidate pair is solved by Newton on its
+/// smooth optimality condition (a feature's closest point is closed form: a point, a line, a plane, a circle, an
+/// infinite cylinder or cone; an ellipsoid enters by its support map), and the solution kept is the one that is
+/// certified: each witness in its feature's extent and a support point of its whole shape along the normal (within
+/// 1e-12 of the radii sum), the smallest distance among those. Pairs without a certified solution keep GJK's
+/// answer with `certified` 0.
+struct FeatureReference {
+  PairResults exact;
+  std::vector<Feature> feature_a, feature_b;
+  std::vector<std::uint8_t> certified;
+};
+FeatureReference feature_witness(const ShapeTable& shapes, const PairBatch& batch);
+
+/// Central differences (steps as finite_differences()) with every perturbed copy solved on the nominal pair's
+/// features: exact where the features are unchanged. `same_features[i]` is 0 when a copy's solution on those
+/// features is not certified (the step crosses onto another feature): such pairs have no valid reference.
+struct FeatureDifferences : FiniteDifferences {
+  std::vector<std::uint8_t> same_features;
+};
+FeatureDifferences feature_finite_differences(const ShapeTable& shapes, const PairBatch& batch,
+                                              const FeatureReference& nominal, const std::vector<double>& h);
 
 }  // namespace batchcol::testing

@@ -84,15 +84,15 @@ BATCHCOL_API void validate(const DerivativeOptions& options);
 
 /// Per-pair derivative status. Values are NaN when the status says nothing was computed.
 enum class DerivativeStatus : std::uint8_t {
-  smooth,          // exact (analytic; including a witness on a face or edge of a polytope, a capsule's or cylinder's
-                   // side, whose support map jumps: taken as infinite curvature along it, the limit is exact) /
+  smooth,          // exact (analytic; including a witness on a face or edge of a polytope, a capsule's, cylinder's
+                   // or cone's side, whose support map jumps: taken as infinite curvature along it, the limit is
+                   // exact) /
                    // computed from all samples (smoothed)
   zero_curvature,  // analytic: a witness is a vertex of a non-inflated polytope (its support map is locally
                    // constant): the derivative is exact, but that witness only moves rigidly with its body, which
                    // is the uninformative derivative smoothed1 replaces
   nonsmooth,       // analytic: the witness points are not unique (face against face, parallel edges, an edge on a
                    // face): Jacobians NaN; the distance gradient is given (its angular part is one subgradient).
-                   // Also a witness on a cone's side: values use the rim's curvature (approximate)
   singular,        // the implicit-function system is singular (touching without curvature, some penetrating
                    // pairs): Jacobians NaN, the distance gradient is given
   partial_samples, // smoothed0: some perturbed samples had no witness (e.g. overlapping below the penetration
