@@ -6,6 +6,7 @@
 #include "broadphase/aabb_soa.hpp"
 #include "kernels/math.hpp"
 #include "ray_bvh.hpp"
+#include "ray_huge_pages.hpp"
 #include "ray_prepared.hpp"
 #include "ray_wide_bvh.hpp"
 #include "scene_state.hpp"
@@ -36,8 +37,9 @@ struct RaySceneIndex::State {
   std::vector<PoseRecord> poses;
   RayBvh bvh;       // binary LBVH: built, refitted, and traversed (in double) by rays the float test cannot take
   WideBvh wide;     // its 8-wide collapse, traversed by every other ray
-  std::vector<RayObject> leaves;      // leaf k = object bvh.leaf_object()[k]
-  std::vector<float> leaf_balls;      // per leaf: the wide traversal's float ball filter (make_leaf_ball)
+  // Read at random by the rays (a leaf each visit): on huge pages when large (ray_huge_pages.hpp).
+  std::vector<RayObject, detail::HugePageAllocator<RayObject>> leaves;  // leaf k = object bvh.leaf_object()[k]
+  std::vector<float, detail::HugePageAllocator<float>> leaf_balls;  // per leaf: the float ball filter (make_leaf_ball)
   std::vector<RayObject> halfspaces;  // tested against every ray
   RaySceneTimings timings;
   bool rebuilt = false;
