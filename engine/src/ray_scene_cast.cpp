@@ -72,9 +72,10 @@ class Caster {
   // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
   // call, and on trees larger than the L2 pushed nodes are prefetched.
   void prepare(WideRay* rays, std::size_t n) const {
-    const float* balls = s_.leaf_balls.data();
+    const float* balls = s_.leaves.empty() ? nullptr : s_.leaves.data()->ball;
     const bool prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
-    for (std::size_t l = 0; l < n; ++l) rays[l].balls = balls, rays[l].prefetch = prefetch;
+    for (std::size_t l = 0; l < n; ++l)
+      rays[l].balls = balls, rays[l].ball_stride = sizeof(RayLeaf) / sizeof(float), rays[l].prefetch = prefetch;
   }
 
   // Intersects one object; true on a hit with t <= t_max.
@@ -205,7 +206,7 @@ class Caster {
       if (found && any) return;
     }
     traverse(r, [&] { return limit; }, [&](std::uint32_t leaf) {
-      if (test(s_.leaves[leaf], r, limit, h, capped) && (!found || before(h, best))) {
+      if (test(s_.leaves[leaf].object, r, limit, h, capped) && (!found || before(h, best))) {
         best = h, found = true, limit = best.t;
         if (any) return false;
       }
@@ -218,7 +219,7 @@ class Caster {
     for (const RayObject& obj : s_.halfspaces)
       if (test(obj, r, r.t_max, h, capped)) hits.push_back(h);
     traverse(r, [&] { return r.t_max; }, [&](std::uint32_t leaf) {
-      if (test(s_.leaves[leaf], r, r.t_max, h, capped)) hits.push_back(h);
+      if (test(s_.leaves[leaf].object, r, r.t_max, h, capped)) hits.push_back(h);
       return true;
     });
   }
