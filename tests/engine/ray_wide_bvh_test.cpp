@@ -121,7 +121,9 @@ TEST(RayWideBvh, LargeArraysAreHugePageAlignedAndKeepTheirContents) {
   const std::size_t large = 3 * detail::kHugePageMin / sizeof(std::uint64_t) + 5;
   for (std::size_t i = 0; i < large; ++i) {
     v.push_back(i * 0x9e3779b97f4a7c15ull);
-    if (i == 7) EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % alignof(std::uint64_t), 0u);
+    if (i == 7) {
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % alignof(std::uint64_t), 0u);
+    }
   }
 #if defined(__linux__)
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % detail::kHugePageBytes, 0u);
