@@ -106,15 +106,14 @@ void RaySceneIndex::update(const Scene& scene, int threads, bool force_rebuild) 
     const auto leaf_start = std::chrono::steady_clock::now();
     const std::vector<std::uint32_t>& order = s.bvh.leaf_object();
     s.leaves.resize(order.size());
-    s.leaf_balls.resize(4 * order.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t k = r.begin(); k < r.end(); ++k) {
                           const std::uint32_t i = order[k];
-                          s.leaves[k] = make_object(s.poses[i], f.shape[i], sc.handle_of(f.slot[i]));
+                          RayLeaf& leaf = s.leaves[k];
+                          leaf.object = make_object(s.poses[i], f.shape[i], sc.handle_of(f.slot[i]));
                           // The same centre and bound as the cast's double ball filter (Caster::ball_misses).
-                          make_leaf_ball(s.leaves[k].t.data(), s.prepared.shapes[f.shape[i]].bound,
-                                         &s.leaf_balls[4 * k]);
+                          make_leaf_ball(leaf.object.t.data(), s.prepared.shapes[f.shape[i]].bound, leaf.ball);
                         }
                       });
     s.timings.boxes_ms += ms_since(leaf_start);

@@ -72,9 +72,10 @@ class Caster {
   // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
   // call, and on trees larger than the L2 pushed nodes are prefetched.
   void prepare(WideRay* rays, std::size_t n) const {
-    const float* balls = s_.leaf_balls.data();
+    const float* balls = s_.leaves.empty() ? nullptr : s_.leaves.data()->ball;
     const bool prefetch = s_.wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes;
-    for (std::size_t l = 0; l < n; ++l) rays[l].balls = balls, rays[l].prefetch = prefetch;
+    for (std::size_t l = 0; l < n; ++l)
+      rays[l].balls = balls, rays[l].ball_stride = sizeof(RayLeaf) / sizeof(float), rays[l].prefetch = prefetch;
   }
 
   // Intersects one object; true on a hit with t <= t_max.
@@ -205,7 +206,7 @@ class Caster {
       if (found && any) return;
     }
     traverse(r, [&] { return limit; }, [&](std::uint32_t leaf) {
-      if (test(s_.leaves[leaf], r, limit, h, capped) && (!found || before(h, best))) {
+      if (test(s_.leaves[leaf].object, r, limit, h, capped) && (!found || before(h, best))) {
         best = h, found = true, limit = best.t;
         if (any) return false;
       }
@@ -218,7 +219,7 @@ class Caster {
     for (const RayObject& obj : s_.halfspaces)
       if (test(obj, r, r.t_max, h, capped)) hits.push_back(h);
     traverse(r, [&] { return r.t_max; }, [&](std::uint32_t leaf) {
-      if (test(s_.leaves[leaf], r, r.t_max, h, capped)) hits.push_back(h);
+      if (test(s_.leaves[leaf].object, r, r.t_max, h, capped)) hits.push_back(h);
       return true;
     });
   }
@@ -256,6 +257,11 @@ constexpr std::array<std::uint32_t, 32> kSpread6 = [] {
 // page walks of 14 random lines a ray): the rays are copied once, in input order, into one 64-byte record each, the
 // results go to a buffer in cast order, and a last pass writes the caller's arrays in input order, so a ray touches
 // 3 scattered lines (its record, its slot of the inverse order, its result), not 14.
+// The ordered cast's buffers (~130 bytes a ray, fresh for every cast) on huge pages when large (ray_huge_pages.hpp):
+// 1M rays fault 130 MB in, ~33k page faults with 4 KiB pages, and the records and results are then read at scattered
+// places in the cast order and the scatter, one TLB entry per ray with small pages, one per 2 MiB with huge ones.
+template <class T> using CastBuffer = std::vector<T, detail::HugePageAllocator<T>>;
+
 struct alignas(64) PackedRay {  // one cache line
   double o[3], d[3], t_max;
   std::uint32_t valid;
@@ -291,7 +297,7 @@ class RayOrder {
         words_[i] = std::uint64_t(p.valid ? key(p, lo, hi, scale) : kMissKey) << 32 | std::uint64_t(i);
       }
     });
-    std::vector<std::uint64_t> scratch(n_);
+    CastBuffer<std::uint64_t> scratch(n_);
     broadphase::radix_sort(words_.data(), scratch.data(), n_, broadphase::digit_shifts(32, 62));
   }
 
@@ -301,10 +307,11 @@ class RayOrder {
   const PackedRay& ray(std::size_t k) const { return packed_[index(k)]; }
   void prefetch(std::size_t k) const { __builtin_prefetch(&packed_[index(k)]); }
 
-  /// Writes results[k] (cast order) to out (input order); frees the records first.
-  void scatter(const std::vector<CastResult>& results, RayResults& out) {
-    packed_ = {};
-    std::vector<std::uint32_t> position(n_);
+  /// Writes results[k] (cast order) to out (input order); frees the records first (`packed_ = {}` only cleared
+  /// them: an empty braced list picks the initializer-list assignment, which keeps the capacity).
+  void scatter(const CastBuffer<CastResult>& results, RayResults& out) {
+    CastBuffer<PackedRay>().swap(packed_);
+    CastBuffer<std::uint32_t> position(n_);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k < r.end(); ++k) position[index(k)] = static_cast<std::uint32_t>(k);
     });
@@ -339,8 +346,8 @@ class RayOrder {
   }
 
   std::size_t n_;
-  std::vector<PackedRay> packed_;
-  std::vector<std::uint64_t> words_;
+  CastBuffer<PackedRay> packed_;
+  CastBuffer<std::uint64_t> words_;
 };
 
 }  // namespace
@@ -361,7 +368,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
       state_->wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes) {
     detail::run_with_threads(options.threads, [&] {
       RayOrder order(rays, state_->wide.nodes()[0]);
-      std::vector<CastResult> results(n);
+      CastBuffer<CastResult> results(n);
       const bool any = options.query == RayQuery::any;
       const WideRaySetup setup = select_wide_ray_setup();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {

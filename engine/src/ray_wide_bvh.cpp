@@ -145,6 +145,11 @@ void WideBvh::collapse(const RayBvh& bvh, const broadphase::AabbSoa& boxes) {
     std::uint32_t binary, wide;
   };
   std::vector<Task> todo{{0u, 0u}};
+  // At most leaves - 1 nodes (each has >= 2 children and is itself a child, except the root): reserved, so the
+  // array is never copied as it grows. Only the pages written are faulted in (on huge pages each regrowth faulted
+  // a fresh mapping in: the 100k-object collapse took 167-172 ms against 104-122 ms reserved, load average 13).
+  nodes_.reserve(bvh.leaf_count() - 1);
+  source_.reserve((bvh.leaf_count() - 1) * kWideArity);
   nodes_.emplace_back();
   source_.resize(kWideArity);
   while (!todo.empty()) {

@@ -10,6 +10,7 @@
 
 #include "broadphase/aabb_soa.hpp"
 #include "ray_bvh.hpp"
+#include "ray_huge_pages.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -28,6 +29,8 @@ struct alignas(64) WideNode {
   std::uint32_t child[kWideArity];
 };
 static_assert(sizeof(WideNode) == 256, "WideNode layout");
+/// The nodes of a tree, on huge pages when large (ray_huge_pages.hpp: a ray reads ~20 of them at random).
+using WideNodes = std::vector<WideNode, detail::HugePageAllocator<WideNode>>;
 
 class WideBvh {
  public:
@@ -36,11 +39,11 @@ class WideBvh {
   /// Copies the boxes of a refitted `bvh` (same topology as at collapse()) into the wide nodes, in parallel.
   void refit(const RayBvh& bvh, const broadphase::AabbSoa& boxes);
 
-  const std::vector<WideNode>& nodes() const { return nodes_; }
+  const WideNodes& nodes() const { return nodes_; }
   void clear() { nodes_.clear(), source_.clear(); }
 
  private:
-  std::vector<WideNode> nodes_;        // node 0 is the root
+  WideNodes nodes_;                    // node 0 is the root
   std::vector<std::uint32_t> source_;  // per node and slot: the binary reference whose box fills the slot
 };
 

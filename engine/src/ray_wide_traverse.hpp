@@ -46,7 +46,8 @@ struct WideRay {
   float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
   float ball_margin;           // kBallMargin * |o|_1, rounded up
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
-  bool prefetch = false;         // request a pushed node's lines early (worth it when the nodes do not fit the L2)
+  std::uint32_t ball_stride = 4;  // floats from one leaf's ball to the next (the balls sit in the leaf records)
+  bool prefetch = false;  // request a pushed child's lines early (worth it when the nodes do not fit the L2)
 };
 
 /// The float ball of a leaf whose exact filter is the ball (c, bound): centre rounded to float, radius covering bound

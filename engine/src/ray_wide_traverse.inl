@@ -18,11 +18,18 @@ inline V load_at(const WideNode* node, std::size_t byte_offset) {
 inline V max_into(V x, V acc) { return x > acc ? x : acc; }
 inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 
-// A node that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
-// larger than the L2 (WideRay::prefetch) its four cache lines are requested now, so the loads overlap the work in
-// between; on smaller trees the lines are there anyway and the requests only cost issue slots.
-inline void prefetch_node(const WideNode* nodes, std::uint32_t ref) {
-  if (ref & kLeafBit) return;
+// A child that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
+// larger than the L2 (WideRay::prefetch) its cache lines are requested now, so the loads overlap the work in
+// between; on smaller trees the lines are there anyway and the requests only cost issue slots. A node's four lines;
+// for a leaf with balls, the two lines of its record from the ball on (the caller's leaf records hold the ball and
+// the object together: ray_scene_state.hpp).
+inline void prefetch_child(const WideNode* nodes, std::uint32_t ref, const WideRay& r) {
+  if (ref & kLeafBit) {
+    if (r.balls == nullptr) return;
+    const char* p = reinterpret_cast<const char*>(r.balls + std::size_t(r.ball_stride) * (ref & ~kLeafBit));
+    __builtin_prefetch(p), __builtin_prefetch(p + 64);
+    return;
+  }
   const char* p = reinterpret_cast<const char*>(nodes + ref);
   for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
 }
@@ -91,7 +98,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   for (;;) {
     if (e.ref & kLeafBit) {
       const std::uint32_t leaf = e.ref & ~kLeafBit;
-      if (r.balls != nullptr && ball_misses(r.balls + 4 * std::size_t(leaf), r)) {
+      if (r.balls != nullptr && ball_misses(r.balls + std::size_t(r.ball_stride) * leaf, r)) {
         if (!pop()) return;
         continue;
       }
@@ -133,7 +140,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       const bool swap = entry[k1] < entry[k0];
       const int near = swap ? k1 : k0, far = swap ? k0 : k1;
       stack[top++] = Entry{n->child[far], entry[far]};
-      if (r.prefetch) prefetch_node(nodes, n->child[far]);
+      if (r.prefetch) prefetch_child(nodes, n->child[far], r);
       e = Entry{n->child[near], entry[near]};
       continue;
     }
@@ -150,7 +157,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
       const int rank = __builtin_popcount(bits & (nearer | (same & ((1u << k) - 1u))));
       base[-rank] = Entry{n->child[k], t};
-      if (r.prefetch && rank != 0) prefetch_node(nodes, n->child[k]);
+      if (r.prefetch && rank != 0) prefetch_child(nodes, n->child[k], r);
     }
     top += count - 1;
     e = stack[top];  // rank 0: the nearest child next, without a trip through the stack

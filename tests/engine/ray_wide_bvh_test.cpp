@@ -112,6 +112,43 @@ TEST(RayWideBvh, CollapseAndRefitKeepEveryLeafOnceInsideExactUnions) {
   }
 }
 
+// The ray index's large arrays are mapped for huge pages (ray_huge_pages.hpp): 2 MiB-aligned from kHugePageMin on
+// (on Linux), the ordinary allocator's alignment below, and the contents kept through growth across the threshold
+// (a vector copies into a new mapping). Whether the kernel backs them with huge pages is its choice; the results
+// cannot depend on it, which the scene tests' bitwise checks cover.
+TEST(RayWideBvh, LargeArraysAreHugePageAlignedAndKeepTheirContents) {
+  std::vector<std::uint64_t, detail::HugePageAllocator<std::uint64_t>> v;
+  const std::size_t large = 3 * detail::kHugePageMin / sizeof(std::uint64_t) + 5;
+  for (std::size_t i = 0; i < large; ++i) {
+    v.push_back(i * 0x9e3779b97f4a7c15ull);
+    if (i == 7) {
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % alignof(std::uint64_t), 0u);
+    }
+  }
+#if defined(__linux__)
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % detail::kHugePageBytes, 0u);
+#endif
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < large; ++i) wrong += v[i] != i * 0x9e3779b97f4a7c15ull;
+  EXPECT_EQ(wrong, 0u);
+  // A tree whose nodes pass the threshold: aligned, and whole after a refit.
+  Rng rng(11);
+  const broadphase::AabbSoa b = random_boxes(rng, 40000, 200.0, 2.0);
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b);
+  ASSERT_GE(wide.nodes().size() * sizeof(WideNode), detail::kHugePageMin);
+#if defined(__linux__)
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(wide.nodes().data()) % detail::kHugePageBytes, 0u);
+#endif
+  check_structure(wide, bvh, b);
+  const broadphase::AabbSoa moved = random_boxes(rng, 40000, 200.0, 2.0);
+  bvh.refit(moved);
+  wide.refit(bvh, moved);
+  check_structure(wide, bvh, moved);
+}
+
 // Exact reference: does the segment o + t d, t in [0, t_max], touch the closed box? Only used on rays whose
 // parameters are exact below (t_max = 1 on a boundary point) or with a relative margin.
 bool slab_hits(const double lo[3], const double hi[3], const double o[3], const double d[3], double t_max) {
