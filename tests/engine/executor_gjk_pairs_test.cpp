@@ -296,6 +296,15 @@ TEST(ExecutorGjkPairs, KernelAnswersEveryValidPairOfManyChunksAndLargeHulls) {
     }
 }
 
+/// The same query in float: a certified boolean double pair whose iterations are the float query's kept its float
+/// answer (run_certified() adds the double GJK's iterations to a refused one's).
+PairResults in_float_precision(const Scene& s, QueryOptions o) {
+  o.precision = Precision::float32;
+  PairResults r;
+  collide(s.shapes, s.batch, o, r);
+  return r;
+}
+
 /// Boolean double queries are answered by the float GJK plus a double certificate (wide_gjk_pairs.inl
 /// run_certified()). Pairs placed within float error of touching, gaps and overlaps of 1e-12 .. 1e-4 times the
 /// shapes' scale (1e-3 .. 1e3 m, extreme aspect ratios included), every GJK type pair of box, cylinder, cone,
@@ -389,10 +398,7 @@ TEST(ExecutorGjkPairs, BooleanDoubleNearTouchingPairsHaveTheDoubleAnswer) {
   // The same query in float: a pair whose boolean double answer took more iterations than the float GJK's is one
   // whose float answer the certificate refused (or had none): near touching there must be many, else the
   // certificate would not be doing its job (accepting every float answer fails the comparison above too).
-  QueryOptions of = o;
-  of.precision = Precision::float32;
-  PairResults in_float;
-  collide(s.shapes, s.batch, of, in_float);
+  const PairResults in_float = in_float_precision(s, o);
   std::size_t refused = 0, gjk_pairs = 0;
   for (std::size_t i = 0; i < got.size(); ++i) {
     if (simd_closed_form(s.shapes[s.batch.shape_a[i]].type, s.shapes[s.batch.shape_b[i]].type, o)) continue;
@@ -437,10 +443,7 @@ TEST(ExecutorGjkPairs, BooleanDoubleSweptOverlapsAreProvenWithinTheRadius) {
   collide(s.shapes, s.batch, o, got);
   const PairResults want = reference<double>(s, o, got, false);  // the plain double GJK's answers
   testing::expect_same_results(reference<double>(s, o, got), got, "certified reference");
-  QueryOptions of = o;
-  of.precision = Precision::float32;
-  PairResults in_float;
-  collide(s.shapes, s.batch, of, in_float);
+  const PairResults in_float = in_float_precision(s, o);
   std::size_t colliding = 0, accepted = 0;
   for (std::size_t i = 0; i < got.size(); ++i) {
     EXPECT_EQ(want.status[i], got.status[i]) << i;
