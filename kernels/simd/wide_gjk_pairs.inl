@@ -397,18 +397,23 @@ template <class T> struct WideGjkPairs {
   // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
 
   /// The types whose boolean double groups run_certified() answers. Their cores are centred at the origin (no hull
-  /// centroid) and their swept radius is the inflation alone (no sphere or capsule radius): FloatFeed::load()
-  /// relies on both. Measured (callgrind AVX2, instructions per pair, main -> this,
-  /// distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755. Left out:
-  /// capsules and spheres (capsule-box 497 -> 231, 1107 -> 951, but overlap 964 -> 1700: their cores end within
-  /// the margin, the radius, on a segment or triangle, which this certificate refuses, so the double GJK runs
-  /// after the float one; a segment / triangle certificate in plain arithmetic made it 230 / 968 / 1016 and cost
-  /// the other rows 1-2%, narrowphase-sessions.md), and convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
+  /// centroid) and their swept radius is the inflation alone, or for spheres and capsules the inflation plus their
+  /// radius (FloatFeed::load() and FloatFeed::radius() rely on both). Measured (callgrind AVX2,
+  /// instructions per pair, main -> this, distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955,
+  /// 2186 -> 1755. Capsules and spheres end within the margin, the radius, on a segment or triangle (without a
+  /// 2-3 vertex certificate capsule-box overlap was 964 -> 1700, the double GJK after the float one):
+  /// certify_within() proves those, out of line (inlined, a plain-arithmetic version cost the other rows 1-2%,
+  /// narrowphase-sessions.md). Left out: convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
   /// four double hull supports per overlap certificate; and a hull's centroid makes the float first direction
   /// differ from the double one rounded).
   static constexpr bool certified_pays(ShapeType t) {
-    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid;
+    return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid ||
+           rounded(t);
   }
+  /// Spheres and capsules: a point or a segment swept by a radius. Their swept radius is T(inflation) + T(radius)
+  /// (make_core()), so the float pass takes it from the shape table (FloatFeed::radius()); their overlaps end with
+  /// the origin within the radius of a segment or triangle of D, which certify_within() proves.
+  static constexpr bool rounded(ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; }
   /// The pairs of a certified run go through its stages a block at a time: one double setup (fill_slots()) that
   /// the gate, the float pass (converted) and the certificate all read, instead of a float and a double setup per
   /// pair (fdbl: ~140 instructions each, AVX2). 256 pairs: ~110 KB (L2); the float lanes drain at a block's end.
@@ -494,6 +499,8 @@ template <class T> struct WideGjkPairs {
     std::size_t count;
     float tolerance, margin;
     typename F::Int momentum;
+    const PairView& in;
+    bool rounded_a, rounded_b;  // rounded(type): the side's float radius comes from the shape table
     std::size_t next = 0;
 
     bool load(typename F::Lanes& L, int l) {
@@ -511,10 +518,18 @@ template <class T> struct WideGjkPairs {
       const float floor = (16.0f * machine_epsilon<float>()) * float(c.scale[s]);  // tolerance_floor(scale)
       L.tolerance[l] = tolerance < floor ? floor : tolerance;
       L.touch[l] = floor;
-      // The float swept radii: for these types make_core()'s radius is the inflation alone, so the block's double
-      // radius is the inflation exactly and rounds to the float fill's T(inflation).
-      L.core_margin[l] = margin + (float(c.radius_a[s]) + float(c.radius_b[s]));
+      // The float swept radii, the float fill's radii + margin (the same operations).
+      L.core_margin[l] = margin + (radius(rounded_a, c.radius_a, c.shape_a, s) + radius(rounded_b, c.radius_b, c.shape_b, s));
       return true;
+    }
+    /// make_core<float>()'s swept radius of one side of slot s. Boxes, cylinders, cones, ellipsoids: the inflation
+    /// alone, so the block's double radius is the inflation exactly and rounds to the float fill's T(inflation).
+    /// Spheres and capsules: float(inflation) + float(radius), which float(double(inflation) + double(radius))
+    /// is not always, so the two are read from the shape table (two loads a side).
+    float radius(bool round, const double* block_radius, const std::int64_t* shape, std::size_t s) const {
+      if (!round) return float(block_radius[s]);
+      const std::int64_t i = shape[s];
+      return float(in.shape_inflation[i]) + float(in.shape_size[0][i]);
     }
     /// drive_boolean_directions(): vertex m's direction is in L.a[L.slot[m]]. Separated and overlapping answers
     /// are kept for the certificate; any other ending (budget, convergence, stall) leaves kind 0.
@@ -533,6 +548,58 @@ template <class T> struct WideGjkPairs {
     }
   };
 
+  /// The proof for lanes whose float answer ended with 2 (segment) or 3 (`triangle` lanes) simplex vertices within
+  /// the swept radius: p[0..2] are those vertices computed again in double (D.support(-v_m), points of the double
+  /// problem's Minkowski difference of the cores, like every point the double GJK proves with). Returns the lanes
+  /// where a point y* of their convex hull provably has |y*| <= `radius` (the double GJK's overlap test,
+  /// max(core margin, touch)): then dist(0, D) <= radius and the shapes collide. No projection through project()
+  /// (its branches and selects are the GJK's, and its result must be bitwise the reference's); instead one point
+  /// of the simplex, any point, whose distance is bounded rigorously:
+  ///  - weights: the segment's t = -<p0, e1> / |e1|^2, the triangle's (a, b) from the 2x2 normal equations
+  ///    (Cramer), each clamped to [0, 1] (a NaN to 0). y* = p0 + a (p1 - p0) + b (p2 - p0) in exact arithmetic, with
+  ///    the clamped doubles a, b, lies in the simplex iff a, b >= 0 and a + b <= 1: a + b < 1 in floating point
+  ///    implies it (rounding is monotone and 1 is a double), and a + b is exact where a or b is 0 (segments: b = 0);
+  ///  - y = fl(p0 + fl(a fl(p1 - p0))) + fl(b fl(p2 - p0)) differs from y* by at most ~4.1 u S per component
+  ///    (u = 2^-53, S = the sum of the three terms' absolute components), so |y - y*| <= 4.1 u S; fl(|y|^2) is
+  ///    |y|^2 within 3 u, and the bound c = radius - E and c^2 round by u each. Accepted iff c > 0 and fl(|y|^2)
+  ///    <= fl(c c) with E = 2^-49 (S + radius) + DBL_MIN (4x the bounds above; DBL_MIN covers underflow):
+  ///    |y*| <= |y| + 4.1 u S <= c (1 + 3.1 u) + 4.1 u S <= radius. NaN or infinite values fail the comparisons.
+  /// Every operation is a lane-wise IEEE operation in a fixed order (no FMA: -ffp-contract=off tree-wide; no
+  /// reductions, no min/max whose NaN rule could differ), so each lane's answer is the same bits at any W.
+  /// Out of line, so that rows with no such lanes keep certify()'s body as it was (a plain-arithmetic certificate
+  /// inlined there cost the other rows 1-2%).
+  __attribute__((noinline)) static std::uint32_t certify_within(const typename G::V3 (&p)[4],
+                                                                const typename G::mask& triangle,
+                                                                const typename G::real& radius) {
+    static_assert(std::is_same_v<T, double>, "the error bound's constants are double's");
+    using V3 = typename G::V3;
+    using real = typename G::real;
+    using mask = typename G::mask;
+    const real zero = G::splat(T(0)), one = G::splat(T(1));
+    const V3 e1 = G::sub(p[1], p[0]);
+    const V3 e2 = G::pick(triangle, G::sub(p[2], p[0]), V3{zero, zero, zero});
+    const real d11 = G::dot(e1, e1), d12 = G::dot(e1, e2), d22 = G::dot(e2, e2);
+    const real r1 = -G::dot(p[0], e1), r2 = -G::dot(p[0], e2);
+    const real det = d11 * d22 - d12 * d12;
+    real a = select(triangle, (d22 * r1 - d12 * r2) / det, r1 / d11);
+    real b = select(triangle, (d11 * r2 - d12 * r1) / det, zero);
+    a = select(a > zero, a, zero), b = select(b > zero, b, zero);  // NaN -> 0
+    a = select(a < one, a, one), b = select(b < one, b, one);
+    const mask in_simplex = (a + b < one) | (a == zero) | (b == zero);
+    const V3 ta = G::scale(a, e1), tb = G::scale(b, e2);
+    const V3 y = G::add(G::add(p[0], ta), tb);
+    const real S = (magnitude(p[0]) + magnitude(ta)) + magnitude(tb);
+    const real E = G::splat(T(0x1p-49)) * (S + radius) + G::splat(std::numeric_limits<T>::min());
+    const real c = radius - E;
+    return lane_bits(in_simplex & (c > zero) & (G::norm2(y) <= c * c));
+  }
+
+  /// |x| + |y| + |z| of each lane (certify_within()'s error bound).
+  static typename G::real magnitude(const typename G::V3& v) {
+    const typename G::real zero{};
+    return (select(v.x < zero, -v.x, v.x) + select(v.y < zero, -v.y, v.y)) + select(v.z < zero, -v.z, v.z);
+  }
+
   /// The certificates of the float answers of the survivors `bits` of the register at slot s, W pairs at a time in
   /// C's double lanes, read straight from the block (vector loads; the float answers widened): an accepted answer
   /// is written; a refused one (or kind 0) is appended to `refused` with its float iterations.
@@ -540,10 +607,15 @@ template <class T> struct WideGjkPairs {
   ///    the double GJK's own test that ends a separated boolean pair (ends_separated);
   ///  - overlapping with 4 vertices: the vertices computed again in double (D.support(-v_m)), accepted iff
   ///    tetrahedron()'s signed volumes say it contains the origin (ends_contains); with one vertex: accepted iff
-  ///    its norm is <= max(core margin, touch) (ends_collision, ends_overlap). Two or three vertices are refused:
-  ///    on fdbl, their certificate through project() gave different bits in the scalar build (W = 1, GCC 12) than
-  ///    in AVX2 / AVX-512 on identical inputs (memcheck and -fsanitize=undefined found nothing; not root caused),
-  ///    so that form is not used.
+  ///    its norm is <= max(core margin, touch) (ends_collision, ends_overlap); with two or three: accepted iff a
+  ///    point of the segment / triangle is proven within max(core margin, touch) (certify_within(), a rigorous
+  ///    error bound; not project(): on fdbl a certificate through project() gave different bits in the scalar
+  ///    build than in AVX2 / AVX-512, not root caused).
+  /// A proven answer stands where the double GJK's differs: near touching, that GJK may stop at its tolerance
+  /// (converged, collide 1 from a lower bound within the tolerance of the core margin) on a pair that is
+  /// separated; the certificate accepts only a separation or an overlap it proves, so the answer is the true one
+  /// there, and it is still deterministic (per-lane arithmetic). Running the double GJK after a proof to copy its
+  /// tolerance answer would cost every overlap a double GJK, the cost this filter removes.
   /// The certificate's support points are points of the double problem's Minkowski difference, so an accepted
   /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
   /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
@@ -555,7 +627,7 @@ template <class T> struct WideGjkPairs {
     using mask = typename G::mask;
     typedef float floats __attribute__((vector_size(sizeof(float) * W), aligned(alignof(float))));
     const auto widened = [&](const float* p) { return __builtin_convertvector(*reinterpret_cast<const floats*>(p + s), real); };
-    std::uint32_t sep_bits = 0, four_bits = 0, one_bits = 0;
+    std::uint32_t sep_bits = 0, four_bits = 0, one_bits = 0, two_bits = 0, three_bits = 0;
     for (std::uint32_t k = bits; k != 0; k &= k - 1) {
       const int l = __builtin_ctz(k);
       const std::size_t q = s + std::size_t(l);
@@ -563,8 +635,10 @@ template <class T> struct WideGjkPairs {
       if (c.kind[q] == 1) sep_bits |= bit;
       if (c.kind[q] == 2 && c.count[q] == 4) four_bits |= bit;
       if (c.kind[q] == 2 && c.count[q] == 1) one_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 2) two_bits |= bit;
+      if (c.kind[q] == 2 && c.count[q] == 3) three_bits |= bit;
     }
-    const std::uint32_t live = sep_bits | four_bits | one_bits;
+    const std::uint32_t live = sep_bits | four_bits | one_bits | two_bits | three_bits;
     std::uint32_t ok_bits = 0;
     const V3 dir = {widened(c.direction[0]), widened(c.direction[1]), widened(c.direction[2])};
     if (live != 0) {
@@ -586,6 +660,12 @@ template <class T> struct WideGjkPairs {
       if (one_bits != 0) {
         // The double GJK's ends_collision (|x| <= core margin) and ends_overlap (|x| <= touch) tests.
         ok_bits |= lane_bits(G::norm(p[0]) <= wmax(cm, touch)) & one_bits;
+      }
+      if (const std::uint32_t within = two_bits | three_bits; within != 0) {
+        G::minkowski(C, G::neg(v[1]), within, p[1], sa, sb);
+        if (three_bits != 0) G::minkowski(C, G::neg(v[2]), three_bits, p[2], sa, sb);
+        else p[2] = p[0];  // read, not used (no triangle lane)
+        ok_bits |= certify_within(p, G::lanes_of(three_bits), wmax(cm, touch)) & within;
       }
       if (four_bits != 0) {
         for (int m = 1; m < 4; ++m) G::minkowski(C, G::neg(v[m]), four_bits, p[m], sa, sb);
@@ -638,8 +718,14 @@ template <class T> struct WideGjkPairs {
     L.relative = F::splat(float(options.relative_tolerance));
     L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
     L.boolean_only = F::truth(true);
-    FloatFeed feed{block, 0, float(options.tolerance), float(options.margin),
-                   typename F::Int(options.solver != Solver::gjk ? -1 : 0)};
+    FloatFeed feed{block,
+                   0,
+                   float(options.tolerance),
+                   float(options.margin),
+                   typename F::Int(options.solver != Solver::gjk ? -1 : 0),
+                   in,
+                   rounded(type_a),
+                   rounded(type_b)};
     for (std::size_t first = 0; first < n; first += kBlock) {
       const std::size_t end = std::min(n, first + kBlock), count = end - first;
       for (std::size_t w = 0; w < kBlock / 64; ++w) block.valid[w] = block.alive[w] = 0;
