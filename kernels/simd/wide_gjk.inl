@@ -131,7 +131,7 @@ template <class T> struct WideGjk {
   /// together (dot products and the running argmax in SIMD, no gathers); otherwise each lane runs the scalar
   /// hull_support (hill climbing with its hint). Both keep the reference's rule: the first vertex with the
   /// largest dot product wins, with the reference's dot product (dot3's association, in T).
-  AI static V3 hull_support_lanes(Side& s, const V3& d, std::uint32_t live) {
+  static V3 hull_support_lanes(Side& s, const V3& d, std::uint32_t live) {
     const real zero = splat(T(0));
     V3 r{zero, zero, zero};
     if (live == 0) return r;
@@ -467,7 +467,7 @@ template <class T> struct WideGjk {
     return r;
   }
 
-  AI static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
+  static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
   /// Face m of tetrahedron p[0..2], s that keeps s (vertex 3), per lane (m = 0: old vertices 1, 2; m = 1: 0, 2;
   /// m = 2: 0, 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.

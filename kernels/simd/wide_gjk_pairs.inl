@@ -373,35 +373,9 @@ template <class T> struct WideGjkPairs {
                          std::size_t n, const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
     if (n == 0) return 0;
     if constexpr (std::is_same_v<T, double>)
-      if (options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b)) {
-        if (type_a != ShapeType::convex && type_b != ShapeType::convex)
-          return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
-        return run_hulls(in, type_a, type_b, pairs, n, options, out, fallback);
-      }
+      if (options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b))
+        return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
     return run_plain(in, type_a, type_b, pairs, n, options, out, fallback);
-  }
-  /// A boolean double group with a convex side: pairs whose hulls are all small (below kHillClimbMinVertices, the
-  /// lane-interleaved rows) run certified, the others plain. Large hulls stay on the double GJK: their float
-  /// supports climb lane by lane like the double ones (float/double 1.04-1.18 on convex250/940), so the float pass
-  /// saves little while the certificate adds up to four climbs (fdbl: convex250 overlap 271 -> 320 ns), and they
-  /// already meet their 5x target.
-  static std::size_t run_hulls(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
-                               std::size_t n, const QueryOptions& options, const ResultView& out,
-                               std::uint32_t* fallback) {
-    thread_local std::vector<std::uint32_t> small, large;
-    small.resize(n);
-    large.resize(n);
-    std::size_t ns = 0, nl = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::uint32_t i = pairs[k];
-      const bool big = (type_a == ShapeType::convex && in.shape_a[i] < in.shape_count &&
-                        in.shape_hull[in.shape_a[i]].vertex_count >= kHillClimbMinVertices) ||
-                       (type_b == ShapeType::convex && in.shape_b[i] < in.shape_count &&
-                        in.shape_hull[in.shape_b[i]].vertex_count >= kHillClimbMinVertices);
-      (big ? large[nl++] : small[ns++]) = i;
-    }
-    std::size_t fallbacks = run_certified(in, type_a, type_b, small.data(), ns, options, out, fallback);
-    return fallbacks + run_plain(in, type_a, type_b, large.data(), nl, options, out, fallback + fallbacks);
   }
   /// Every pair through the GJK of precision T (a certified run's refused pairs too).
   static std::size_t run_plain(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
@@ -422,21 +396,19 @@ template <class T> struct WideGjkPairs {
 
   // ---- Boolean double queries: a double gate, the float GJK, a double certificate (run_certified()) ----
 
-  /// The types whose boolean double groups run_certified() answers. Their swept radius is the inflation alone, or
-  /// for spheres and capsules the inflation plus their radius (FloatFeed::load() and FloatFeed::radius() rely on
-  /// it); a hull's centroid is handled in FloatFeed::load(). Measured (callgrind AVX2, instructions per pair,
-  /// main -> this, distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955, 2186 -> 1755.
-  /// Capsules and spheres end within the margin, the radius, on a segment or triangle (without a 2-3 vertex
-  /// certificate capsule-box overlap was 964 -> 1700, the double GJK after the float one): certify_within()
-  /// proves those, out of line (inlined, a plain-arithmetic version cost the other rows 1-2%,
-  /// narrowphase-sessions.md). Hulls (hcert; small ones only, run_hulls()): the gate and the certificate load each
-  /// lane's double hull (load_hulls(): the rows of a small hull), the float pass its float one; fdbl's two setups
-  /// had made distant convex8 pairs 32.5 -> 60.5 ns, the single setup here makes them 759 -> 506 instructions,
-  /// close 2431 -> 2413, overlap 2390 -> 2779 (two hull copies and four double hull supports per overlap
-  /// certificate).
+  /// The types whose boolean double groups run_certified() answers. Their cores are centred at the origin (no hull
+  /// centroid) and their swept radius is the inflation alone, or for spheres and capsules the inflation plus their
+  /// radius (FloatFeed::load() and FloatFeed::radius() rely on both). Measured (callgrind AVX2,
+  /// instructions per pair, main -> this, distant / close / overlap): ellipsoid-ellipsoid 495 -> 217, 1182 -> 955,
+  /// 2186 -> 1755. Capsules and spheres end within the margin, the radius, on a segment or triangle (without a
+  /// 2-3 vertex certificate capsule-box overlap was 964 -> 1700, the double GJK after the float one):
+  /// certify_within() proves those, out of line (inlined, a plain-arithmetic version cost the other rows 1-2%,
+  /// narrowphase-sessions.md). Left out: convex hulls (fdbl: convex8 overlap 96.5 -> 108.9 ns, convex250 overlap 271 -> 320:
+  /// four double hull supports per overlap certificate; and a hull's centroid makes the float first direction
+  /// differ from the double one rounded).
   static constexpr bool certified_pays(ShapeType t) {
     return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid ||
-           t == ShapeType::convex || rounded(t);
+           rounded(t);
   }
   /// Spheres and capsules: a point or a segment swept by a radius. Their swept radius is T(inflation) + T(radius)
   /// (make_core()), so the float pass takes it from the shape table (FloatFeed::radius()); their overlaps end with
@@ -481,17 +453,6 @@ template <class T> struct WideGjkPairs {
     }
   }
 
-  /// The double hulls of the lanes `bits` of the register at slot s into the gate's / certificate's lanes (their
-  /// rows for small hulls, a fresh climbing hint for large ones: load_hull(), as a double GJK lane starts).
-  static void load_hulls(const PairView& in, const Block& c, std::size_t s, std::uint32_t bits, Lanes& g) {
-    if (g.A.type != ShapeType::convex && g.B.type != ShapeType::convex) return;
-    for (std::uint32_t k = bits; k != 0; k &= k - 1) {
-      const int l = __builtin_ctz(k);
-      if (g.A.type == ShapeType::convex) G::load_hull(g.A, &in.shape_hull[c.shape_a[s + std::size_t(l)]], l);
-      if (g.B.type == ShapeType::convex) G::load_hull(g.B, &in.shape_hull[c.shape_b[s + std::size_t(l)]], l);
-    }
-  }
-
   /// The gate, W pairs per register straight from the block's double setups: w = D.support(-d0) along the first
   /// direction d0 (the centres' offset, start_lane()'s), and the double loop's own separation test on it,
   /// <w, d0> / |d0| > core margin (ends_separated, the same operations). A pair that passes is separated, proven
@@ -499,7 +460,7 @@ template <class T> struct WideGjkPairs {
   /// iteration) and runs neither GJK; the others are listed for the float pass. Distant pairs end here: one
   /// Minkowski support per pair instead of the GJK's loop (box-cylinder distant: 511 -> 232 instructions a pair,
   /// AVX2).
-  static std::size_t gate(const PairView& in, Block& c, std::size_t count, bool on, Lanes& g, const ResultView& out) {
+  static std::size_t gate(Block& c, std::size_t count, bool on, Lanes& g, const ResultView& out) {
     using V3 = typename G::V3;
     std::size_t survivors = 0;
     for (std::size_t s = 0; s < count; s += std::size_t(W)) {
@@ -509,7 +470,6 @@ template <class T> struct WideGjkPairs {
       for (int i = 0; i < 3; ++i) g.t[i] = lanes_at(c.t[i] + s);
       g.A.s0 = lanes_at(c.size_a[0] + s), g.A.s1 = lanes_at(c.size_a[1] + s), g.A.s2 = lanes_at(c.size_a[2] + s);
       g.B.s0 = lanes_at(c.size_b[0] + s), g.B.s1 = lanes_at(c.size_b[1] + s), g.B.s2 = lanes_at(c.size_b[2] + s);
-      load_hulls(in, c, s, bits, g);
       const V3 d = {lanes_at(c.init[0] + s), lanes_at(c.init[1] + s), lanes_at(c.init[2] + s)};
       V3 w, sa, sb;
       G::minkowski(g, G::neg(d), bits, w, sa, sb);
@@ -531,17 +491,15 @@ template <class T> struct WideGjkPairs {
   /// converted from the block's double one, answers kept in the block by slot. The float setup's values are the
   /// float fill_slots()'s bits: R, t, the sizes, the inflations and the scale are computed in double there too and
   /// rounded once; the floor, tolerance, core margin and the zero test of the first direction are the same float
-  /// operations on them; and the first direction, -t in either precision for cores centred at the origin, rounds
-  /// to the float one (a hull's core is centred at its centroid: load() computes that direction in float from the
-  /// rounded centroids, as the float fill does). The hulls are loaded as a float lane loads them (load_hull()). So
-  /// the float pass has solve_pair<float>'s answers.
+  /// operations on them; and the first direction, -t in either precision for cores centred at the origin
+  /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
   struct FloatFeed {
     using F = WideGjk<float>;
-    const PairView& in;
     Block& c;
     std::size_t count;
     float tolerance, margin;
     typename F::Int momentum;
+    const PairView& in;
     bool rounded_a, rounded_b;  // rounded(type): the side's float radius comes from the shape table
     std::size_t next = 0;
 
@@ -549,28 +507,11 @@ template <class T> struct WideGjkPairs {
       if (next == count) return false;
       const std::size_t s = c.list[next++];
       L.pair[l] = std::int64_t(s);
-      float R[9], t[3];
-      for (int e = 0; e < 9; ++e) L.R[e][l] = R[e] = float(c.R[e][s]);
-      for (int i = 0; i < 3; ++i) L.t[i][l] = t[i] = float(c.t[i][s]);
+      for (int e = 0; e < 9; ++e) L.R[e][l] = float(c.R[e][s]);
+      for (int i = 0; i < 3; ++i) L.t[i][l] = float(c.t[i][s]);
       L.A.s0[l] = float(c.size_a[0][s]), L.A.s1[l] = float(c.size_a[1][s]), L.A.s2[l] = float(c.size_a[2][s]);
       L.B.s0[l] = float(c.size_b[0][s]), L.B.s1[l] = float(c.size_b[1][s]), L.B.s2[l] = float(c.size_b[2][s]);
       Vec3<float> init(float(c.init[0][s]), float(c.init[1][s]), float(c.init[2][s]));
-      if (L.A.type == ShapeType::convex || L.B.type == ShapeType::convex) {
-        // A hull's core is centred at its centroid: the float fill's first direction is float arithmetic on the
-        // rounded centroids, R and t (fill_slots()'s expression, in its association), not the double one rounded.
-        const HullView* ha = L.A.type == ShapeType::convex ? &in.shape_hull[c.shape_a[s]] : nullptr;
-        const HullView* hb = L.B.type == ShapeType::convex ? &in.shape_hull[c.shape_b[s]] : nullptr;
-        if (ha) F::load_hull(L.A, ha, l);
-        if (hb) F::load_hull(L.B, hb, l);
-        float ca[3] = {0.0f, 0.0f, 0.0f}, cb[3] = {0.0f, 0.0f, 0.0f};
-        for (int i = 0; i < 3; ++i) {
-          if (ha) ca[i] = float(ha->centroid[i]);
-          if (hb) cb[i] = float(hb->centroid[i]);
-        }
-        float v[3];
-        for (int r = 0; r < 3; ++r) v[r] = ca[r] - (((R[3 * r] * cb[0] + R[3 * r + 1] * cb[1]) + R[3 * r + 2] * cb[2]) + t[r]);
-        init = Vec3<float>(v[0], v[1], v[2]);
-      }
       if (!((init.x() * init.x() + init.y() * init.y()) + init.z() * init.z() > 0.0f)) init = Vec3<float>::UnitX();
       F::reset_search(L, l, init);
       L.momentum[l] = momentum;
@@ -679,8 +620,7 @@ template <class T> struct WideGjkPairs {
   /// answer is proven in double exactly as the double GJK proves its own; a pair within float error of touching
   /// fails it and runs the double GJK. The answer's direction is the float direction (widened), its iterations
   /// the float pass's.
-  static void certify(const PairView& in, const Block& c, std::size_t s, std::uint32_t bits, Lanes& C,
-                      const ResultView& out,
+  static void certify(const Block& c, std::size_t s, std::uint32_t bits, Lanes& C, const ResultView& out,
                       std::uint32_t* refused, std::int32_t* refused_iterations, std::size_t& refusals) {
     using V3 = typename G::V3;
     using real = typename G::real;
@@ -706,7 +646,6 @@ template <class T> struct WideGjkPairs {
       for (int i = 0; i < 3; ++i) C.t[i] = lanes_at(c.t[i] + s);
       C.A.s0 = lanes_at(c.size_a[0] + s), C.A.s1 = lanes_at(c.size_a[1] + s), C.A.s2 = lanes_at(c.size_a[2] + s);
       C.B.s0 = lanes_at(c.size_b[0] + s), C.B.s1 = lanes_at(c.size_b[1] + s), C.B.s2 = lanes_at(c.size_b[2] + s);
-      load_hulls(in, c, s, live, C);
       const real cm = lanes_at(c.core_margin + s), touch = lanes_at(c.floor + s);
       V3 v[4];
       for (int m = 0; m < 4; ++m)
@@ -769,36 +708,38 @@ template <class T> struct WideGjkPairs {
     refused_iterations.resize(n);
     std::size_t refusals = 0;
     Source setup{in, options, type_a, type_b, pairs, n, out, fallback};
-    Lanes check;  // the gate's and the certificate's lanes (R, t, the sizes, the hulls, the margins)
+    Lanes check;  // the gate's and the certificate's lanes (R, t, the sizes, the margins)
     check.A.type = type_a;
     check.B.type = type_b;
-    typename G::Rows check_rows;
-    check_rows.attach(check.A, check.B);
     typename F::Lanes L;
     L.A.type = type_a;
     L.B.type = type_b;
-    typename F::Rows rows;
-    rows.attach(L.A, L.B);
     L.max_iterations = F::splat_mask(typename F::Int(options.max_iterations));
     L.relative = F::splat(float(options.relative_tolerance));
     L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
     L.boolean_only = F::truth(true);
-    FloatFeed feed{in, block, 0, float(options.tolerance), float(options.margin),
-                   typename F::Int(options.solver != Solver::gjk ? -1 : 0), rounded(type_a), rounded(type_b)};
+    FloatFeed feed{block,
+                   0,
+                   float(options.tolerance),
+                   float(options.margin),
+                   typename F::Int(options.solver != Solver::gjk ? -1 : 0),
+                   in,
+                   rounded(type_a),
+                   rounded(type_b)};
     for (std::size_t first = 0; first < n; first += kBlock) {
       const std::size_t end = std::min(n, first + kBlock), count = end - first;
       for (std::size_t w = 0; w < kBlock / 64; ++w) block.valid[w] = block.alive[w] = 0;
       setup.fill_slots(block, first, end,
                        [&](std::size_t s, std::uint32_t v) { block.valid[s / 64] |= std::uint64_t(v) << (s % 64); });
       // No gate when the budget allows no iteration: the double GJK would end at its budget, undecided.
-      const std::size_t survivors = gate(in, block, count, options.max_iterations >= 1, check, out);
+      const std::size_t survivors = gate(block, count, options.max_iterations >= 1, check, out);
       if (survivors == 0) continue;
       feed.count = survivors;
       feed.next = 0;
       F::drive_boolean_directions(L, feed, options.solver);
       for (std::size_t k = 0; k < count; k += std::size_t(W))
         if (const std::uint32_t bits = std::uint32_t(block.alive[k / 64] >> (k % 64)) & ((2u << (W - 1)) - 1u))
-          certify(in, block, k, bits, check, out, refused.data(), refused_iterations.data(), refusals);
+          certify(block, k, bits, check, out, refused.data(), refused_iterations.data(), refusals);
     }
     std::size_t fallbacks = setup.fallbacks;
     if (refusals == 0) return fallbacks;

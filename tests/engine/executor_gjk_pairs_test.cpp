@@ -174,18 +174,13 @@ PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& 
     r.iterations[i] = p.iterations;
     if constexpr (std::is_same_v<T, double>) {
       const ShapeType type_a = s.shapes[b.shape_a[i]].type, type_b = s.shapes[b.shape_b[i]].type;
-      // The types run_certified() takes (WideGjkPairs::certified_pays(), wide_gjk_pairs.inl), hulls only when
-      // every hull of the pair is small (run_hulls()).
+      // The types run_certified() takes (WideGjkPairs::certified_pays(), wide_gjk_pairs.inl).
       const auto pays = [](ShapeType t) {
         return t == ShapeType::box || t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::ellipsoid ||
-               t == ShapeType::sphere || t == ShapeType::capsule || t == ShapeType::convex;
-      };
-      const auto small = [&](std::uint32_t shape) {
-        return s.shapes[shape].type != ShapeType::convex ||
-               s.shapes[shape].hull->vertices.size() < kernels::kHillClimbMinVertices;
+               t == ShapeType::sphere || t == ShapeType::capsule;
       };
       if (certified && o.level == QueryLevel::boolean && !kernels::may_have_closed_form(type_a, type_b, o) &&
-          pays(type_a) && pays(type_b) && small(b.shape_a[i]) && small(b.shape_b[i])) {
+          pays(type_a) && pays(type_b)) {
         r.direction.set(i, kernels::mul<double>(Ra, p.direction));
         certified_reference(va, vb, X, o, Ra, got, i, r);
         continue;
