@@ -39,6 +39,17 @@ broadphase::AabbSoa random_boxes(Rng& rng, std::size_t n, double extent, double 
   return b;
 }
 
+// Random boxes (random_boxes()), their binary tree and its wide collapse.
+struct Trees {
+  broadphase::AabbSoa b;
+  RayBvh bvh;
+  WideBvh wide;
+  Trees(Rng& rng, std::size_t n, double extent, double size) : b(random_boxes(rng, n, extent, size)) {
+    bvh.build(b);
+    wide.collapse(bvh, b);
+  }
+};
+
 struct Leaves {
   std::vector<std::uint32_t> seen;  // leaf ranks in visiting order
 };
@@ -133,11 +144,8 @@ TEST(RayWideBvh, LargeArraysAreHugePageAlignedAndKeepTheirContents) {
   EXPECT_EQ(wrong, 0u);
   // A tree whose nodes pass the threshold: aligned, and whole after a refit.
   Rng rng(11);
-  const broadphase::AabbSoa b = random_boxes(rng, 40000, 200.0, 2.0);
-  RayBvh bvh;
-  bvh.build(b);
-  WideBvh wide;
-  wide.collapse(bvh, b);
+  Trees trees(rng, 40000, 200.0, 2.0);
+  auto& [b, bvh, wide] = trees;
   ASSERT_GE(wide.nodes().size() * sizeof(WideNode), detail::kHugePageMin);
 #if defined(__linux__)
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(wide.nodes().data()) % detail::kHugePageBytes, 0u);
@@ -285,11 +293,8 @@ TEST(RayWideBvh, FloatTestIsTightAndTheSameOnEveryInstructionSet) {
   // and every leaf the exact test hits on the box narrowed by 1e-5 is visited (no test this bounds can pass by
   // visiting everything). The visiting order is the same for every instruction set.
   Rng rng(23);
-  const broadphase::AabbSoa b = random_boxes(rng, 2000, 60.0, 2.0);
-  RayBvh bvh;
-  bvh.build(b);
-  WideBvh wide;
-  wide.collapse(bvh, b);
+  const Trees trees(rng, 2000, 60.0, 2.0);
+  const auto& [b, bvh, wide] = trees;
   std::size_t visited = 0, isa_runs = 0;
   for (int trial = 0; trial < 2000; ++trial) {
     double o[3], d[3];
