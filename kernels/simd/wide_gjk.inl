@@ -885,11 +885,18 @@ template <class T> struct WideGjk {
     w = sub(a, b);
   }
 
-  static V3 face_direction(const Lanes& L, const V3& x) {
+  /// The reference's face_direction() given xn = norm(x) (the loop's), with its operations' results: the largest
+  /// of the three vertex norms is the square root of the largest squared norm (a correctly rounded square root is
+  /// monotone, so max and sqrt commute bit for bit, NaN included), one square root instead of three. `turned`:
+  /// the lanes whose direction is the normal rather than x.
+  /// Why: square roots and divisions are the witness loop's bottleneck on AVX-512 double (one 8-lane vsqrtpd or
+  /// vdivpd issues every ~16 cycles on this Xeon, the same per lane as 4-lane AVX2), not its instruction count.
+  static V3 face_direction(const Lanes& L, const V3& x, const real& xn, mask& turned) {
     const V3 n = cross(sub(L.w[1], L.w[0]), sub(L.w[2], L.w[0]));
-    const real w = wmax(wmax(norm(L.w[0]), norm(L.w[1])), norm(L.w[2]));
-    const real xn = norm(x), nn = norm(n);
+    const real w = wsqrt<T>(wmax(wmax(norm2(L.w[0]), norm2(L.w[1])), norm2(L.w[2])));
+    const real nn = norm(n);
     const mask keep = ~(nn > xn * w);
+    turned = ~keep;
     const V3 signed_n = pick(dot(n, x) < splat(T(0)), neg(n), n);
     return pick(keep, x, scale(xn / nn, signed_n));
   }
@@ -1116,11 +1123,14 @@ template <class T> struct WideGjk {
         const V3 dn_dir = add(divide(scale(delta, L.d_prev), dn), divide(scale(one - delta, y), yn));
         const V3 du_dir = add(scale(delta, L.d_prev), scale(one - delta, y));
         d = pick(normalized, dn_dir, pick(unnormalized, du_dir, d));
+        d = pick(norm2(d) > zero, d, x);
       } else if (solver == Solver::polyak && any(live & L.momentum)) {
         const real beta = one / (kk + T(1));  // T(1) / T(k + 2)
         d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
+        d = pick(norm2(d) > zero, d, x);
       }
-      d = pick(norm(d) > zero, d, x);
+      // Momentum cancelled out: the gradient. Inside the momentum branches (plain GJK's d is x), on |d|^2 > 0,
+      // which is |d| > 0 bit for bit (sqrt(a) > 0 exactly when a > 0, NaN false in both): no square root.
       // Newton's direction, where the last iteration set one up, replaces plain GJK's and momentum's (and ends
       // momentum for the lane: Newton converges quadratically where momentum's gain is linear).
       mask newton_step = splat_mask(0);
@@ -1139,12 +1149,18 @@ template <class T> struct WideGjk {
       }
       const mask plain = equal(d, x);
       const mask face = live & plain & (L.count == splat_mask(3));
-      if (any(face)) d = pick(face, face_direction(L, x), d);
+      mask turned = splat_mask(0);
+      if (any(face)) {
+        d = pick(face, face_direction(L, x, xn, turned), d);
+        turned &= face;
+      }
 
       const std::uint32_t live_bits = lane_bits(live);
       V3 sw, sa, sb;
       minkowski(L, neg(d), live_bits, sw, sa, sb);
-      const real dnorm = norm(d);
+      // |d|: where d is x (plain steps not turned to a face normal) it is xn bit for bit; one square root less
+      // in the iterations where every live lane steps along x.
+      const real dnorm = any(live & (~plain | turned)) ? norm(d) : xn;
       const real lb = dot(sw, d) / dnorm;
       const mask progress = lb > L.lower + T(0.1) * (xn - L.lower);
       L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
@@ -1202,9 +1218,15 @@ template <class T> struct WideGjk {
         ends_stall_overlap = stall & (xn <= T(2) * L.touch);
         ends_stall = stall & ~ends_stall_overlap;
         const mask moves = live & ~no_decrease;  // includes ends_contains: S = next, x = proj.x
-        const real next_xn = wsqrt<T>(next_xx);
-        const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
-        L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
+        // |next x| only where read: momentum lanes that stepped (lagging) and Newton's bookkeeping. Plain GJK (the
+        // witness and distance solver) skips its square root.
+        const mask momentum_moved = moves & ~ends_contains & ~plain & L.momentum;
+        real next_xn{};
+        if (newton_live || any(momentum_moved)) next_xn = wsqrt<T>(next_xx);
+        if (any(momentum_moved)) {
+          const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
+          L.momentum &= ~(momentum_moved & lagging);
+        }
         // Compaction in place, slot by slot: slot m takes vertex q = index[m] >= m (the indices of a support set
         // are increasing, so a kept vertex never moves up) and reads slots m .. 3 only, none written yet. Lanes
         // that do not move select nothing (from_q false) and keep their vertex m (m < 3; slot 3 gets s, stale:
