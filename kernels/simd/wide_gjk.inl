@@ -443,7 +443,11 @@ template <class T> struct WideGjk {
     const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
     const real sum = (C[0] + C[1]) + C[2];
     Face f;
-    for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] / sum;
+    // One division and three products instead of three divisions (tests/support/reference_simplex_projection.hpp
+    // alike): the loop is bound by its divisions and square roots on AVX-512 double (face_direction() says why);
+    // the weights move by at most an ulp or so, well inside the rounding of the areas themselves.
+    const real inv = splat(T(1)) / sum;
+    for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] * inv;
     f.x = add(add(scale(f.lambda[0], qi), scale(f.lambda[1], qj)), scale(f.lambda[2], qk));
     const mask degenerate = (nn == zero) | (total == zero);
     f.use = ~degenerate & inside & (sum != zero);
@@ -953,8 +957,9 @@ template <class T> struct WideGjk {
     const real c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
     const real c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
     const real det = (a * c00 + p * c01) + q * c02;
-    return {((c00 * r.x + c01 * r.y) + c02 * r.z) / det, ((c01 * r.x + c11 * r.y) + c12 * r.z) / det,
-            ((c02 * r.x + c12 * r.y) + c22 * r.z) / det};
+    const real inv = splat(T(1)) / det;  // one division (face()'s weights say why)
+    return {((c00 * r.x + c01 * r.y) + c02 * r.z) * inv, ((c01 * r.x + c11 * r.y) + c12 * r.z) * inv,
+            ((c02 * r.x + c12 * r.y) + c22 * r.z) * inv};
   }
 
   /// Newton's direction for a polytope against a curved core (flat_newton_side()), after the support point
@@ -1279,7 +1284,7 @@ template <class T> struct WideGjk {
             L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
         }
         if (newton_live && any(read)) {
-          const V3 n = divide(d, dnorm);
+          const V3 n = scale(one / dnorm, d);  // one division (face()'s weights say why)
           real step2;
           V3 nd;
           real shrunk;  // the step2 a lane that just took a Newton step must reach to keep them
