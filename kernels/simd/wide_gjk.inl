@@ -443,7 +443,11 @@ template <class T> struct WideGjk {
     const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
     const real sum = (C[0] + C[1]) + C[2];
     Face f;
-    for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] / sum;
+    // One division and three products instead of three divisions (tests/support/reference_simplex_projection.hpp
+    // alike): the loop is bound by its divisions and square roots on AVX-512 double (face_direction() says why);
+    // the weights move by at most an ulp or so, well inside the rounding of the areas themselves.
+    const real inv = splat(T(1)) / sum;
+    for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] * inv;
     f.x = add(add(scale(f.lambda[0], qi), scale(f.lambda[1], qj)), scale(f.lambda[2], qk));
     const mask degenerate = (nn == zero) | (total == zero);
     f.use = ~degenerate & inside & (sum != zero);
@@ -885,11 +889,18 @@ template <class T> struct WideGjk {
     w = sub(a, b);
   }
 
-  static V3 face_direction(const Lanes& L, const V3& x) {
+  /// The reference's face_direction() given xn = norm(x) (the loop's), with its operations' results: the largest
+  /// of the three vertex norms is the square root of the largest squared norm (a correctly rounded square root is
+  /// monotone, so max and sqrt commute bit for bit, NaN included), one square root instead of three. `turned`:
+  /// the lanes whose direction is the normal rather than x.
+  /// Why: square roots and divisions are the witness loop's bottleneck on AVX-512 double (one 8-lane vsqrtpd or
+  /// vdivpd issues every ~16 cycles on this Xeon, the same per lane as 4-lane AVX2), not its instruction count.
+  static V3 face_direction(const Lanes& L, const V3& x, const real& xn, mask& turned) {
     const V3 n = cross(sub(L.w[1], L.w[0]), sub(L.w[2], L.w[0]));
-    const real w = wmax(wmax(norm(L.w[0]), norm(L.w[1])), norm(L.w[2]));
-    const real xn = norm(x), nn = norm(n);
+    const real w = wsqrt<T>(wmax(wmax(norm2(L.w[0]), norm2(L.w[1])), norm2(L.w[2])));
+    const real nn = norm(n);
     const mask keep = ~(nn > xn * w);
+    turned = ~keep;
     const V3 signed_n = pick(dot(n, x) < splat(T(0)), neg(n), n);
     return pick(keep, x, scale(xn / nn, signed_n));
   }
@@ -946,8 +957,9 @@ template <class T> struct WideGjk {
     const real c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
     const real c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
     const real det = (a * c00 + p * c01) + q * c02;
-    return {((c00 * r.x + c01 * r.y) + c02 * r.z) / det, ((c01 * r.x + c11 * r.y) + c12 * r.z) / det,
-            ((c02 * r.x + c12 * r.y) + c22 * r.z) / det};
+    const real inv = splat(T(1)) / det;  // one division (face()'s weights say why)
+    return {((c00 * r.x + c01 * r.y) + c02 * r.z) * inv, ((c01 * r.x + c11 * r.y) + c12 * r.z) * inv,
+            ((c02 * r.x + c12 * r.y) + c22 * r.z) * inv};
   }
 
   /// Newton's direction for a polytope against a curved core (flat_newton_side()), after the support point
@@ -1116,11 +1128,14 @@ template <class T> struct WideGjk {
         const V3 dn_dir = add(divide(scale(delta, L.d_prev), dn), divide(scale(one - delta, y), yn));
         const V3 du_dir = add(scale(delta, L.d_prev), scale(one - delta, y));
         d = pick(normalized, dn_dir, pick(unnormalized, du_dir, d));
+        d = pick(norm2(d) > zero, d, x);
       } else if (solver == Solver::polyak && any(live & L.momentum)) {
         const real beta = one / (kk + T(1));  // T(1) / T(k + 2)
         d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
+        d = pick(norm2(d) > zero, d, x);
       }
-      d = pick(norm(d) > zero, d, x);
+      // Momentum cancelled out: the gradient. Inside the momentum branches (plain GJK's d is x), on |d|^2 > 0,
+      // which is |d| > 0 bit for bit (sqrt(a) > 0 exactly when a > 0, NaN false in both): no square root.
       // Newton's direction, where the last iteration set one up, replaces plain GJK's and momentum's (and ends
       // momentum for the lane: Newton converges quadratically where momentum's gain is linear).
       mask newton_step = splat_mask(0);
@@ -1139,12 +1154,18 @@ template <class T> struct WideGjk {
       }
       const mask plain = equal(d, x);
       const mask face = live & plain & (L.count == splat_mask(3));
-      if (any(face)) d = pick(face, face_direction(L, x), d);
+      mask turned = splat_mask(0);
+      if (any(face)) {
+        d = pick(face, face_direction(L, x, xn, turned), d);
+        turned &= face;
+      }
 
       const std::uint32_t live_bits = lane_bits(live);
       V3 sw, sa, sb;
       minkowski(L, neg(d), live_bits, sw, sa, sb);
-      const real dnorm = norm(d);
+      // |d|: where d is x (plain steps not turned to a face normal) it is xn bit for bit; one square root less
+      // in the iterations where every live lane steps along x.
+      const real dnorm = any(live & (~plain | turned)) ? norm(d) : xn;
       const real lb = dot(sw, d) / dnorm;
       const mask progress = lb > L.lower + T(0.1) * (xn - L.lower);
       L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
@@ -1202,9 +1223,15 @@ template <class T> struct WideGjk {
         ends_stall_overlap = stall & (xn <= T(2) * L.touch);
         ends_stall = stall & ~ends_stall_overlap;
         const mask moves = live & ~no_decrease;  // includes ends_contains: S = next, x = proj.x
-        const real next_xn = wsqrt<T>(next_xx);
-        const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
-        L.momentum &= ~(moves & ~ends_contains & ~plain & lagging);
+        // |next x| only where read: momentum lanes that stepped (lagging) and Newton's bookkeeping. Plain GJK (the
+        // witness and distance solver) skips its square root.
+        const mask momentum_moved = moves & ~ends_contains & ~plain & L.momentum;
+        real next_xn{};
+        if (newton_live || any(momentum_moved)) next_xn = wsqrt<T>(next_xx);
+        if (any(momentum_moved)) {
+          const mask lagging = (xn - next_xn <= tol) | (L.stale >= splat_mask(kMaxStaleMomentumSteps));
+          L.momentum &= ~(momentum_moved & lagging);
+        }
         // Compaction in place, slot by slot: slot m takes vertex q = index[m] >= m (the indices of a support set
         // are increasing, so a kept vertex never moves up) and reads slots m .. 3 only, none written yet. Lanes
         // that do not move select nothing (from_q false) and keep their vertex m (m < 3; slot 3 gets s, stale:
@@ -1257,7 +1284,7 @@ template <class T> struct WideGjk {
             L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
         }
         if (newton_live && any(read)) {
-          const V3 n = divide(d, dnorm);
+          const V3 n = scale(one / dnorm, d);  // one division (face()'s weights say why)
           real step2;
           V3 nd;
           real shrunk;  // the step2 a lane that just took a Newton step must reach to keep them

@@ -138,8 +138,9 @@ template <class T> Vec3<T> newton_solve(const std::array<T, 6>& h, T lb, const V
   const T c00 = b * c - t * t, c01 = q * t - p * c, c02 = p * t - b * q;
   const T c11 = a * c - q * q, c12 = p * q - a * t, c22 = a * b - p * p;
   const T det = (a * c00 + p * c01) + q * c02;
-  return Vec3<T>(((c00 * r.x() + c01 * r.y()) + c02 * r.z()) / det, ((c01 * r.x() + c11 * r.y()) + c12 * r.z()) / det,
-                 ((c02 * r.x() + c12 * r.y()) + c22 * r.z()) / det);
+  const T inv = T(1) / det;
+  return Vec3<T>(((c00 * r.x() + c01 * r.y()) + c02 * r.z()) * inv, ((c01 * r.x() + c11 * r.y()) + c12 * r.z()) * inv,
+                 ((c02 * r.x() + c12 * r.y()) + c22 * r.z()) * inv);
 }
 
 /// Newton's direction after the support point w of D in direction -n (unit n, lb = <w, n>, r = w - lb n):
@@ -348,7 +349,8 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     last_s = s.w;
     // Newton's direction for the next iteration (wide_gjk.inl: when, and why).
     if (newton && (!flat_pair || lb > T(0))) {  // polytope pairs: only separated along d (wide_gjk.inl)
-      const Vec3<T> n(d.x() / d_norm, d.y() / d_norm, d.z() / d_norm);
+      const T inv_norm = T(1) / d_norm;
+      const Vec3<T> n(inv_norm * d.x(), inv_norm * d.y(), inv_norm * d.z());
       T step2 = T(0);
       Vec3<T> nd;
       T shrunk;
