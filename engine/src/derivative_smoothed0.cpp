@@ -27,6 +27,10 @@ namespace {
 /// Samples per block of a task: the block's poses, directions, noise and answers (~40 doubles per sample, ~330 KB)
 /// stay in L2 between the sample generation, the GJK and the reduction. Even: blocks end on antithetic pairs.
 constexpr std::size_t kBlockSamples = 1024;
+/// Small M: one pair's M / 2 first samples fill a part of a register of the sample builder (M = 4: 2 of AVX2's 4
+/// double lanes, 2 of AVX-512's 8), whose draws and poses cost the same whatever its lanes hold; so up to
+/// kGroupEvens / (M / 2) pairs are built together (build_group()). kGroupEvens: AVX-512's lanes.
+constexpr std::size_t kGroupEvens = 8;
 
 struct Noise {
   double translation = 0.0, rotation = 0.0;  // standard deviations: metres, radians
@@ -168,9 +172,32 @@ void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t coun
     even.direction[e] = b.at(Block::kDir + e) + slot, odd.direction[e] = even.direction[e] + evens;
   }
   for (int e = 0; e < 6; ++e) even.z[e] = b.at(Block::kZ + e) + slot, odd.z[e] = even.z[e] + evens;
-  kernels::simd::build_samples(c.isa, p.samples, j0 / 2, evens, odds, even, odd);
+  const kernels::simd::SamplePlan* plans[] = {&p.samples};
+  kernels::simd::build_samples(c.isa, plans, 1, count, j0 / 2, evens, odds, even, odd);
   std::fill_n(b.shape_a.data() + slot, count, c.batch.shape_a[p.i]);
   std::fill_n(b.shape_b.data() + slot, count, c.batch.shape_b[p.i]);
+}
+
+/// All M samples (M even, M / 2 <= kGroupEvens / 2) of the n pairs group[0 .. n), pair q's at block slot
+/// slot + q M as build() lays them out, from one call of the builder, whose registers then hold several pairs'
+/// samples. Each sample gets the bits build() gives it.
+void build_group(const Context& c, const PairPlan* const* group, std::size_t n, std::size_t M, Block& b,
+                 std::size_t slot) {
+  const std::size_t e = M / 2;
+  kernels::simd::SampleArrays even, odd;
+  for (int a = 0; a < 9; ++a) even.R[a] = b.at(Block::kR + a) + slot, odd.R[a] = even.R[a] + e;
+  for (int a = 0; a < 3; ++a) {
+    even.t[a] = b.at(Block::kT + a) + slot, odd.t[a] = even.t[a] + e;
+    even.direction[a] = b.at(Block::kDir + a) + slot, odd.direction[a] = even.direction[a] + e;
+  }
+  for (int a = 0; a < 6; ++a) even.z[a] = b.at(Block::kZ + a) + slot, odd.z[a] = even.z[a] + e;
+  const kernels::simd::SamplePlan* plans[kGroupEvens] = {};
+  for (std::size_t q = 0; q < n; ++q) plans[q] = &group[q]->samples;
+  kernels::simd::build_samples(c.isa, plans, n, M, 0, e, e, even, odd);
+  for (std::size_t q = 0; q < n; ++q) {
+    std::fill_n(b.shape_a.data() + slot + q * M, M, c.batch.shape_a[group[q]->i]);
+    std::fill_n(b.shape_b.data() + slot + q * M, M, c.batch.shape_b[group[q]->i]);
+  }
 }
 
 /// The scalar path for one sample: setup, GJK, completion (closed forms, EPA, float stalls redone in double).
@@ -330,6 +357,8 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
   // ~8 times per call at M = 4.
   thread_local std::vector<PairPlan> plans;
   thread_local std::vector<Span> spans;
+  // Pairs per group (build_group()); 1: each pair alone (odd M: the last antithetic pair has no copy).
+  const std::size_t group = M % 2 == 0 && M / 2 <= kGroupEvens / 2 ? kGroupEvens / (M / 2) : 1;
   StoreBlock out(d);
   Sums sums;
   std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
@@ -343,6 +372,34 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
     spans.clear();
     std::size_t used = 0;
     while (i < end && used + 2 <= kBlockSamples) {
+      if (group > 1) {
+        // Up to `group` whole pairs, of any type pairs (the runs below group the spans by type pair).
+        const PairPlan* members[kGroupEvens] = {};
+        std::size_t n = 0;
+        while (i < end && n < group && used + (n + 1) * M <= kBlockSamples) {
+          if (count == plans.size()) plans.emplace_back();
+          PairPlan& p = plans[count];
+          plan_pair(c, i, p);
+          if (!p.ok) {
+            store_nothing(out, i);
+            ++i;
+            continue;
+          }
+          ++count;
+          ++i;
+          ++n;
+        }
+        if (n == 0) {
+          if (i < end) break;  // the block is full
+          continue;
+        }
+        // plans may have grown: the members' addresses are taken once the group is complete.
+        for (std::size_t q = 0; q < n; ++q) members[q] = &plans[count - n + q];
+        build_group(c, members, n, M, block, used);
+        for (std::size_t q = 0; q < n; ++q) spans.push_back({count - n + q, used + q * M, M, 0});
+        used += n * M;
+        continue;
+      }
       if (!planned) {
         if (count == plans.size()) plans.emplace_back();
         PairPlan& p = plans[count];

@@ -30,8 +30,8 @@ namespace batchcol::kernels::simd {
                                  const SampleResults&, std::uint32_t*);                                            \
   std::size_t gjk_samples_float(const PairView&, ShapeType, ShapeType, const SampleBatch&, const QueryOptions&,     \
                                 const SampleResults&, std::uint32_t*);                                             \
-  void build_samples(const SamplePlan&, std::uint64_t, std::size_t, std::size_t, const SampleArrays&,               \
-                     const SampleArrays&);                                                                         \
+  void build_samples(const SamplePlan* const*, std::size_t, std::size_t, std::uint64_t, std::size_t, std::size_t, \
+                     const SampleArrays&, const SampleArrays&);                                                    \
   void draw_gaussians4(std::uint64_t, std::uint64_t, std::uint64_t, std::size_t, double* const*);                  \
   void accumulate_samples(const double*, const Status*, const double* const*, std::size_t, std::size_t,            \
                           SampleSums&);                                                                            \
@@ -169,9 +169,10 @@ std::size_t gjk_samples<float>(InstructionSet isa, const PairView& shapes, Shape
   return kernels_of(isa).gjk_samples_float(shapes, a, b, in, options, out, fallback);
 }
 
-void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
-                   std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd) {
-  kernels_of(isa).build_samples(p, a0, count, odd_count, even, odd);
+void build_samples(InstructionSet isa, const SamplePlan* const* plans, std::size_t pairs, std::size_t stride,
+                   std::uint64_t a0, std::size_t count, std::size_t odd_count, const SampleArrays& even,
+                   const SampleArrays& odd) {
+  kernels_of(isa).build_samples(plans, pairs, stride, a0, count, odd_count, even, odd);
 }
 
 void accumulate_samples(InstructionSet isa, const double* values, const Status* status, const double* const* z,

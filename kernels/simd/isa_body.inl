@@ -46,9 +46,9 @@ void start_cells_double(const double* xyz, std::size_t n, std::uint32_t* cell) {
 }
 void start_cells_float(const float* xyz, std::size_t n, std::uint32_t* cell) { WideGjk<float>::start_cells_of(xyz, n, cell); }
 
-void build_samples(const SamplePlan& p, std::uint64_t a0, std::size_t count, std::size_t odd_count,
-                   const SampleArrays& even, const SampleArrays& odd) {
-  WideSamples::run(p, a0, count, odd_count, even, odd);
+void build_samples(const SamplePlan* const* plans, std::size_t pairs, std::size_t stride, std::uint64_t a0,
+                   std::size_t count, std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd) {
+  WideSamples::run(plans, pairs, stride, a0, count, odd_count, even, odd);
 }
 void accumulate_samples(const double* values, const Status* status, const double* const* z, std::size_t count,
                         std::size_t evens, SampleSums& sums) {

@@ -113,11 +113,14 @@ struct SampleArrays {
   double* direction[3] = {};
   double* z[6] = {};
 };
-/// Antithetic pairs k = a0 .. a0 + count - 1 of plan p (kernels/simd/wide_samples.inl): z from the counter key
-/// (pair, k), sample 2k (E R0, t0 + s_t z, z) at index k - a0 of `even`, its antithetic copy (E^T R0, t0 - s_t z, -z)
-/// at index k - a0 of `odd` for the first odd_count pairs. The same bits on every instruction set.
-void build_samples(InstructionSet isa, const SamplePlan& p, std::uint64_t a0, std::size_t count,
-                   std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd);
+/// Antithetic pairs k = a0 .. a0 + count - 1 of each plan plans[q], q < pairs (kernels/simd/wide_samples.inl): z
+/// from the counter key (pair, k), sample 2k (E R0, t0 + s_t z, z) at index q stride + k - a0 of `even`, its
+/// antithetic copy (E^T R0, t0 - s_t z, -z) at the same index of `odd` for the first odd_count pairs (several
+/// plans: odd_count == count). Several plans share registers when count < W; the same bits on every instruction
+/// set, whatever a plan shares a register with.
+void build_samples(InstructionSet isa, const SamplePlan* const* plans, std::size_t pairs, std::size_t stride,
+                   std::uint64_t a0, std::size_t count, std::size_t odd_count, const SampleArrays& even,
+                   const SampleArrays& odd);
 /// One pair's running sums of the smoothed0 estimator (engine/src/derivative_smoothed0.cpp), in A's frame: over the
 /// samples that entered (`valid` of them), the sum of their 10 values v (distance, witness a, witness b, normal) and
 /// the sums of (v - g0) z_f for the 6 noise coordinates f. Rows of 12 (two padding entries) for whole registers.

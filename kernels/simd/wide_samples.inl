@@ -99,7 +99,11 @@ struct WideSamples {
   template <int N> static void gaussians(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, real* z) {
     u64 index{};
     for (int l = 0; l < W; ++l) index[l] = k0 + std::uint64_t(l);
-    u64 state = splitmix(splitmix((u64{} + key) ^ index) ^ stream);
+    gaussians<N>(u64{} + key, index, stream, z);
+  }
+  /// The same with a key and an index per lane (lanes of different pairs).
+  template <int N> static void gaussians(u64 key, u64 index, std::uint64_t stream, real* z) {
+    u64 state = splitmix(splitmix(key ^ index) ^ stream);
     for (int g = 0; g < N; g += 2) {
       const real radius = wsqrt<double>(-2.0 * log_unit(uniform(state)));
       real s, c;
@@ -188,65 +192,164 @@ struct WideSamples {
     }
   }
 
-  /// Samples of antithetic pairs a0 .. a0 + count - 1 of plan p: pair e's first sample goes to index e of `even`,
-  /// its antithetic copy to index e of `odd` (odd's arrays may be null when count == 1 and the copy is not wanted:
-  /// `odd_count` copies are written, count or count - 1).
-  static void run(const SamplePlan& p, std::uint64_t a0, std::size_t count, std::size_t odd_count,
-                  const SampleArrays& even, const SampleArrays& odd) {
-    for (std::size_t e0 = 0; e0 < count; e0 += W) {
-      const int lanes = int(std::min<std::size_t>(W, count - e0));
-      // CounterRng(seed, pair, k, 0): p.key holds splitmix(splitmix(seed) ^ pair).
+  /// A register's plan values when its lanes belong to several pairs (small M: M / 2 < W): each field one vector,
+  /// lane l the value of its own pair's plan. Every lane then does the single-plan operations with its own values
+  /// (a double times a register and a register times a register are the same IEEE operation per lane).
+  struct LanePlan {
+    real R0[9], t0[3], n0[3], first[3], P[18], translation, rotation;
+    mask predict;
+  };
+  static bool predicts(const SamplePlan& p) { return p.predict; }
+  static bool predicts(const LanePlan& p) { return any(p.predict); }
+  /// The first GJK direction's coordinate r: -(n0 + P z) where the pair predicts, else its `first`.
+  static real first_direction(const SamplePlan& p, int r, const real& predicted) {
+    return p.predict ? predicted : splat(p.first[r]);
+  }
+  static real first_direction(const LanePlan& p, int r, const real& predicted) {
+    return select(p.predict, predicted, p.first[r]);
+  }
+
+  /// One register of samples from their noise z: B's perturbed poses (E R0, t0 + s_t z) and antithetic copies
+  /// (E^T R0, t0 - s_t z), first directions and noise, each array's register stored by put(array, register, n)
+  /// (n = lanes, odd_lanes: the lanes to store).
+  // GCC 12 reports -Wuninitialized inside its own _mm512_sqrt_pd (the `__m512d __Y = __Y;` of
+  // _mm512_undefined_pd(), GCC bug 105593, fixed in GCC 13) once this function is a template of its own; the
+  // operand is an intentionally undefined pass-through that the unmasked sqrt never reads.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+  // Always inlined: out of line, the single-plan registers' z and stores went through memory (M = 16, AVX2: +350
+  // instructions per register, callgrind).
+  template <class Plan, class Put>
+  __attribute__((always_inline)) static void poses(const Plan& p, const real (&z)[6], const Put& put, int lanes,
+                                                   int odd_lanes, const SampleArrays& even, const SampleArrays& odd) {
+    // exp([w]x) through the unit quaternion (cos h, sin(h) w / (2h)), h = |w| / 2 (the engine's rotation_exp).
+    const real w0 = p.rotation * z[3], w1 = p.rotation * z[4], w2 = p.rotation * z[5];
+    const real angle2 = (w0 * w0 + w1 * w1) + w2 * w2;
+    const real h = 0.5 * wsqrt<double>(angle2);
+    real sinc, c;
+    sinc_cos_small(h, sinc, c);
+    const mask wide = h > 0.7853981633974483;
+    if (any(wide)) {
+      for (int l = 0; l < W; ++l) {
+        if (!wide[l]) continue;
+        sinc[l] = std::sin(h[l]) / h[l];
+        c[l] = std::cos(h[l]);
+      }
+    }
+    const real k = 0.5 * sinc, x = k * w0, y = k * w1, zq = k * w2;
+    const real xx = x * x, yy = y * y, zz = zq * zq, xy = x * y, xz = x * zq, yz = y * zq, cx = c * x, cy = c * y,
+               cz = c * zq;
+    const real E[9] = {1.0 - 2.0 * (yy + zz), 2.0 * (xy - cz),       2.0 * (xz + cy),
+                       2.0 * (xy + cz),       1.0 - 2.0 * (xx + zz), 2.0 * (yz - cx),
+                       2.0 * (xz - cy),       2.0 * (yz + cx),       1.0 - 2.0 * (xx + yy)};
+    real dz[3] = {splat(0.0), splat(0.0), splat(0.0)};
+    if (predicts(p))
+      for (int r = 0; r < 3; ++r)
+        dz[r] = ((((p.P[6 * r] * z[0] + p.P[6 * r + 1] * z[1]) + p.P[6 * r + 2] * z[2]) + p.P[6 * r + 3] * z[3]) +
+                 p.P[6 * r + 4] * z[4]) + p.P[6 * r + 5] * z[5];
+    real R[9], Rt[9], t[3], tm[3], d[3], dm[3];
+    for (int r = 0; r < 3; ++r) {
+      for (int q = 0; q < 3; ++q) {
+        R[3 * r + q] = (E[3 * r] * p.R0[q] + E[3 * r + 1] * p.R0[3 + q]) + E[3 * r + 2] * p.R0[6 + q];
+        Rt[3 * r + q] = (E[r] * p.R0[q] + E[3 + r] * p.R0[3 + q]) + E[6 + r] * p.R0[6 + q];
+      }
+      const real v = p.translation * z[r];
+      t[r] = p.t0[r] + v;
+      tm[r] = p.t0[r] - v;
+      d[r] = first_direction(p, r, -(p.n0[r] + dz[r]));
+      dm[r] = first_direction(p, r, -(p.n0[r] - dz[r]));
+    }
+    for (int e = 0; e < 9; ++e) put(even.R[e], R[e], lanes);
+    for (int e = 0; e < 3; ++e) put(even.t[e], t[e], lanes), put(even.direction[e], d[e], lanes);
+    for (int e = 0; e < 6; ++e) put(even.z[e], z[e], lanes);
+    if (odd_lanes == 0) return;
+    for (int e = 0; e < 9; ++e) put(odd.R[e], Rt[e], odd_lanes);
+    for (int e = 0; e < 3; ++e) put(odd.t[e], tm[e], odd_lanes), put(odd.direction[e], dm[e], odd_lanes);
+    for (int e = 0; e < 6; ++e) put(odd.z[e], -z[e], odd_lanes);
+  }
+#pragma GCC diagnostic pop
+
+  typedef double v2 __attribute__((vector_size(16)));
+  /// Lanes 2h, 2h + 1 of v (h = H, H + 1, .. while 2h < n) to dst + h stride: two lanes per pair (M = 4), each
+  /// pair's lanes one 16-byte store at its own samples (a lane extraction straight to memory).
+  template <int H = 0>
+  __attribute__((always_inline)) static void put_pairs(double* dst, std::size_t stride, const real& v, int n) {
+    if constexpr (2 * H < W) {
+      if (2 * H >= n) return;
+      const v2 half = __builtin_shufflevector(v, v, 2 * H, 2 * H + 1);
+      std::memcpy(dst + H * stride, &half, sizeof half);
+      put_pairs<H + 1>(dst, stride, v, n);
+    }
+  }
+
+  /// Samples of antithetic pairs a0 .. a0 + count - 1 of each of the `pairs` plans: plan q's pair a0 + e goes to
+  /// index q stride + e of `even`, its antithetic copy to the same index of `odd` (with one plan, odd's arrays may
+  /// be null when count == 1 and the copy is not wanted: `odd_count` copies are written, count or count - 1; with
+  /// several plans every pair has its copy, odd_count == count). Several plans fill the registers that one pair's
+  /// count < W antithetic pairs would leave partly empty (M = 4: 2 of AVX2's 4 lanes, 2 of AVX-512's 8): the draws
+  /// and poses of a register cost the same whatever its lanes hold.
+  static void run(const SamplePlan* const* plans, std::size_t pairs, std::size_t stride, std::uint64_t a0,
+                  std::size_t count, std::size_t odd_count, const SampleArrays& even, const SampleArrays& odd) {
+    const std::size_t total = pairs * count, odd_total = pairs == 1 ? odd_count : total;
+    for (std::size_t e0 = 0; e0 < total; e0 += W) {
+      const int lanes = int(std::min<std::size_t>(W, total - e0));
+      const int odd_lanes = int(std::min<std::size_t>(lanes, odd_total > e0 ? odd_total - e0 : 0));
+      const std::size_t q0 = e0 / count, q1 = (e0 + std::size_t(lanes) - 1) / count;
       real z[6];
-      gaussians<6>(p.key, 0, a0 + e0, z);
-      // exp([w]x) through the unit quaternion (cos h, sin(h) w / (2h)), h = |w| / 2 (the engine's rotation_exp).
-      const real w0 = p.rotation * z[3], w1 = p.rotation * z[4], w2 = p.rotation * z[5];
-      const real angle2 = (w0 * w0 + w1 * w1) + w2 * w2;
-      const real h = 0.5 * wsqrt<double>(angle2);
-      real sinc, c;
-      sinc_cos_small(h, sinc, c);
-      const mask wide = h > 0.7853981633974483;
-      if (any(wide)) {
+      if (q0 == q1) {  // one pair's samples (every register when count >= W, but for the last)
+        const SamplePlan& p = *plans[q0];
+        const std::size_t j0 = e0 - q0 * count, at = q0 * stride + j0;
+        // CounterRng(seed, pair, k, 0): p.key holds splitmix(splitmix(seed) ^ pair).
+        gaussians<6>(p.key, 0, a0 + j0, z);
+        const auto put = [at](double* dst, const real& v, int n) {
+          if (n == W) std::memcpy(dst + at, &v, sizeof v);
+          else for (int l = 0; l < n; ++l) dst[at + l] = v[l];
+        };
+        poses(p, z, put, lanes, odd_lanes, even, odd);
+        continue;
+      }
+      // Lanes of pairs q0 .. q1: each lane's plan, key, index and place (padding lanes past `lanes` take the last
+      // lane's plan and are not stored), then each field from the lanes' plans.
+      const SamplePlan* lane[W];
+      std::size_t at[W];
+      u64 key{}, index{};
+      {
+        std::size_t q = q0, j = e0 - q0 * count;
         for (int l = 0; l < W; ++l) {
-          if (!wide[l]) continue;
-          sinc[l] = std::sin(h[l]) / h[l];
-          c[l] = std::cos(h[l]);
+          lane[l] = plans[q];
+          at[l] = q * stride + j;
+          key[l] = plans[q]->key;
+          index[l] = a0 + j;
+          if (l + 1 < lanes && ++j == count) j = 0, ++q;
         }
       }
-      const real k = 0.5 * sinc, x = k * w0, y = k * w1, zq = k * w2;
-      const real xx = x * x, yy = y * y, zz = zq * zq, xy = x * y, xz = x * zq, yz = y * zq, cx = c * x, cy = c * y,
-                 cz = c * zq;
-      const real E[9] = {1.0 - 2.0 * (yy + zz), 2.0 * (xy - cz),       2.0 * (xz + cy),
-                         2.0 * (xy + cz),       1.0 - 2.0 * (xx + zz), 2.0 * (yz - cx),
-                         2.0 * (xz - cy),       2.0 * (yz + cx),       1.0 - 2.0 * (xx + yy)};
-      real dz[3] = {splat(0.0), splat(0.0), splat(0.0)};
-      if (p.predict)
-        for (int r = 0; r < 3; ++r)
-          dz[r] = ((((p.P[6 * r] * z[0] + p.P[6 * r + 1] * z[1]) + p.P[6 * r + 2] * z[2]) + p.P[6 * r + 3] * z[3]) +
-                   p.P[6 * r + 4] * z[4]) + p.P[6 * r + 5] * z[5];
-      real R[9], Rt[9], t[3], tm[3], d[3], dm[3];
-      for (int r = 0; r < 3; ++r) {
-        for (int q = 0; q < 3; ++q) {
-          R[3 * r + q] = (E[3 * r] * p.R0[q] + E[3 * r + 1] * p.R0[3 + q]) + E[3 * r + 2] * p.R0[6 + q];
-          Rt[3 * r + q] = (E[r] * p.R0[q] + E[3 + r] * p.R0[3 + q]) + E[6 + r] * p.R0[6 + q];
-        }
-        const real v = p.translation * z[r];
-        t[r] = p.t0[r] + v;
-        tm[r] = p.t0[r] - v;
-        d[r] = p.predict ? -(p.n0[r] + dz[r]) : splat(p.first[r]);
-        dm[r] = p.predict ? -(p.n0[r] - dz[r]) : splat(p.first[r]);
-      }
-      const auto put = [&](double* dst, const real& v, int n) {
-        if (n == W) std::memcpy(dst + e0, &v, sizeof v);
-        else for (int l = 0; l < n; ++l) dst[e0 + l] = v[l];
+      gaussians<6>(key, index, 0, z);
+      LanePlan lp;
+      const auto field = [&](auto get) {
+        real v;
+        for (int l = 0; l < W; ++l) v[l] = get(*lane[l]);
+        return v;
       };
-      const int odd_lanes = int(std::min<std::size_t>(lanes, odd_count > e0 ? odd_count - e0 : 0));
-      for (int e = 0; e < 9; ++e) put(even.R[e], R[e], lanes);
-      for (int e = 0; e < 3; ++e) put(even.t[e], t[e], lanes), put(even.direction[e], d[e], lanes);
-      for (int e = 0; e < 6; ++e) put(even.z[e], z[e], lanes);
-      if (odd_lanes == 0) continue;
-      for (int e = 0; e < 9; ++e) put(odd.R[e], Rt[e], odd_lanes);
-      for (int e = 0; e < 3; ++e) put(odd.t[e], tm[e], odd_lanes), put(odd.direction[e], dm[e], odd_lanes);
-      for (int e = 0; e < 6; ++e) put(odd.z[e], -z[e], odd_lanes);
+      for (int e = 0; e < 9; ++e) lp.R0[e] = field([e](const SamplePlan& p) { return p.R0[e]; });
+      for (int e = 0; e < 3; ++e) {
+        lp.t0[e] = field([e](const SamplePlan& p) { return p.t0[e]; });
+        lp.n0[e] = field([e](const SamplePlan& p) { return p.n0[e]; });
+        lp.first[e] = field([e](const SamplePlan& p) { return p.first[e]; });
+      }
+      for (int e = 0; e < 18; ++e) lp.P[e] = field([e](const SamplePlan& p) { return p.P[e]; });
+      lp.translation = field([](const SamplePlan& p) { return p.translation; });
+      lp.rotation = field([](const SamplePlan& p) { return p.rotation; });
+      lp.predict = field([](const SamplePlan& p) { return p.predict ? 1.0 : 0.0; }) != 0.0;
+      if (count == 2) {  // M = 4: every register starts a pair (e0 and W even), lanes 2h, 2h + 1 are pair q0 + h
+        const std::size_t base = q0 * stride;
+        const auto put = [base, stride](double* dst, const real& v, int n) { put_pairs(dst + base, stride, v, n); };
+        poses(lp, z, put, lanes, odd_lanes, even, odd);
+      } else {
+        const auto put = [&at](double* dst, const real& v, int n) {
+          for (int l = 0; l < n; ++l) dst[at[l]] = v[l];
+        };
+        poses(lp, z, put, lanes, odd_lanes, even, odd);
+      }
     }
   }
 };

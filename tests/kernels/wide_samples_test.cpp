@@ -56,7 +56,8 @@ TEST(WideSamples, NoiseIsTheCounterGeneratorsAndPosesFollowThePlan) {
         if (!kernels::simd::cpu_has(isa)) continue;
         SCOPED_TRACE(std::string(to_string(isa)) + (predict ? " predicted" : " plain"));
         Arrays even(count), odd(count);
-        kernels::simd::build_samples(isa, p, 5, count, odds, even.view, odd.view);
+        const kernels::simd::SamplePlan* plans[] = {&p};
+        kernels::simd::build_samples(isa, plans, 1, count, 5, count, odds, even.view, odd.view);
         for (std::size_t k = 0; k < count; ++k) {
           double z[6];
           detail::gaussian_vector<6>(42, 9, 5 + k, 0, z);
@@ -93,6 +94,48 @@ TEST(WideSamples, NoiseIsTheCounterGeneratorsAndPosesFollowThePlan) {
         all.insert(all.end(), odd.data.begin(), odd.data.end());
         if (reference.empty()) reference = all;
         else EXPECT_EQ(std::memcmp(all.data(), reference.data(), all.size() * sizeof(double)), 0);
+      }
+    }
+  }
+}
+
+TEST(WideSamples, SeveralPairsPerRegisterGiveEachPairsOwnSamples) {
+  // Small M packs several pairs' samples into one register: 5 plans of 1, 2 (M = 4, the 16-byte stores) or 3
+  // antithetic pairs, laid out as the engine's block (plan q's firsts at q stride, its copies right after them), so
+  // that registers mix 2 to 8 pairs and the last one is partial on AVX2 and AVX-512. Every entry must be the bits
+  // of the plan built alone, whatever its lane neighbours are (their own keys, rotations, predictions), and
+  // nothing else is written.
+  const std::size_t pairs = 5;
+  std::vector<kernels::simd::SamplePlan> p;
+  for (std::size_t q = 0; q < pairs; ++q) {
+    p.push_back(plan(42, 100 + q, q % 2 == 0 ? 0.05 : 0.6, q % 3 != 1));
+    for (int e = 0; e < 3; ++e) p.back().t0[e] += 0.1 * double(q), p.back().first[e] += double(q);
+    p.back().translation *= double(q + 1);
+  }
+  const kernels::simd::SamplePlan* ptr[pairs];
+  for (std::size_t q = 0; q < pairs; ++q) ptr[q] = &p[q];
+  for (std::size_t count : {1, 2, 3}) {
+    const std::size_t stride = 2 * count, n = pairs * stride + 1;  // one spare entry: nothing past the block
+    for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
+      if (!kernels::simd::cpu_has(isa)) continue;
+      SCOPED_TRACE(std::string(to_string(isa)) + " count " + std::to_string(count));
+      Arrays block(n);
+      kernels::simd::SampleArrays odd = block.view;
+      for (double*& a : odd.R) a += count;
+      for (double*& a : odd.t) a += count;
+      for (double*& a : odd.direction) a += count;
+      for (double*& a : odd.z) a += count;
+      kernels::simd::build_samples(isa, ptr, pairs, stride, 3, count, count, block.view, odd);
+      for (int a = 0; a < 21; ++a) EXPECT_EQ(block.data[a * n + n - 1], -7.0) << a;
+      for (std::size_t q = 0; q < pairs; ++q) {
+        Arrays e1(count), o1(count);
+        kernels::simd::build_samples(isa, ptr + q, 1, count, 3, count, count, e1.view, o1.view);
+        for (int a = 0; a < 21; ++a)
+          for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t at = a * n + q * stride + k, alone = a * count + k;
+            ASSERT_TRUE(same(block.data[at], e1.data[alone])) << q << " " << a << " " << k;
+            ASSERT_TRUE(same(block.data[at + count], o1.data[alone])) << q << " " << a << " " << k;
+          }
       }
     }
   }
