@@ -160,18 +160,25 @@ struct Span {
   std::size_t plan, first, count, j0;
 };
 
-/// Writes samples j0 .. j0 + count of plan p (j0 even) at block slot `slot`: the first samples of the antithetic
-/// pairs (2k: z drawn from the key (seed, pair, k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
-/// the transposed rotation) after them, so that build_samples() writes whole registers.
-void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
-  const std::size_t evens = (count + 1) / 2, odds = count / 2;
-  kernels::simd::SampleArrays even, odd;
+/// The builder's output arrays for samples written from block slot `slot`: the first samples of the antithetic
+/// pairs at slot .., their copies `evens` slots after them.
+void sample_arrays(Block& b, std::size_t slot, std::size_t evens, kernels::simd::SampleArrays& even,
+                   kernels::simd::SampleArrays& odd) {
   for (int e = 0; e < 9; ++e) even.R[e] = b.at(Block::kR + e) + slot, odd.R[e] = even.R[e] + evens;
   for (int e = 0; e < 3; ++e) {
     even.t[e] = b.at(Block::kT + e) + slot, odd.t[e] = even.t[e] + evens;
     even.direction[e] = b.at(Block::kDir + e) + slot, odd.direction[e] = even.direction[e] + evens;
   }
   for (int e = 0; e < 6; ++e) even.z[e] = b.at(Block::kZ + e) + slot, odd.z[e] = even.z[e] + evens;
+}
+
+/// Writes samples j0 .. j0 + count of plan p (j0 even) at block slot `slot`: the first samples of the antithetic
+/// pairs (2k: z drawn from the key (seed, pair, k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
+/// the transposed rotation) after them, so that build_samples() writes whole registers.
+void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
+  const std::size_t evens = (count + 1) / 2, odds = count / 2;
+  kernels::simd::SampleArrays even, odd;
+  sample_arrays(b, slot, evens, even, odd);
   const kernels::simd::SamplePlan* plans[] = {&p.samples};
   kernels::simd::build_samples(c.isa, plans, 1, count, j0 / 2, evens, odds, even, odd);
   std::fill_n(b.shape_a.data() + slot, count, c.batch.shape_a[p.i]);
@@ -185,12 +192,7 @@ void build_group(const Context& c, const PairPlan* const* group, std::size_t n, 
                  std::size_t slot) {
   const std::size_t e = M / 2;
   kernels::simd::SampleArrays even, odd;
-  for (int a = 0; a < 9; ++a) even.R[a] = b.at(Block::kR + a) + slot, odd.R[a] = even.R[a] + e;
-  for (int a = 0; a < 3; ++a) {
-    even.t[a] = b.at(Block::kT + a) + slot, odd.t[a] = even.t[a] + e;
-    even.direction[a] = b.at(Block::kDir + a) + slot, odd.direction[a] = even.direction[a] + e;
-  }
-  for (int a = 0; a < 6; ++a) even.z[a] = b.at(Block::kZ + a) + slot, odd.z[a] = even.z[a] + e;
+  sample_arrays(b, slot, e, even, odd);
   const kernels::simd::SamplePlan* plans[kGroupEvens] = {};
   for (std::size_t q = 0; q < n; ++q) plans[q] = &group[q]->samples;
   kernels::simd::build_samples(c.isa, plans, n, M, 0, e, e, even, odd);
