@@ -366,6 +366,16 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
   std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
   bool planned = false;          // pair i is planned, in plans[count - 1] (its samples continue in this block)
   std::size_t count = 0;         // plans in use; the vector only grows, so a pair is planned in place, not copied
+  // Plans pair i in plans[count]; a pair that cannot be planned gets its empty outputs and is skipped (false).
+  const auto plan_next = [&]() {
+    if (count == plans.size()) plans.emplace_back();
+    PairPlan& p = plans[count];
+    plan_pair(c, i, p);
+    if (p.ok) return true;
+    store_nothing(out, i);
+    ++i;
+    return false;
+  };
   while (i < end) {
     // Fill the block with whole antithetic pairs of samples, pair after pair; a pair left unfinished by the last
     // block keeps its plan, moved to the front.
@@ -379,14 +389,7 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
         const PairPlan* members[kGroupEvens] = {};
         std::size_t n = 0;
         while (i < end && n < group && used + (n + 1) * M <= kBlockSamples) {
-          if (count == plans.size()) plans.emplace_back();
-          PairPlan& p = plans[count];
-          plan_pair(c, i, p);
-          if (!p.ok) {
-            store_nothing(out, i);
-            ++i;
-            continue;
-          }
+          if (!plan_next()) continue;
           ++count;
           ++i;
           ++n;
@@ -403,15 +406,8 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
         continue;
       }
       if (!planned) {
-        if (count == plans.size()) plans.emplace_back();
-        PairPlan& p = plans[count];
-        plan_pair(c, i, p);
         j = 0;
-        if (!p.ok) {
-          store_nothing(out, i);
-          ++i;
-          continue;
-        }
+        if (!plan_next()) continue;
         ++count;
         planned = true;
       }

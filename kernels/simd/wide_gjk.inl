@@ -1119,6 +1119,8 @@ template <class T> struct WideGjk {
 
       V3 d = x;
       const real kk = to_real<T>(L.k);  // k + 1 of the reference (k already incremented)
+      // Each momentum branch ends with "momentum cancelled out: the gradient" (plain GJK's d is x already), tested
+      // on |d|^2 > 0, which is |d| > 0 bit for bit (sqrt(a) > 0 exactly when a > 0, NaN false in both): no root.
       if (solver == Solver::nesterov && any(live & L.momentum)) {  // else every lane steps along x
         const real delta = kk / (kk + T(2));  // T(k + 1) / T(k + 3)
         const V3 y = add(scale(delta, x), scale(one - delta, L.last_s));
@@ -1134,8 +1136,6 @@ template <class T> struct WideGjk {
         d = pick(L.momentum, add(scale(one - beta, x), scale(beta, L.d_prev)), d);
         d = pick(norm2(d) > zero, d, x);
       }
-      // Momentum cancelled out: the gradient. Inside the momentum branches (plain GJK's d is x), on |d|^2 > 0,
-      // which is |d| > 0 bit for bit (sqrt(a) > 0 exactly when a > 0, NaN false in both): no square root.
       // Newton's direction, where the last iteration set one up, replaces plain GJK's and momentum's (and ends
       // momentum for the lane: Newton converges quadratically where momentum's gain is linear).
       mask newton_step = splat_mask(0);
