@@ -369,13 +369,12 @@ template <class T> struct WideGjkPairs {
     }
   };
 
-  static std::size_t run(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
-                         std::size_t n, const QueryOptions& options, const ResultView& out, std::uint32_t* fallback) {
-    if (n == 0) return 0;
+  /// Whether a group goes to run_certified() (boolean double queries of the types certified_pays() names) rather
+  /// than run_plain(). The entry points (simd/isa_body.inl) compile the two paths in separate translation units.
+  static bool certifies(ShapeType type_a, ShapeType type_b, const QueryOptions& options) {
     if constexpr (std::is_same_v<T, double>)
-      if (options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b))
-        return run_certified(in, type_a, type_b, pairs, n, options, out, fallback);
-    return run_plain(in, type_a, type_b, pairs, n, options, out, fallback);
+      return options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b);
+    return false;
   }
   /// Every pair through the GJK of precision T (a certified run's refused pairs too).
   static std::size_t run_plain(const PairView& in, ShapeType type_a, ShapeType type_b, const std::uint32_t* pairs,
