@@ -84,7 +84,7 @@ bool wide_type_pair(ShapeType a, ShapeType b, const QueryOptions& q) {
   return plain(a) && plain(b) && !kernels::may_have_closed_form(a, b, q);
 }
 
-/// Ra^T v, in the order of Eigen's R_a.transpose() * v: ((Ra(0,r) v0 + Ra(1,r) v1) + Ra(2,r) v2.
+/// Ra^T v, in the order of Eigen's R_a.transpose() * v: (Ra(0,r) v0 + Ra(1,r) v1) + Ra(2,r) v2.
 inline void rotate_back(const double (&Ra)[3][3], const double* v, double* out) {
   for (int r = 0; r < 3; ++r) out[r] = (Ra[0][r] * v[0] + Ra[1][r] * v[1]) + Ra[2][r] * v[2];
 }
