@@ -21,6 +21,10 @@
 #include <cmath>
 #include <vector>
 
+// The vector types of derivative_finish_lanes.inl cross no call boundary between instruction sets (each set's code
+// calls only its own, always inlined) and no object boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace batchcol::detail {
 namespace {
 
@@ -50,20 +54,18 @@ bool curved(const ShapeTable& shapes, std::uint32_t s) {
                                    shape.type != ShapeType::triangle && shape.type != ShapeType::halfspace);
 }
 
-/// What the samples of pair i share, in A's frame: B's pose (R, t), the unperturbed answer g0 (distance, witness
-/// points, normal), the noise scales, the first GJK direction without perturbation and its first-order change P z.
+/// What the samples of pair i share: A's pose (Ra row-major, ta) for the mapping to the world, the unperturbed answer
+/// g0 in A's frame (distance, witness points, normal), the noise scales, and `samples`, what build_samples() reads:
+/// B's pose in A's frame, the first GJK direction without perturbation and its first-order change P z.
 struct PairPlan {
   std::size_t i = 0;
   bool ok = false;  // false: no nominal witness, or b has no finite size (store_nothing)
-  Eigen::Matrix3d Ra, R;
-  Eigen::Vector3d ta, t, warm;
-  Eigen::Matrix<double, 10, 1> g0;
+  double Ra[3][3], ta[3];
+  double g0[10];
   Noise s;
-  bool predict = false;
-  Eigen::Matrix<double, 3, 6> P;
   ShapeType type_a = ShapeType::sphere, type_b = ShapeType::sphere;
   bool wide = false;  // the type pair runs through gjk_samples
-  kernels::simd::SamplePlan samples;  // the above as build_samples() reads it
+  kernels::simd::SamplePlan samples;
 };
 
 struct Context {
@@ -82,6 +84,16 @@ bool wide_type_pair(ShapeType a, ShapeType b, const QueryOptions& q) {
   return plain(a) && plain(b) && !kernels::may_have_closed_form(a, b, q);
 }
 
+/// Ra^T v, in the order of Eigen's R_a.transpose() * v: (Ra(0,r) v0 + Ra(1,r) v1) + Ra(2,r) v2.
+inline void rotate_back(const double (&Ra)[3][3], const double* v, double* out) {
+  for (int r = 0; r < 3; ++r) out[r] = (Ra[0][r] * v[0] + Ra[1][r] * v[1]) + Ra[2][r] * v[2];
+}
+
+/// Plans pair i. Plain loops in the operation order of the Eigen expressions they replace (R_a.transpose() * R_b,
+/// R_a.transpose() * v, s * (R_a.transpose() * X * R_a): Eigen moves the scalar onto R_a.transpose() and sums the
+/// outer product's row 2 as a0 + (a1 + a2); each order found by a bitwise comparison against Eigen on 20000 random
+/// poses and Jacobians): the same bits, without the 3x3 temporaries, the PairPlan copies of R, t and P and
+/// Eigen's ~410 instructions for P.
 void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
   p.i = i;
   PairGeometry g;
@@ -93,43 +105,79 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
     p.ok = false;
     return;
   }
-  p.Ra = R_a;
-  p.ta = c.batch.translation_a[i];
-  p.R = R_a.transpose() * R_b;
-  const Eigen::Vector3d t_b = c.batch.translation_b[i];
-  p.t = R_a.transpose() * (t_b - p.ta);
-  p.g0 << g.distance, R_a.transpose() * (g.witness_a - p.ta), R_a.transpose() * (g.witness_b - p.ta),
-      R_a.transpose() * g.normal;
-  const Eigen::Vector3d d = c.results.direction.size() == c.batch.size() ? Eigen::Vector3d(c.results.direction[i])
-                                                                         : Eigen::Vector3d(-g.normal);
-  p.warm = R_a.transpose() * d;
+  kernels::simd::SamplePlan& sp = p.samples;
+  double(&Ra)[3][3] = p.Ra;
+  double Rb[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) Ra[r][q] = R_a(r, q), Rb[r][q] = R_b(r, q);
+  const double ta[3] = {c.batch.translation_a.x[i], c.batch.translation_a.y[i], c.batch.translation_a.z[i]};
+  const double tb[3] = {c.batch.translation_b.x[i], c.batch.translation_b.y[i], c.batch.translation_b.z[i]};
+  for (int r = 0; r < 3; ++r) {
+    p.ta[r] = ta[r];
+    for (int q = 0; q < 3; ++q) sp.R0[3 * r + q] = (Ra[0][r] * Rb[0][q] + Ra[1][r] * Rb[1][q]) + Ra[2][r] * Rb[2][q];
+  }
+  const double dt[3] = {tb[0] - ta[0], tb[1] - ta[1], tb[2] - ta[2]};
+  rotate_back(Ra, dt, sp.t0);
+  const double wa[3] = {g.witness_a.x() - ta[0], g.witness_a.y() - ta[1], g.witness_a.z() - ta[2]};
+  const double wb[3] = {g.witness_b.x() - ta[0], g.witness_b.y() - ta[1], g.witness_b.z() - ta[2]};
+  p.g0[0] = g.distance;
+  rotate_back(Ra, wa, p.g0 + 1);
+  rotate_back(Ra, wb, p.g0 + 4);
+  rotate_back(Ra, g.normal.data(), p.g0 + 7);
+  double d[3] = {-g.normal.x(), -g.normal.y(), -g.normal.z()};
+  if (c.results.direction.size() == c.batch.size())
+    d[0] = c.results.direction.x[i], d[1] = c.results.direction.y[i], d[2] = c.results.direction.z[i];
+  rotate_back(Ra, d, sp.first);
+  for (int r = 0; r < 3; ++r) sp.n0[r] = p.g0[7 + r];
   const auto& types = ShapeTableAccess::types(c.shapes);
   p.type_a = types[c.batch.shape_a[i]];
   p.type_b = types[c.batch.shape_b[i]];
   p.wide = wide_type_pair(p.type_a, p.type_b, c.query);
-  p.predict = false;
+  sp.predict = false;
   if (c.predictor && (c.predictor->status[i] == DerivativeStatus::smooth ||
                       c.predictor->status[i] == DerivativeStatus::zero_curvature)) {
     // A sample moves b about its own origin by v_n = s_t Ra z_v and w = s_w Ra z_w (z in A's frame): the world
-    // twist (v_n + t_b x w, w); the normal moves by J_n of that, taken back to A's frame.
+    // twist (v_n + t_b x w, w); the normal moves by J_n of that, taken back to A's frame:
+    // P = [s_t Ra^T Jv Ra, s_w Ra^T (Jv [t_b]x + Jw) Ra].
     const Mat36 J = c.predictor->normal_wrt_b[i];
-    const Eigen::Matrix3d Jv = J.leftCols<3>(), Jw = J.rightCols<3>();
-    p.P.leftCols<3>() = p.s.translation * (R_a.transpose() * Jv * R_a);
-    p.P.rightCols<3>() = p.s.rotation * (R_a.transpose() * (Jv * skew(t_b) + Jw) * R_a);
-    p.predict = p.P.allFinite();
+    const double S[3][3] = {{0.0, -tb[2], tb[1]}, {tb[2], 0.0, -tb[0]}, {-tb[1], tb[0], 0.0}};  // skew(t_b)
+    double X[2][3][3];  // Jv, Jv [t_b]x + Jw
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) {
+        X[0][r][q] = J(r, q);
+        X[1][r][q] = ((J(r, 0) * S[0][q] + J(r, 1) * S[1][q]) + J(r, 2) * S[2][q]) + J(r, 3 + q);
+      }
+    // Two columns per SSE2 register (k, q = 0, 1; column 2 alone): the same operations per entry.
+    using V2 = double __attribute__((vector_size(16)));
+    const auto ld = [](const double* p) { V2 v; std::memcpy(&v, p, sizeof v); return v; };
+    const V2 ra01[3] = {ld(Ra[0]), ld(Ra[1]), ld(Ra[2])};
+    V2 bad = {0.0, 0.0};  // x - x: 0 for finite x, NaN otherwise
+    for (int h = 0; h < 2; ++h) {
+      const double s = h == 0 ? p.s.translation : p.s.rotation;
+      double sR[3][3];  // s Ra
+      for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q) sR[r][q] = s * Ra[r][q];
+      const V2 x01[3] = {ld(X[h][0]), ld(X[h][1]), ld(X[h][2])};
+      for (int r = 0; r < 3; ++r) {  // row r of (s Ra)^T X, then of that times Ra
+        const V2 l01 = (x01[0] * sR[0][r] + x01[1] * sR[1][r]) + x01[2] * sR[2][r];
+        const double l2 = (sR[0][r] * X[h][0][2] + sR[1][r] * X[h][1][2]) + sR[2][r] * X[h][2][2];
+        const double l0 = l01[0], l1 = l01[1];
+        const V2 a0 = ra01[0] * l0, a1 = ra01[1] * l1, a2 = ra01[2] * l2;
+        const V2 v01 = r < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
+        const double b0 = l0 * Ra[0][2], b1 = l1 * Ra[1][2], b2 = l2 * Ra[2][2];
+        const double v2 = r < 2 ? (b0 + b1) + b2 : b0 + (b1 + b2);
+        double* out = sp.P + 6 * r + 3 * h;
+        out[0] = v01[0], out[1] = v01[1], out[2] = v2;
+        bad += (v01 - v01) + (v2 - v2);
+      }
+    }
+    const bool finite = bad[0] + bad[1] == 0.0;
+    sp.predict = finite;
   }
-  kernels::simd::SamplePlan& sp = p.samples;
+  if (!sp.predict) std::fill_n(sp.P, 18, 0.0);
   sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // CounterRng's (seed, pair) half of the key
-  for (int r = 0; r < 3; ++r) {
-    for (int q = 0; q < 3; ++q) sp.R0[3 * r + q] = p.R(r, q);
-    sp.t0[r] = p.t[r];
-    sp.n0[r] = p.g0[7 + r];
-    sp.first[r] = p.warm[r];
-    for (int e = 0; e < 6; ++e) sp.P[6 * r + e] = p.predict ? p.P(r, e) : 0.0;
-  }
   sp.translation = p.s.translation;
   sp.rotation = p.s.rotation;
-  sp.predict = p.predict;
 }
 
 /// One block's samples, structure of arrays (the kernel's layout), and their answers, one row of kRow per sample
@@ -269,85 +317,123 @@ void accumulate(const Context& c, Block& b, std::size_t first, std::size_t count
   kernels::simd::accumulate_samples(c.isa, b.row(first), b.status.data() + first, z, count, (count + 1) / 2, sums);
 }
 
-/// The estimator from the sums, mapped from A's frame and A-frame noise to the world, written straight into the
-/// pair's StoreBlock slot. Loops in the operation order of the Eigen expressions they replace (products
-/// summed k = 0, 1, 2 left to right, except row 2 of Ra times a 3-row block, which Eigen computes after its 2-row
-/// packet as a0 + (a1 + a2); the same divisions; the rigid-motion blocks' signed zeros), so the bits are those of
-/// the Eigen version; that one cost ~1600 instructions per pair (block temporaries, a PairJacobians copy
-/// and write_jacobians()), more than four M = 4 samples' GJK.
-void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlock& out) {
+/// What FinishLanes keeps of a pair for the lanes: the sums, the noise scales, A's rotation, B's position and the
+/// smoothed witness points and normal in the world (x[0], x[1], x[2]), lane l of each array.
+struct FinishIn {
+  static constexpr std::size_t kLanes = 8;
+  alignas(64) double G[6][10][kLanes];
+  alignas(64) double valid[kLanes], s_t[kLanes], s_w[kLanes], Ra[9][kLanes], tb[3][kLanes], x[3][3][kLanes];
+};
+
+}  // namespace
+
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
+namespace finish_avx512 {
+#include "derivative_finish_lanes.inl"
+}  // namespace finish_avx512
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace finish_avx2 {
+#include "derivative_finish_lanes.inl"
+}  // namespace finish_avx2
+#pragma GCC pop_options
+namespace finish_baseline {
+#include "derivative_finish_lanes.inl"
+}  // namespace finish_baseline
+
+namespace {
+
+/// The estimator of up to FinishIn::kLanes consecutive pairs, mapped to the world in SIMD lanes (one pair per
+/// lane, derivative_finish_lanes.inl) and written straight to the output arrays, each array one whole register of
+/// 8 consecutive pairs when the block is full (StoreBlock's reason: 120 arrays a power of two apart, written pair by
+/// pair, share one L1 set). Pair by pair in SSE2 (the previous finish_pair()) this cost 1507 instructions per pair
+/// (callgrind, AVX2 build, ellipsoids M = 4), more than a witness query's GJK loop. Flushes when a pair is not the
+/// next one, when full and on destruction.
+class FinishLanes {
+ public:
+  static constexpr std::size_t kLanes = FinishIn::kLanes;
+  FinishLanes(DerivativeResults& d, InstructionSet isa) : d_(d), isa_(isa) {}
+  FinishLanes(const FinishLanes&) = delete;
+  FinishLanes& operator=(const FinishLanes&) = delete;
+  ~FinishLanes() { flush(); }
+  void add(std::size_t i, const Sums& sums, const PairPlan& p, const double (&tb)[3], const double (&x)[3][3]) {
+    if (count_ == kLanes || (count_ > 0 && i != first_ + count_)) flush();
+    if (count_ == 0) first_ = i;
+    const std::size_t l = count_++;
+    for (int e = 0; e < 6; ++e)
+      for (int r = 0; r < 10; ++r) in_.G[e][r][l] = sums.G[e][r];
+    in_.valid[l] = double(sums.valid);
+    in_.s_t[l] = p.s.translation;
+    in_.s_w[l] = p.s.rotation;
+    for (int r = 0; r < 3; ++r) {
+      for (int q = 0; q < 3; ++q) in_.Ra[3 * r + q][l] = p.Ra[r][q], in_.x[r][q][l] = x[r][q];
+      in_.tb[r][l] = tb[r];
+    }
+  }
+  void flush() {
+    if (count_ == 0) return;
+    const std::size_t n = d_.status.size();
+    double* const arrays[8] = {d_.distance_gradient_a.data.data(), d_.distance_gradient_b.data.data(),
+                               d_.witness_a_wrt_a.data.data(),     d_.witness_a_wrt_b.data.data(),
+                               d_.witness_b_wrt_a.data.data(),     d_.witness_b_wrt_b.data.data(),
+                               d_.normal_wrt_a.data.data(),        d_.normal_wrt_b.data.data()};
+    double* rows[StoreEntries];  // entry e of pair first_ (StoreBlock::flush()'s mapping)
+    int e = 0;
+    for (int a = 0; a < 8; ++a)
+      for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
+    if (count_ == kLanes) {
+      solve(rows);
+    } else {
+      alignas(64) double buffer[StoreEntries][kLanes];
+      double* buffer_rows[StoreEntries];
+      for (int k = 0; k < StoreEntries; ++k) buffer_rows[k] = buffer[k];
+      solve(buffer_rows);
+      for (int k = 0; k < StoreEntries; ++k) std::copy_n(buffer[k], count_, rows[k]);
+    }
+    count_ = 0;
+  }
+
+ private:
+  void solve(double* const* out) const {
+    if (isa_ == InstructionSet::avx512) finish_avx512::finish_lanes(in_, out);
+    else if (isa_ == InstructionSet::avx2) finish_avx2::finish_lanes(in_, out);
+    else finish_baseline::finish_lanes(in_, out);
+  }
+  DerivativeResults& d_;
+  InstructionSet isa_;
+  FinishIn in_{};  // value-initialised: lanes past count_ are computed (not written) on initialised numbers
+  std::size_t first_ = 0, count_ = 0;
+};
+
+/// The estimator from the sums: the smoothed values mapped from A's frame to the world here, the derivatives
+/// queued for FinishLanes. Each entry gets the operations, in their order, of the Eigen expressions the mapping
+/// replaced (products summed k = 0, 1, 2 left to right, except row 2 of Ra times a 3-row block, which Eigen
+/// computes after its 2-row packet as a0 + (a1 + a2); the same divisions; the rigid-motion blocks' signed zeros),
+/// so the bits are those of the Eigen version.
+void finish_pair(const Context& c, const PairPlan& p, const Sums& sums, StoreBlock& out, FinishLanes& lanes) {
   const std::size_t i = p.i;
   if (sums.valid == 0) return store_nothing(out, i);
   DerivativeResults& d = out.d;
   const double valid = double(sums.valid);
   double mean[10];
   for (int r = 0; r < 10; ++r) mean[r] = sums.mean[r] / valid;
-  // Column-major like the sums, GT[e][r] = G(r, e), two rows per SSE2 register where the operation runs along a
-  // column (every entry still gets its own operations in the scalar order: the bits do not change).
-  using V2 = double __attribute__((vector_size(16)));
-  const auto ld = [](const double* p) { V2 v; std::memcpy(&v, p, sizeof v); return v; };
-  const auto st = [](double* p, V2 v) { std::memcpy(p, &v, sizeof v); };
-  // G = sums / valid, divided by the noise scale: the score of the Gaussian is S^-1 z.
-  double GT[6][10];
-  for (int e = 0; e < 6; ++e) {
-    const double s = e < 3 ? p.s.translation : p.s.rotation;
-    for (int r = 0; r < 10; r += 2) st(&GT[e][r], ld(&sums.G[e][r]) / valid / s);
-  }
-  // Values and noise to the world: v_world - g0_world = Ra (v_A - g0_A) for the points and the normal, and the
-  // world noise is Ra z.
-  double Ra[3][3];
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) Ra[r][q] = p.Ra(r, q);
-  for (int e = 0; e < 6; ++e)
-    for (int r = 1; r < 10; r += 3) {
-      double* g = &GT[e][r];
-      const double g0 = g[0], g1 = g[1], g2 = g[2];
-      for (int q = 0; q < 2; ++q) g[q] = (Ra[q][0] * g0 + Ra[q][1] * g1) + Ra[q][2] * g2;
-      g[2] = Ra[2][0] * g0 + (Ra[2][1] * g1 + Ra[2][2] * g2);
-    }
-  // The noise moved b about its own origin t_b: a world twist (v, w) is the noise coordinates (v - [t_b]x w, w).
-  const Eigen::Vector3d t_b = c.batch.translation_b[i];
-  const double S[3][3] = {{0.0, -t_b.z(), t_b.y()}, {t_b.z(), 0.0, -t_b.x()}, {-t_b.y(), t_b.x(), 0.0}};  // skew()
-  for (int r = 0; r < 10; r += 2) {  // G.leftCols() * Ra^T, G.rightCols() * Ra^T, then minus G.leftCols() [t_b]x
-    V2 col[6], w[6];
-    for (int e = 0; e < 6; ++e) col[e] = ld(&GT[e][r]);
-    for (int h = 0; h < 6; h += 3)
-      for (int q = 0; q < 3; ++q) w[h + q] = (col[h] * Ra[q][0] + col[h + 1] * Ra[q][1]) + col[h + 2] * Ra[q][2];
-    for (int q = 0; q < 3; ++q) w[3 + q] -= (w[0] * S[0][q] + w[1] * S[1][q]) + w[2] * S[2][q];
-    for (int e = 0; e < 6; ++e) st(&GT[e][r], w[e]);
-  }
-  const auto world = [&](int r0, double* v) {  // Ra m + ta (r0 = 1, 4) or Ra m (r0 = 7)
+  const double(&Ra)[3][3] = p.Ra;
+  // Values to the world: Ra m + ta (r0 = 1, 4) or Ra m (r0 = 7).
+  const auto world = [&](int r0, double* v) {
     for (int q = 0; q < 2; ++q) v[q] = (Ra[q][0] * mean[r0] + Ra[q][1] * mean[r0 + 1]) + Ra[q][2] * mean[r0 + 2];
     v[2] = Ra[2][0] * mean[r0] + (Ra[2][1] * mean[r0 + 1] + Ra[2][2] * mean[r0 + 2]);
   };
-  double xa[3], xb[3], n[3];
-  world(1, xa), world(4, xb), world(7, n);
-  for (int q = 0; q < 3; ++q) xa[q] += p.ta[q], xb[q] += p.ta[q];
-  double* slot = out.slot(i);
-  constexpr std::size_t kS = StoreBlock::kStride;
-  for (int e = 0; e < 6; ++e)
-    slot[(store_at::distance_a + e) * kS] = -GT[e][0], slot[(store_at::distance_b + e) * kS] = GT[e][0];
-  // The a-twist blocks: [I, -[x]x] - the b-twist block (rigid_motion(); [0, -[n]x] for the normal), -[x]x with
-  // rigid_motion()'s -0.0 diagonal.
-  const auto a_block = [&](std::size_t e0, const double* x, double identity, int r0) {
-    const double minus_skew[3][3] = {{-0.0, x[2], -x[1]}, {-x[2], -0.0, x[0]}, {x[1], -x[0], -0.0}};
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 6; ++q) {
-        const double m = q < 3 ? (r == q ? identity : 0.0) : minus_skew[r][q - 3];
-        slot[(e0 + 6 * r + q) * kS] = m - GT[q][r0 + r];
-      }
-  };
-  const auto b_block = [&](std::size_t e0, int r0) {
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 6; ++q) slot[(e0 + 6 * r + q) * kS] = GT[q][r0 + r];
-  };
-  a_block(store_at::witness_a_a, xa, 1.0, 1), b_block(store_at::witness_a_b, 1);
-  a_block(store_at::witness_b_a, xb, 1.0, 4), b_block(store_at::witness_b_b, 4);
-  a_block(store_at::normal_a, n, 0.0, 7), b_block(store_at::normal_b, 7);
+  double x[3][3];  // witness a, witness b, normal
+  world(1, x[0]), world(4, x[1]), world(7, x[2]);
+  for (int q = 0; q < 3; ++q) x[0][q] += p.ta[q], x[1][q] += p.ta[q];
+  const double tb[3] = {c.batch.translation_b.x[i], c.batch.translation_b.y[i], c.batch.translation_b.z[i]};
+  lanes.add(i, sums, p, tb, x);
   d.smoothed_distance[i] = mean[0];
-  d.smoothed_witness_a.set(i, Eigen::Vector3d(xa[0], xa[1], xa[2]));
-  d.smoothed_witness_b.set(i, Eigen::Vector3d(xb[0], xb[1], xb[2]));
-  d.smoothed_normal.set(i, Eigen::Vector3d(n[0], n[1], n[2]));
+  d.smoothed_witness_a.set(i, Eigen::Vector3d(x[0][0], x[0][1], x[0][2]));
+  d.smoothed_witness_b.set(i, Eigen::Vector3d(x[1][0], x[1][1], x[1][2]));
+  d.smoothed_normal.set(i, Eigen::Vector3d(x[2][0], x[2][1], x[2][2]));
   d.status[i] = sums.valid == c.o.samples ? DerivativeStatus::smooth : DerivativeStatus::partial_samples;
 }
 
@@ -361,7 +447,8 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
   thread_local std::vector<Span> spans;
   // Pairs per group (build_group()); 1: each pair alone (odd M: the last antithetic pair has no copy).
   const std::size_t group = M % 2 == 0 && M / 2 <= kGroupEvens / 2 ? kGroupEvens / (M / 2) : 1;
-  StoreBlock out(d);
+  StoreBlock out(d);  // the pairs without an estimator (store_nothing())
+  FinishLanes lanes(d, c.isa);
   Sums sums;
   std::size_t i = begin, j = 0;  // the next sample to build: sample j of pair i
   bool planned = false;          // pair i is planned, in plans[count - 1] (its samples continue in this block)
@@ -440,7 +527,7 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
         for (int e = 0; e < 10; ++e) sums.g0[e] = p.g0[e];
       }
       accumulate(c, block, sp.first, sp.count, sums);
-      if (sp.j0 + sp.count == M) finish_pair(c, p, sums, out);
+      if (sp.j0 + sp.count == M) finish_pair(c, p, sums, out, lanes);
     }
   }
 }

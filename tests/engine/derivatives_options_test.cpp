@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace batchcol::testing {
 namespace {
@@ -161,6 +163,87 @@ TEST(DerivativesOptions, BitwiseIdenticalForAnyThreadCount) {
     o.seed = 43;
     differentiate(shapes, batch, q, o, r, d2);
     EXPECT_EQ(same_bits(d1.witness_a_wrt_b.data, d2.witness_a_wrt_b.data), m == DerivativeMethod::analytic);
+  }
+}
+
+// smoothed0 maps its estimator to the world 8 pairs at a time, one pair per SIMD lane, in code compiled for each
+// instruction set (engine/src/derivative_finish_lanes.inl), flushed early where a pair without witness (here a
+// halfspace pair every 11 pairs, at every lane position) breaks a run of consecutive pairs: every set must give
+// the same bits, and each lane's a-twist blocks must be its own rigid motion minus its own b-twist block, exactly as
+// the mapping computes them ([I, -[x]x] - J_b with the pair's smoothed witness point x; [0, -[n]x] - J_b for the
+// normal), which a lane mixed up with another pair's would break.
+TEST(DerivativesOptions, Smoothed0SameBitsOnEveryInstructionSetAndEachLaneItsOwnPair) {
+  Rng rng(13);
+  ShapeTable shapes;
+  const PairBatch separated = random_separated_pairs(rng, shapes, bounded_shape_types(), 300);
+  const auto h = shapes.add(Shape::halfspace({0, 0, 1}, 0));
+  PairBatch batch;
+  for (std::size_t i = 0; i < separated.size(); ++i) {
+    if (i % 11 == 5) batch.add(separated.shape_a[i], Pose::from_translation({0, 0, 3}), h, Pose::identity());
+    batch.add(separated.shape_a[i], separated.pose_a(i), separated.shape_b[i], separated.pose_b(i));
+  }
+  const auto skew = [](const Eigen::Vector3d& x) {
+    Eigen::Matrix3d m;
+    m << 0, -x.z(), x.y(), x.z(), 0, -x.x(), -x.y(), x.x(), 0;
+    return m;
+  };
+  for (int samples : {4, 7}) {  // 4: several pairs per sample register; 7: pair by pair
+    DerivativeOptions o;
+    o.method = DerivativeMethod::smoothed0;
+    o.samples = samples;
+    o.seed = 5;
+    DerivativeResults reference;
+    PairResults r;
+    QueryOptions q;
+    q.isa = InstructionSet::scalar;
+    differentiate(shapes, batch, q, o, r, reference);
+    int checked = 0;
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      if (reference.status[i] != DerivativeStatus::smooth) continue;
+      ++checked;
+      Mat36 rigid_a, rigid_b, rigid_n;
+      rigid_a << Eigen::Matrix3d::Identity(), -skew(reference.smoothed_witness_a[i]);
+      rigid_b << Eigen::Matrix3d::Identity(), -skew(reference.smoothed_witness_b[i]);
+      rigid_n << Eigen::Matrix3d::Zero(), -skew(reference.smoothed_normal[i]);
+      const Mat36 a_a = rigid_a - reference.witness_a_wrt_b[i], b_a = rigid_b - reference.witness_b_wrt_b[i],
+                  n_a = rigid_n - reference.normal_wrt_b[i];
+      EXPECT_EQ(std::memcmp(a_a.data(), reference.witness_a_wrt_a[i].data(), sizeof(Mat36)), 0) << i;
+      EXPECT_EQ(std::memcmp(b_a.data(), reference.witness_b_wrt_a[i].data(), sizeof(Mat36)), 0) << i;
+      EXPECT_EQ(std::memcmp(n_a.data(), reference.normal_wrt_a[i].data(), sizeof(Mat36)), 0) << i;
+      const Row6 minus_b = -reference.distance_gradient_b[i];
+      EXPECT_EQ(std::memcmp(minus_b.data(), reference.distance_gradient_a[i].data(), sizeof(Row6)), 0) << i;
+    }
+    EXPECT_GE(checked, 250) << samples;
+    for (std::size_t i = 5; i < batch.size(); i += 12) EXPECT_EQ(reference.status[i], DerivativeStatus::no_witness);
+    int compared = 0;
+    for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
+      try {
+        resolve_instruction_set(isa);
+      } catch (const InputError&) {
+        continue;  // not on this CPU
+      }
+      ++compared;
+      q.isa = isa;
+      DerivativeResults d;
+      differentiate(shapes, batch, q, o, r, d);
+      EXPECT_EQ(d.status, reference.status) << to_string(isa);
+      EXPECT_TRUE(same_bits(d.distance_gradient_a.data, reference.distance_gradient_a.data)) << to_string(isa);
+      EXPECT_TRUE(same_bits(d.distance_gradient_b.data, reference.distance_gradient_b.data)) << to_string(isa);
+      for (const auto& [x, y] : {std::pair{&d.witness_a_wrt_a, &reference.witness_a_wrt_a},
+                                 std::pair{&d.witness_a_wrt_b, &reference.witness_a_wrt_b},
+                                 std::pair{&d.witness_b_wrt_a, &reference.witness_b_wrt_a},
+                                 std::pair{&d.witness_b_wrt_b, &reference.witness_b_wrt_b},
+                                 std::pair{&d.normal_wrt_a, &reference.normal_wrt_a},
+                                 std::pair{&d.normal_wrt_b, &reference.normal_wrt_b}})
+        EXPECT_TRUE(same_bits(x->data, y->data)) << to_string(isa);
+      EXPECT_TRUE(same_bits(d.smoothed_distance, reference.smoothed_distance)) << to_string(isa);
+      for (const auto& [x, y] : {std::pair{&d.smoothed_witness_a, &reference.smoothed_witness_a},
+                                 std::pair{&d.smoothed_witness_b, &reference.smoothed_witness_b},
+                                 std::pair{&d.smoothed_normal, &reference.smoothed_normal}})
+        EXPECT_TRUE(same_bits(x->x, y->x) && same_bits(x->y, y->y) && same_bits(x->z, y->z)) << to_string(isa);
+    }
+    std::printf("smoothed0 M = %d: %d pairs checked, %d instruction sets compared with scalar\n", samples, checked,
+                compared);
   }
 }
 
