@@ -29,12 +29,19 @@ struct Hit {
   ObjectHandle object;
 };
 
-// Batches from this size on are cast in RayOrder (below), on trees of at least kLargeTreeBytes of wide nodes; records
-// of rays this far ahead in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies:
-// +12% on 10k hulls, whose 0.4 MB of wide nodes stay in the L2 anyway, and measured 15% slower there); it pays when
-// the nodes do not fit a core's L2 (1-2 MB on current x86 servers): 100k mixed objects, +20% rays/s. The traversal
-// prefetches pushed nodes on such trees only, for the same reason.
+// Batches from this size on are cast in RayOrder (below) when what a ray reads at random, the wide nodes and the
+// leaf records (RayLeaf: the leaf's ball and object), takes at least kRandomReadBytes; records of rays this far ahead
+// in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies); it pays when those
+// arrays do not stay in a core's L2 (2 MB on the Xeons measured, shared with the shapes' data and the rays): 100k
+// mixed objects (26 MB of nodes, 13 MB of leaves), +20% rays/s, and 10k hulls of 250 vertices (0.67 MB of nodes,
+// 1.28 MB of leaves, ~0.6 MB of hull walk data), where perf put 25% of the traversal's samples on the first load of
+// a node and 13% on the leaf's ball in input order (14% and 8% in this order), and the order measured +5% rays per
+// CPU second (1 thread, 4 alternating rounds) and +12% in the same-run ratio to Embree (2 threads, median of 8
+// alternating pairs; Emerald Rapids VM at 2.1 GHz; the nodes alone, the previous criterion, are below 1 MiB there).
+// The traversal prefetches pushed nodes on trees whose nodes alone exceed it (kLargeTreeBytes): on 10k hulls in this
+// order that prefetching measured 0.83-1.00 of the rays per CPU second without it (4 rounds).
 constexpr std::size_t kSortedCastMin = 4096;
+constexpr std::size_t kRandomReadBytes = std::size_t(1) << 20;
 constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 constexpr std::size_t kPrefetchAhead = 8;
 
@@ -365,7 +372,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   // Closest and any hits of large batches are cast in RayOrder (all-hit rows are gathered per chunk in input order,
   // so that query keeps the input order; small batches gain nothing from the sort).
   if (!all && n >= kSortedCastMin && n < (std::size_t(1) << 32) &&
-      state_->wide.nodes().size() * sizeof(WideNode) >= kLargeTreeBytes) {
+      state_->wide.nodes().size() * sizeof(WideNode) + state_->leaves.size() * sizeof(RayLeaf) >= kRandomReadBytes) {
     detail::run_with_threads(options.threads, [&] {
       RayOrder order(rays, state_->wide.nodes()[0]);
       CastBuffer<CastResult> results(n);
