@@ -824,6 +824,26 @@ template <class T> struct WideGjk {
     L.newton_steps[l] = 0;
   }
 
+  /// reset_search() for the lanes of `bits` at once, `init` their (non-zero) initial directions: the same values,
+  /// one masked blend per field (the batch-array boolean refill, WideGjkPairs' load_lanes()). Keep the two alike.
+  AI static void reset_search_lanes(Lanes& L, std::uint32_t bits, const V3& init) {
+    const mask m = lanes_of(bits), none = splat_mask(0);
+    const real zero = splat(T(0));
+    L.fresh |= bits;
+    L.lambda[0] = select(m, splat(T(1)), L.lambda[0]);
+    L.count = select(m, splat_mask(1), L.count);
+    L.slot[0] = select(m, none, L.slot[0]);
+    L.d_prev = pick(m, init, L.d_prev);
+    L.direction = pick(m, V3{zero, zero, zero}, L.direction);
+    L.lower = select(m, splat(-std::numeric_limits<T>::infinity()), L.lower);
+    L.k = select(m, none, L.k);
+    L.stale = select(m, none, L.stale);
+    if (L.newton_pair < 0) [[unlikely]] L.newton_pair = newton_pair_type(L.A.type, L.B.type) ? 1 : 0;
+    L.newton = select(m, splat_mask(-Int(L.newton_pair)), L.newton);
+    L.newton_next = select(m, none, L.newton_next);
+    L.newton_steps = select(m, none, L.newton_steps);
+  }
+
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
     LaneStart q;
     for (int i = 0; i < 3; ++i) {
@@ -1074,14 +1094,31 @@ template <class T> struct WideGjk {
     loop<true, true>(L, source, solver, false);
   }
 
+  /// Sources that start several lanes at once: `std::uint32_t load_lanes(Lanes&, std::uint32_t want)` starts the
+  /// next pairs in the lanes of `want` (lane order, as load() lane by lane would) and returns the lanes it started.
+  template <class S, class = void> struct LoadsLanes : std::false_type {};
+  template <class S>
+  struct LoadsLanes<S, std::void_t<decltype(std::declval<S&>().load_lanes(std::declval<Lanes&>(), 0u))>>
+      : std::true_type {};
+
   template <bool Boolean, bool Dirs = false, class Source>
   static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
+    // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
+    // refilled together (done() reads and load() writes only its own lane, so the answers are the same).
+    // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512).
+    constexpr bool batch = Boolean && has_expand_load && std::is_same_v<T, float> && LoadsLanes<Source>::value;
     // Lanes holding a pair, kept as bits beside L.pair (rebuilding them from L.pair and the live mask from them
     // lane by lane cost ~55 instructions per demo pair, AVX2).
     std::uint32_t active = 0;
-    for (int l = 0; l < W; ++l) {
-      if (source.load(L, l)) active |= 1u << l;
-      else L.pair[l] = -1;
+    if constexpr (batch) {
+      active = source.load_lanes(L, W == 32 ? ~0u : (1u << W) - 1);
+      for (int l = 0; l < W; ++l)
+        if (!(active >> l & 1u)) L.pair[l] = -1;
+    } else {
+      for (int l = 0; l < W; ++l) {
+        if (source.load(L, l)) active |= 1u << l;
+        else L.pair[l] = -1;
+      }
     }
     const real zero = splat(T(0)), one = splat(T(1));
     const bool points = !Boolean && points_;
@@ -1091,7 +1128,17 @@ template <class T> struct WideGjk {
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
-      if (!source.load(L, l)) L.pair[l] = -1, active &= ~(1u << l);
+      if constexpr (!batch)
+        if (!source.load(L, l)) L.pair[l] = -1, active &= ~(1u << l);
+    };
+    // batch: refills the lanes of `ended` (answered by close()).
+    const auto refill_ended = [&](std::uint32_t ended) {
+      if constexpr (batch) {
+        if (ended == 0) return;
+        const std::uint32_t empty = ended & ~source.load_lanes(L, ended);
+        for (std::uint32_t e = empty; e != 0; e &= e - 1) L.pair[__builtin_ctz(e)] = -1;
+        active &= ~empty;
+      }
     };
 
     while (active != 0) {
@@ -1104,6 +1151,7 @@ template <class T> struct WideGjk {
           const int l = __builtin_ctz(left);
           close(l, touching[l] ? GjkStatus::overlap : GjkStatus::max_iterations);
         }
+        refill_ended(bits);
         continue;  // refilled lanes start with k = 0
       }
       mask live = lanes_of(active);
@@ -1340,6 +1388,7 @@ template <class T> struct WideGjk {
         else if (b_converged & bit) close(l, GjkStatus::converged);
         else if (b_stall & bit) close(l, GjkStatus::stalled);
       }
+      refill_ended(b_overlap | b_collision | b_separated | b_converged | b_stall);
     }
   }
 };

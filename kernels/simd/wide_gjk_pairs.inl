@@ -260,6 +260,77 @@ template <class T> struct WideGjkPairs {
       lp.scale = c.scale[s];
       return true;
     }
+    /// load() for the lanes of `want` at once (the boolean loop's refill on AVX-512, WideGjk::loop()): lane l takes
+    /// the chunk's next valid slot in lane order, as load() lane by lane, so the same pairs go to the same lanes;
+    /// the lanes that take consecutive slots get each field of Lanes by one expand load from the chunk's array
+    /// instead of one scalar store per lane and field (~50 a lane: the loop's next vector reads of those fields
+    /// then wait for the stores too). The lanes' LanePair and hulls are still copied lane by lane. Returns the
+    /// lanes started (fewer than `want` when the run has no pairs left). Out of line as load() is: inlined into
+    /// the loop it made GCC outline face_direction() from it.
+    __attribute__((noinline)) std::uint32_t load_lanes(Lanes& L, std::uint32_t want) {
+      std::uint32_t got = 0;
+      while (want != 0) {
+        while (chunk.left == 0) {
+          if (read == n) return got;
+          fill_chunk();
+        }
+        const int s = __builtin_ctzll(chunk.left);
+        const std::uint64_t ends = ~(chunk.left >> s);  // its lowest bit: the end of the run of valid slots at s
+        const int run = ends == 0 ? 64 : __builtin_ctzll(ends);
+        std::uint32_t take = 0;  // the lowest min(run, popcount(want)) lanes of want
+        int k = 0;
+        for (std::uint32_t w = want; w != 0 && k < run; w &= w - 1, ++k) take |= w & (~w + 1u);
+        load_run(L, take, std::size_t(s));
+        chunk.left &= ~(((std::uint64_t(1) << k) - 1) << s);  // k <= W < 64
+        want &= ~take;
+        got |= take;
+      }
+      return got;
+    }
+    /// Slots s, s + 1, ... into the lanes of `take` in lane order: load()'s writes.
+    __attribute__((always_inline)) void load_run(Lanes& L, std::uint32_t take, std::size_t s) {
+      const Chunk& c = chunk;
+      for (int e = 0; e < 9; ++e) L.R[e] = expand_load<T>(L.R[e], take, c.R[e] + s);
+      for (int i = 0; i < 3; ++i) L.t[i] = expand_load<T>(L.t[i], take, c.t[i] + s);
+      side_run(L.A, c.size_a, take, s);
+      side_run(L.B, c.size_b, take, s);
+      const typename G::V3 init{expand_load<T>(L.d_prev.x, take, c.init[0] + s),
+                                expand_load<T>(L.d_prev.y, take, c.init[1] + s),
+                                expand_load<T>(L.d_prev.z, take, c.init[2] + s)};
+      G::reset_search_lanes(L, take, init);
+      L.momentum = select(G::lanes_of(take), G::splat_mask(momentum), L.momentum);
+      L.tolerance = expand_load<T>(L.tolerance, take, c.tolerance + s);
+      L.touch = expand_load<T>(L.touch, take, c.floor + s);  // gjk_limits(): touch = floor
+      L.core_margin = expand_load<T>(L.core_margin, take, c.core_margin + s);
+      for (std::uint32_t left = take; left != 0; left &= left - 1, ++s) {
+        const int l = __builtin_ctz(left);
+        L.pair[l] = std::int64_t(s);
+        if (L.A.type == ShapeType::convex) G::load_hull(L.A, &in.shape_hull[c.shape_a[s]], l);
+        if (L.B.type == ShapeType::convex) G::load_hull(L.B, &in.shape_hull[c.shape_b[s]], l);
+        LanePair& lp = lane[l];
+        lp.pair = c.pair[s];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) lp.Ra[j][i] = c.Ra[3 * i + j][s];
+        lp.radius_a = c.radius_a[s];
+        lp.radius_b = c.radius_b[s];
+        lp.radii = c.radii[s];
+        lp.scale = c.scale[s];
+      }
+    }
+    /// side() for the lanes of `take` (slots s, s + 1, ...), hulls aside (load_run() loads them lane by lane).
+    template <std::size_t N>
+    __attribute__((always_inline)) static void side_run(typename G::Side& side, const T (&size)[3][N], std::uint32_t take, std::size_t s) {
+      switch (side.type) {
+        case ShapeType::sphere:
+        case ShapeType::convex: return;
+        case ShapeType::capsule: side.s1 = expand_load<T>(side.s1, take, size[1] + s); return;
+        default:
+          side.s0 = expand_load<T>(side.s0, take, size[0] + s);
+          side.s1 = expand_load<T>(side.s1, take, size[1] + s);
+          side.s2 = expand_load<T>(side.s2, take, size[2] + s);
+          return;
+      }
+    }
     /// Slot s of one side into lane l, as load_side() takes it: the sizes of the types that have them (the
     /// support of the others reads none), the hull of a convex core. (No triangle: its pairs are not run here.)
     template <std::size_t N>
