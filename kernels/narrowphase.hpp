@@ -105,7 +105,7 @@ void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, d
   s.scale = g.scale;
   s.floor = g.floor;
   GjkParams<T>& params = s.params;
-  params.solver = resolve_solver(opt.solver, opt.level);
+  params.solver = resolve_solver(opt.solver, opt.level, s.A.type, s.B.type);
   params.tolerance = g.tolerance;
   params.relative_tolerance = g.relative;
   params.max_iterations = g.max_iterations;

@@ -217,7 +217,9 @@ void run_generic(const ShapeTable& shapes, const PairBatchView& batch, const Que
   std::size_t pending = 0;
   ShapeType pending_a = ShapeType::sphere, pending_b = ShapeType::sphere;
   const auto flush = [&] {
-    kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(), options.solver,
+    // The chunk's one shape-pair type (set_gjk_parameters() resolved its setups' solver alike).
+    kernels::simd::gjk_lanes<T>(isa, s.setups.data(), pending, s.gjk.data(),
+                                resolve_solver(options.solver, options.level, pending_a, pending_b),
                                 options.level >= QueryLevel::witness);
     for (std::size_t j = 0; j < pending; ++j)
       kernels::simd::write_pair_output(kernels::complete_pair(s.setups[j], s.gjk[j], options), s.frames[j].Ra,
@@ -281,7 +283,9 @@ void run_tile(const ShapeTable& shapes, const PairBatchView& batch, const QueryO
     const std::uint32_t* pairs = s.group_pairs.data();
     const std::size_t count = s.group_pairs.size();
     if (gjk) {
-      fallbacks += kernels::simd::gjk_pairs<T>(isa, view, type_a(g), type_b(g), pairs, count, options, results, left_out);
+      QueryOptions group = options;
+      group.solver = resolve_solver(options.solver, options.level, type_a(g), type_b(g));
+      fallbacks += kernels::simd::gjk_pairs<T>(isa, view, type_a(g), type_b(g), pairs, count, group, results, left_out);
     } else if (kind == WideClosedForm::segments) {
       fallbacks += kernels::simd::segment_pairs(isa, view, type_a(g) == ShapeType::capsule,
                                                 type_b(g) == ShapeType::capsule, pairs, count, query, results, left_out);
@@ -307,8 +311,9 @@ void collide(const ShapeTable& shapes, const PairBatch& batch, const QueryOption
 void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOptions& requested, PairResults& results) {
   validate(requested);
   detail::validate_shapes_for(shapes, requested);
-  QueryOptions options = requested;  // the kernels see the solver that runs, never `automatic`
-  options.solver = resolve_solver(requested.solver, requested.level);
+  // options.solver stays the requested one: the kernels see the solver that runs, never `automatic`, resolved per
+  // shape-pair type where they are called (resolve_solver() with the types; set_gjk_parameters() per setup).
+  const QueryOptions& options = requested;
   detail::validate_batch_layout(batch);
   // Every computed array's entries are written once, by the pair's kernel; the others stay empty.
   detail::size_results(results, batch.size(), options.level);

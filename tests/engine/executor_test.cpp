@@ -265,33 +265,80 @@ TEST(Executor, MarginMakesNearPairsCollide) {
     }
 }
 
-// The default solver is `automatic`: polyak for boolean queries, gjk for the other levels. Its results are the
-// named solver's, bit for bit, and not those of the other solvers (iteration counts differ on some pair).
-TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndGjkOtherwise) {
+// The default solver is `automatic`: polyak for boolean queries, gjk for the other levels except momentum_pays()'s
+// pair types (an ellipsoid against an ellipsoid, cylinder, cone or hull), which run polyak there too. Each
+// pair's results are its resolved solver's, bit for bit, and not those of the other solvers (iteration counts
+// differ on some pair).
+TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndEllipsoidPairsAndGjkOtherwise) {
   EXPECT_EQ(QueryOptions{}.solver, Solver::automatic);
   EXPECT_EQ(resolve_solver(Solver::automatic, QueryLevel::boolean), Solver::polyak);
   for (QueryLevel level : {QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration})
     EXPECT_EQ(resolve_solver(Solver::automatic, level), Solver::gjk);
   for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak})
     EXPECT_EQ(resolve_solver(named, QueryLevel::boolean), named);
+  // Per pair type: boolean stays polyak; the other levels polyak exactly for momentum_pays()'s pairs, in either
+  // order; a named solver is never changed.
+  for (ShapeType a : testing::bounded_shape_types())
+    for (ShapeType b : testing::bounded_shape_types()) {
+      EXPECT_EQ(resolve_solver(Solver::automatic, QueryLevel::boolean, a, b), Solver::polyak);
+      const bool ellipsoid = a == ShapeType::ellipsoid || b == ShapeType::ellipsoid;
+      const ShapeType other = a == ShapeType::ellipsoid ? b : a;
+      const bool partner = other == ShapeType::ellipsoid || other == ShapeType::cylinder || other == ShapeType::cone ||
+                           other == ShapeType::convex;
+      const Solver want = ellipsoid && partner ? Solver::polyak : Solver::gjk;
+      for (QueryLevel level : {QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
+        EXPECT_EQ(resolve_solver(Solver::automatic, level, a, b), want) << to_string(a) << "-" << to_string(b);
+        for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak})
+          EXPECT_EQ(resolve_solver(named, level, a, b), named);
+      }
+    }
+  EXPECT_TRUE(momentum_pays(ShapeType::ellipsoid, ShapeType::ellipsoid));
+  EXPECT_TRUE(momentum_pays(ShapeType::convex, ShapeType::ellipsoid));
+  EXPECT_FALSE(momentum_pays(ShapeType::cylinder, ShapeType::cylinder));
+  EXPECT_FALSE(momentum_pays(ShapeType::capsule, ShapeType::ellipsoid));
 
   const Scene s = mixed_scene(3000, 5);
+  const std::size_t n = s.batch.size();
+  std::size_t momentum_pairs = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    momentum_pairs += momentum_pays(s.shapes[s.batch.shape_a[i]].type, s.shapes[s.batch.shape_b[i]].type) ? 1 : 0;
+  ASSERT_GT(momentum_pairs, std::size_t(50));  // the scene has pairs on both sides of the rule
+  ASSERT_LT(momentum_pairs, n - 50);
   for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness, QueryLevel::penetration}) {
     QueryOptions automatic;
     automatic.level = level;
     PairResults got;
     collide(s.shapes, s.batch, automatic, got);
+    std::vector<PairResults> named_results;
     for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
       QueryOptions o = automatic;
       o.solver = named;
-      PairResults want;
-      collide(s.shapes, s.batch, o, want);
-      if (named == resolve_solver(Solver::automatic, level)) {
-        testing::expect_same_results(want, got, std::string("automatic = ") + to_string(named) + " at " + to_string(level));
-      } else {
-        EXPECT_NE(want.iterations, got.iterations) << to_string(named) << " at " << to_string(level);
-      }
+      named_results.emplace_back();
+      collide(s.shapes, s.batch, o, named_results.back());
     }
+    // The named solvers' results pair by pair as automatic resolves them.
+    PairResults want = named_results[0];
+    std::size_t differ[3] = {0, 0, 0}, used[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < n; ++i) {
+      const Solver r = resolve_solver(Solver::automatic, level, s.shapes[s.batch.shape_a[i]].type,
+                                      s.shapes[s.batch.shape_b[i]].type);
+      const PairResults& from = named_results[static_cast<std::size_t>(r)];
+      ++used[static_cast<std::size_t>(r)];
+      want.status[i] = from.status[i];
+      want.collide[i] = from.collide[i];
+      want.iterations[i] = from.iterations[i];
+      if (!want.distance.empty()) want.distance[i] = from.distance[i];
+      for (auto m : {&PairResults::witness_a, &PairResults::witness_b, &PairResults::normal, &PairResults::direction})
+        if (!(want.*m).empty()) (want.*m).set(i, (from.*m)[i]);
+      for (std::size_t k = 0; k < 3; ++k)
+        if (k != static_cast<std::size_t>(r) && named_results[k].iterations[i] != got.iterations[i]) ++differ[k];
+    }
+    testing::expect_same_results(want, got, std::string("automatic at ") + to_string(level));
+    // A solver that automatic does not run on every pair differs from it on some pair it does not run on.
+    for (std::size_t k = 0; k < 3; ++k)
+      if (used[k] < n) {
+        EXPECT_GT(differ[k], std::size_t(0)) << k << " at " << to_string(level);
+      }
   }
 }
 

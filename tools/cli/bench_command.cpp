@@ -150,7 +150,7 @@ nlohmann::json to_json(const CaseResult& r, const BenchSettings& s, const QueryO
                      {"pairs_answered", t.handled}, {"calls_per_run", t.calls_per_run}, {"collide_disagreements", t.disagreements}});
   }
   nlohmann::json j = {{"case", r.bench_case.name()}, {"regime", to_string(regime)}, {"query", to_string(o.level)},
-                      {"precision", s.precision}, {"solver", to_string(resolve_solver(o.solver, o.level))},
+                      {"precision", s.precision}, {"solver", to_string(resolve_solver(o.solver, o.level, r.bench_case.a.type, r.bench_case.b.type))},
                       {"solver_requested", to_string(o.solver)}, {"threads", threads},
                       {"pairs", s.pairs}, {"isa", to_string(o.isa)}, {"kernel", r.kernel}, {"pairs_per_second", r.pairs_per_second},
                       {"ns_per_pair", r.ns_per_pair}, {"error_median", r.error_median}, {"error_max", r.error_max},
@@ -262,7 +262,7 @@ Command add_bench_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--query", s->query, "boolean, distance, witness or penetration")->capture_default_str();
   app->add_option("--precision", s->precision, "double or float")->capture_default_str();
-  app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean, else gjk)")->capture_default_str();
+  app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean and for ellipsoid-ellipsoid, -cylinder, -cone and -convex, else gjk)")->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();
