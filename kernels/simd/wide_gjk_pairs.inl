@@ -135,7 +135,7 @@ template <class T> struct WideGjkPairs {
     LanePair lane[W];  // written by load() before done() reads it
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
-    // would zero the chunk's ~25 KB at every run() (one run() per type-pair group of a tile, a few dozen pairs
+    // would zero the chunk's ~25 KB at every run (one run_plain() per type-pair group of a tile, a few dozen pairs
     // in a mixed batch).
     Source(const PairView& in_, const QueryOptions& options_, ShapeType a, ShapeType b, const std::uint32_t* pairs_,
            std::size_t n_, const ResultView& out_, std::uint32_t* fallback_)
@@ -294,9 +294,11 @@ template <class T> struct WideGjkPairs {
       for (int i = 0; i < 3; ++i) L.t[i] = expand_load<T>(L.t[i], take, c.t[i] + s);
       side_run(L.A, c.size_a, take, s);
       side_run(L.B, c.size_b, take, s);
-      const typename G::V3 init{expand_load<T>(L.d_prev.x, take, c.init[0] + s),
-                                expand_load<T>(L.d_prev.y, take, c.init[1] + s),
-                                expand_load<T>(L.d_prev.z, take, c.init[2] + s)};
+      // Zero, not L.d_prev, under the lanes not taken: pick() in reset_search_lanes() drops them, and d_prev is
+      // never initialised before a lane's first load.
+      const typename G::real zero = G::splat(T(0));
+      const typename G::V3 init{expand_load<T>(zero, take, c.init[0] + s), expand_load<T>(zero, take, c.init[1] + s),
+                                expand_load<T>(zero, take, c.init[2] + s)};
       G::reset_search_lanes(L, take, init);
       L.momentum = select(G::lanes_of(take), G::splat_mask(momentum), L.momentum);
       L.tolerance = expand_load<T>(L.tolerance, take, c.tolerance + s);
@@ -441,7 +443,8 @@ template <class T> struct WideGjkPairs {
   };
 
   /// Whether a group goes to run_certified() (boolean double queries of the types certified_pays() names) rather
-  /// than run_plain(). The entry points (simd/isa_body.inl) compile the two paths in separate translation units.
+  /// than run_plain(). The entry points (simd/isa_body.inl) put run_certified() in a translation unit of its own
+  /// (it still instantiates run_plain() for the pairs it refuses; kernels/CMakeLists.txt: which copy is linked).
   static bool certifies(ShapeType type_a, ShapeType type_b, const QueryOptions& options) {
     if constexpr (std::is_same_v<T, double>)
       return options.level == QueryLevel::boolean && certified_pays(type_a) && certified_pays(type_b);

@@ -329,7 +329,8 @@ TEST(RayScene, EmptySceneAndHalfspacesOnly) {
 }
 
 // Large batches on large trees are cast in a coherent order with the rays and results copied (ray_scene_cast.cpp,
-// RayOrder: batches of >= 4096 rays when the wide nodes exceed 1 MiB; 60k objects here give 19928 nodes, 5.1 MB).
+// RayOrder: batches of >= 4096 rays when the wide nodes and the objects' records reach 1 MiB; 60k objects here give
+// 19928 nodes, 5.1 MB).
 // Their results must be those of input order bit for bit: batches of 1000 rays are below the threshold and are cast
 // in input order. Invalid rays are mixed in (they sort last and must keep their status).
 TEST(RayScene, CastOrderOfLargeBatchesGivesTheSameBits) {
