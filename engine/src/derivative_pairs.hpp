@@ -32,6 +32,11 @@ template <class Body> void for_pairs(int threads, std::size_t n, const Body& bod
 bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
                       PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b);
 
+/// rows[e] = where entry e of pair `first` lives in d's arrays (StoreEntries of them, in the output arrays' order:
+/// the two 6-vectors, then 18 per matrix; entry e of an array is its SoA index k of data[k * n + i]). Flushing
+/// StoreBlock and smoothed0's FinishLanes write a block of consecutive pairs from rows[e][0 .. count).
+void entry_rows(DerivativeResults& d, std::size_t first, double** rows);
+
 /// Collects the derivatives of up to 8 consecutive pairs in a structure-of-arrays buffer (entry e of slot j at
 /// buf_[e][j], in the order of the output arrays: distance_gradient_a/b (6 each), then witness_a_wrt_a,
 /// witness_a_wrt_b, witness_b_wrt_a, witness_b_wrt_b, normal_wrt_a, normal_wrt_b (18 each, row-major)) and writes

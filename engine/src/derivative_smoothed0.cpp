@@ -374,15 +374,8 @@ class FinishLanes {
   }
   void flush() {
     if (count_ == 0) return;
-    const std::size_t n = d_.status.size();
-    double* const arrays[8] = {d_.distance_gradient_a.data.data(), d_.distance_gradient_b.data.data(),
-                               d_.witness_a_wrt_a.data.data(),     d_.witness_a_wrt_b.data.data(),
-                               d_.witness_b_wrt_a.data.data(),     d_.witness_b_wrt_b.data.data(),
-                               d_.normal_wrt_a.data.data(),        d_.normal_wrt_b.data.data()};
-    double* rows[StoreEntries];  // entry e of pair first_ (StoreBlock::flush()'s mapping)
-    int e = 0;
-    for (int a = 0; a < 8; ++a)
-      for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
+    double* rows[StoreEntries];
+    entry_rows(d_, first_, rows);
     if (count_ == kLanes) {
       solve(rows);
     } else {

@@ -48,8 +48,7 @@ bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
 
 void StoreBlock::add(std::size_t i, const PairJacobians& J) { write_jacobians(J, slot(i), kStride); }
 
-void StoreBlock::flush() {
-  if (count_ == 0) return;
+void entry_rows(DerivativeResults& d, std::size_t first, double** rows) {
   const std::size_t n = d.status.size();
   double* const arrays[8] = {d.distance_gradient_a.data.data(), d.distance_gradient_b.data.data(),
                              d.witness_a_wrt_a.data.data(),     d.witness_a_wrt_b.data.data(),
@@ -57,10 +56,15 @@ void StoreBlock::flush() {
                              d.normal_wrt_a.data.data(),        d.normal_wrt_b.data.data()};
   // Entries 0-11 are the two 6-vectors, then 18 per matrix: entry e is row e % 6 (vectors) or e - start of the
   // matrix's (6 r + c), which is exactly the SoA index k of data[k * n + i].
-  double* rows[kEntries];
   int e = 0;
   for (int a = 0; a < 8; ++a)
-    for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first_;
+    for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first;
+}
+
+void StoreBlock::flush() {
+  if (count_ == 0) return;
+  double* rows[kEntries];
+  entry_rows(d, first_, rows);
   if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
     smooth_.solve(rows, normal_b_only);
   } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
