@@ -247,7 +247,12 @@ template <class T> struct WideGjkPairs {
       L.tolerance[l] = c.tolerance[s];
       L.touch[l] = c.floor[s];  // gjk_limits(): touch = floor
       L.core_margin[l] = c.core_margin[s];
-
+      lane_pair(l, s);
+      return true;
+    }
+    /// Lane l's LanePair (what done() reads: the pair, A's pose, the radii) from chunk slot s.
+    __attribute__((always_inline)) void lane_pair(int l, std::size_t s) {
+      const Chunk& c = chunk;
       LanePair& lp = lane[l];
       lp.pair = c.pair[s];
       for (int i = 0; i < 3; ++i)
@@ -258,7 +263,6 @@ template <class T> struct WideGjkPairs {
       lp.radius_b = c.radius_b[s];
       lp.radii = c.radii[s];
       lp.scale = c.scale[s];
-      return true;
     }
     /// load() for the lanes of `want` at once (the boolean loop's refill on AVX-512, WideGjk::loop()): lane l takes
     /// the chunk's next valid slot in lane order, as load() lane by lane, so the same pairs go to the same lanes;
@@ -309,14 +313,7 @@ template <class T> struct WideGjkPairs {
         L.pair[l] = std::int64_t(s);
         if (L.A.type == ShapeType::convex) G::load_hull(L.A, &in.shape_hull[c.shape_a[s]], l);
         if (L.B.type == ShapeType::convex) G::load_hull(L.B, &in.shape_hull[c.shape_b[s]], l);
-        LanePair& lp = lane[l];
-        lp.pair = c.pair[s];
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) lp.Ra[j][i] = c.Ra[3 * i + j][s];
-        lp.radius_a = c.radius_a[s];
-        lp.radius_b = c.radius_b[s];
-        lp.radii = c.radii[s];
-        lp.scale = c.scale[s];
+        lane_pair(l, s);
       }
     }
     /// side() for the lanes of `take` (slots s, s + 1, ...), hulls aside (load_run() loads them lane by lane).
