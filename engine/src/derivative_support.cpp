@@ -108,6 +108,61 @@ Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
   return {a00, a11, a22};
 }
 
+// Two symmetric matrices' Jacobi sweeps in one SSE2 register (lane 0, lane 1), for smoothed1's two shapes of a
+// pair (psd_projection_pair()): each lane does symmetric_eigenvalues()'s operations in its order (elementwise IEEE
+// operations; both sides of a test computed and one kept), and a lane whose sweep test has failed keeps its values,
+// so each lane ends with the scalar function's bits at about the instructions of one matrix.
+using V2 = double __attribute__((vector_size(16)));
+using M2 = long long __attribute__((vector_size(16)));  // a V2 compare's lanes: all ones or zero
+
+inline V2 abs2(V2 x) { return (V2)((M2)x & 0x7FFFFFFFFFFFFFFFll); }
+inline V2 max2(V2 a, V2 b) { return a < b ? b : a; }  // std::max(a, b)
+
+/// jacobi_rotate() in the lanes where `go` is set (and a_pq != 0, its early return). The common case, both lanes
+/// rotating and no |theta| above 1e150, skips the selects (~20 of the ~60 instructions of a rotation in SSE2).
+inline void jacobi_rotate2(M2 go, V2& app, V2& aqq, V2& apq, V2& arp, V2& arq) {
+  go &= apq != 0.0;
+  const V2 theta = (aqq - app) / (2.0 * apq), at = abs2(theta);
+  const M2 large = at > 1e150;
+  V2 magnitude = 1.0 / (at + _mm_sqrt_pd(at * at + 1.0));
+  if (__builtin_expect(large[0] | large[1], 0)) magnitude = large ? 0.5 / at : magnitude;
+  const M2 sign = M2{} + (-0x7FFFFFFFFFFFFFFFll - 1);  // the sign bit
+  const V2 t = (V2)((M2)magnitude | ((M2)theta & sign));  // copysign(magnitude, theta)
+  const V2 c = 1.0 / _mm_sqrt_pd(t * t + 1.0), s = t * c;
+  const V2 rp = arp, rq = arq;
+  if (__builtin_expect(go[0] & go[1], 1)) {
+    app -= t * apq;
+    aqq += t * apq;
+    apq = V2{};
+    arp = c * rp - s * rq;
+    arq = s * rp + c * rq;
+    return;
+  }
+  app = go ? app - t * apq : app;
+  aqq = go ? aqq + t * apq : aqq;
+  apq = go ? V2{} : apq;
+  arp = go ? c * rp - s * rq : rp;
+  arq = go ? s * rp + c * rq : rq;
+}
+
+/// symmetric_eigenvalues() of A (lane 0) and B (lane 1).
+void symmetric_eigenvalues2(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B, Eigen::Vector3d& la,
+                            Eigen::Vector3d& lb) {
+  const auto pair = [&](int r, int c) { return V2{A(r, c), B(r, c)}; };
+  V2 a00 = pair(0, 0), a11 = pair(1, 1), a22 = pair(2, 2), a01 = pair(0, 1), a02 = pair(0, 2), a12 = pair(1, 2);
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const V2 off = max2(max2(abs2(a01), abs2(a02)), abs2(a12));
+    const V2 diagonal = max2(max2(abs2(a00), abs2(a11)), abs2(a22));
+    const M2 go = off > 1e-18 * diagonal;
+    if (!(go[0] | go[1])) break;
+    jacobi_rotate2(go, a00, a11, a01, a02, a12);  // (p, q, r) = (0, 1, 2)
+    jacobi_rotate2(go, a00, a22, a02, a01, a12);  // (0, 2, 1)
+    jacobi_rotate2(go, a11, a22, a12, a01, a02);  // (1, 2, 0)
+  }
+  la = {a00[0], a11[0], a22[0]};
+  lb = {a00[1], a11[1], a22[1]};
+}
+
 /// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
 /// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.
 inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vector3d& d) {
@@ -118,11 +173,14 @@ inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vec
 
 }  // namespace
 
-Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
-  // Positive definite by Sylvester's criterion (the leading minors): the projection is H itself. The common case
-  // on curved shapes at larger M, and no eigenvalues needed. Each minor must clear 1e-12 of the sum of its terms'
-  // magnitudes, far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by
-  // rounding alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+namespace {
+
+/// False when psd_projection(H) is H without eigenvalues: positive definite by Sylvester's criterion (the leading
+/// minors), the common case on curved shapes at larger M, or not finite (NaN in, NaN out, as the
+/// eigendecomposition did; no rotations on NaN). Each minor must clear 1e-12 of the sum of its terms' magnitudes,
+/// far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by rounding
+/// alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+bool needs_eigenvalues(const Eigen::Matrix3d& H) {
   const double a00 = H(0, 0), a11 = H(1, 1), a22 = H(2, 2), a01 = H(0, 1), a02 = H(0, 2), a12 = H(1, 2);
   const double m2 = a00 * a11 - a01 * a01, m2_size = std::abs(a00 * a11) + a01 * a01;
   const double c0 = a11 * a22 - a12 * a12, c1 = a01 * a22 - a12 * a02, c2 = a01 * a12 - a11 * a02;
@@ -130,9 +188,12 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   const double det_size = std::abs(a00) * (std::abs(a11 * a22) + a12 * a12) +
                           std::abs(a01) * (std::abs(a01 * a22) + std::abs(a12 * a02)) +
                           std::abs(a02) * (std::abs(a01 * a12) + std::abs(a11 * a02));
-  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return H;
-  if (!H.allFinite()) return H;  // NaN in, NaN out (as the eigendecomposition did), no rotations on NaN
-  Eigen::Vector3d l = symmetric_eigenvalues(H);
+  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return false;
+  return H.allFinite();
+}
+
+/// The projection of H given its eigenvalues l (any order).
+Eigen::Matrix3d project(const Eigen::Matrix3d& H, Eigen::Vector3d l) {
   // l0 >= l1 >= l2
   if (l[1] > l[0]) std::swap(l[0], l[1]);
   if (l[2] > l[1]) std::swap(l[1], l[2]);
@@ -152,6 +213,25 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   const Eigen::Matrix3d Q = (H - l[1] * I) * (H - l[2] * I) / ((l[0] - l[1]) * (l[0] - l[2]));
   const Eigen::Matrix3d P = l[0] * Q;
   return (0.5 * (P + P.transpose())).eval();
+}
+
+}  // namespace
+
+Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
+  return needs_eigenvalues(H) ? project(H, symmetric_eigenvalues(H)) : H;
+}
+
+void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B) {
+  const bool a = needs_eigenvalues(A), b = needs_eigenvalues(B);
+  if (a && b) {
+    Eigen::Vector3d la, lb;
+    symmetric_eigenvalues2(A, B, la, lb);
+    A = project(A, la);
+    B = project(B, lb);
+    return;
+  }
+  if (a) A = project(A, symmetric_eigenvalues(A));
+  if (b) B = project(B, symmetric_eigenvalues(B));
 }
 
 SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {
@@ -342,11 +422,10 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
   return p;
 }
 
-Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
+Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
                                           InstructionSet isa) {
-  const OwnedShapeView view(shape);
-  const auto core = kernels::make_core<double>(view.view);
+  const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d p = kernels::support(core, d, hint);
@@ -378,14 +457,15 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
     }
     std::fill(dc + n, dc + n4, 0.0);
   }
-  if (shape.type == ShapeType::convex && !kernels::hull_climbs(view.hull) && view.hull.vertex_count > 0) {
+  if (view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
+      view.hull->vertex_count > 0) {
     // A scanned hull (kernels::hull_support's small-hull path): the same first maximum of the same dot products
     // (hull_dot's expression in double), four directions at a time in two SSE2 registers instead of a call and a
     // scalar scan per direction (~170 instructions per sample on an 8-vertex hull). max(di, best) is di > best ?
     // di : best (best when either is NaN, as the scalar '>'). Intrinsics: GCC scalarised the vector-extension
     // selects of this loop through the stack.
-    const double* v = view.hull.vertices;
-    const std::uint32_t count = view.hull.vertex_count;
+    const double* v = view.hull->vertices;
+    const std::uint32_t count = view.hull->vertex_count;
     // Each vertex's coordinates and index broadcast once per call (scanned hulls have < kHillClimbMinVertices = 32
     // vertices when built by Shape::convex; a larger hull without blocks broadcasts in the loop).
     constexpr std::uint32_t kKept = 32;
@@ -474,8 +554,7 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
-  H = (0.5 * (H + H.transpose())).eval();
-  return psd_projection(H);
+  return (0.5 * (H + H.transpose())).eval();
 }
 
 }  // namespace batchcol::detail
