@@ -112,7 +112,11 @@ struct SmoothLanes {
   Side a, b;
   std::size_t column[kLanes];
   std::size_t count = 0;
-  void clear() { count = 0; }
+  /// Some lane has a sphere or ellipsoid side (curvature() needed); false when every lane's H is its given H0 (all
+  /// smoothed1 pairs, analytic pairs with features): solve() then takes H = H0 + 0.0, the same bits as the full
+  /// formula with R = radii2 = round = 0 (each of its terms is +0 or -0, and x + 0 - 0 + (-0) is x, +0 for -0).
+  bool curved = false;
+  void clear() { count = 0, curved = false; }
   /// The next lane takes pair g, for output column `column`; a null side uses g.H_a / g.H_b.
   void add(std::size_t column, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
            const CurvedSide* curved_b = nullptr);
@@ -123,7 +127,7 @@ struct SmoothLanes {
   void solve(double* const* out, bool normal_b_only = false) const;
 
  private:
-  template <bool kNormalB> void solve_lanes(double* const* out) const;
+  template <bool kNormalB, bool kCurved> void solve_lanes(double* const* out) const;
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two

@@ -108,6 +108,61 @@ Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
   return {a00, a11, a22};
 }
 
+// Two symmetric matrices' Jacobi sweeps in one SSE2 register (lane 0, lane 1), for smoothed1's two shapes of a
+// pair (psd_projection_pair()): each lane does symmetric_eigenvalues()'s operations in its order (elementwise IEEE
+// operations; both sides of a test computed and one kept), and a lane whose sweep test has failed keeps its values,
+// so each lane ends with the scalar function's bits at about the instructions of one matrix.
+using V2 = double __attribute__((vector_size(16)));
+using M2 = long long __attribute__((vector_size(16)));  // a V2 compare's lanes: all ones or zero
+
+inline V2 abs2(V2 x) { return (V2)((M2)x & 0x7FFFFFFFFFFFFFFFll); }
+inline V2 max2(V2 a, V2 b) { return a < b ? b : a; }  // std::max(a, b)
+
+/// jacobi_rotate() in the lanes where `go` is set (and a_pq != 0, its early return). The common case, both lanes
+/// rotating and no |theta| above 1e150, skips the selects (~20 of the ~60 instructions of a rotation in SSE2).
+inline void jacobi_rotate2(M2 go, V2& app, V2& aqq, V2& apq, V2& arp, V2& arq) {
+  go &= apq != 0.0;
+  const V2 theta = (aqq - app) / (2.0 * apq), at = abs2(theta);
+  const M2 large = at > 1e150;
+  V2 magnitude = 1.0 / (at + _mm_sqrt_pd(at * at + 1.0));
+  if (__builtin_expect(large[0] | large[1], 0)) magnitude = large ? 0.5 / at : magnitude;
+  const M2 sign = M2{} + (-0x7FFFFFFFFFFFFFFFll - 1);  // the sign bit
+  const V2 t = (V2)((M2)magnitude | ((M2)theta & sign));  // copysign(magnitude, theta)
+  const V2 c = 1.0 / _mm_sqrt_pd(t * t + 1.0), s = t * c;
+  const V2 rp = arp, rq = arq;
+  if (__builtin_expect(go[0] & go[1], 1)) {
+    app -= t * apq;
+    aqq += t * apq;
+    apq = V2{};
+    arp = c * rp - s * rq;
+    arq = s * rp + c * rq;
+    return;
+  }
+  app = go ? app - t * apq : app;
+  aqq = go ? aqq + t * apq : aqq;
+  apq = go ? V2{} : apq;
+  arp = go ? c * rp - s * rq : rp;
+  arq = go ? s * rp + c * rq : rq;
+}
+
+/// symmetric_eigenvalues() of A (lane 0) and B (lane 1).
+void symmetric_eigenvalues2(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B, Eigen::Vector3d& la,
+                            Eigen::Vector3d& lb) {
+  const auto pair = [&](int r, int c) { return V2{A(r, c), B(r, c)}; };
+  V2 a00 = pair(0, 0), a11 = pair(1, 1), a22 = pair(2, 2), a01 = pair(0, 1), a02 = pair(0, 2), a12 = pair(1, 2);
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const V2 off = max2(max2(abs2(a01), abs2(a02)), abs2(a12));
+    const V2 diagonal = max2(max2(abs2(a00), abs2(a11)), abs2(a22));
+    const M2 go = off > 1e-18 * diagonal;
+    if (!(go[0] | go[1])) break;
+    jacobi_rotate2(go, a00, a11, a01, a02, a12);  // (p, q, r) = (0, 1, 2)
+    jacobi_rotate2(go, a00, a22, a02, a01, a12);  // (0, 2, 1)
+    jacobi_rotate2(go, a11, a22, a12, a01, a02);  // (1, 2, 0)
+  }
+  la = {a00[0], a11[0], a22[0]};
+  lb = {a00[1], a11[1], a22[1]};
+}
+
 /// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
 /// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.
 inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vector3d& d) {
@@ -118,11 +173,14 @@ inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vec
 
 }  // namespace
 
-Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
-  // Positive definite by Sylvester's criterion (the leading minors): the projection is H itself. The common case
-  // on curved shapes at larger M, and no eigenvalues needed. Each minor must clear 1e-12 of the sum of its terms'
-  // magnitudes, far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by
-  // rounding alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+namespace {
+
+/// False when psd_projection(H) is H without eigenvalues: positive definite by Sylvester's criterion (the leading
+/// minors), the common case on curved shapes at larger M, or not finite (NaN in, NaN out, as the
+/// eigendecomposition did; no rotations on NaN). Each minor must clear 1e-12 of the sum of its terms' magnitudes,
+/// far above their rounding (~4e-16 of it): a nearly singular H whose computed minors are positive by rounding
+/// alone (an eigenvalue of -1e-12 |H| passed) takes the eigenvalues instead.
+bool needs_eigenvalues(const Eigen::Matrix3d& H) {
   const double a00 = H(0, 0), a11 = H(1, 1), a22 = H(2, 2), a01 = H(0, 1), a02 = H(0, 2), a12 = H(1, 2);
   const double m2 = a00 * a11 - a01 * a01, m2_size = std::abs(a00 * a11) + a01 * a01;
   const double c0 = a11 * a22 - a12 * a12, c1 = a01 * a22 - a12 * a02, c2 = a01 * a12 - a11 * a02;
@@ -130,9 +188,12 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   const double det_size = std::abs(a00) * (std::abs(a11 * a22) + a12 * a12) +
                           std::abs(a01) * (std::abs(a01 * a22) + std::abs(a12 * a02)) +
                           std::abs(a02) * (std::abs(a01 * a12) + std::abs(a11 * a02));
-  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return H;
-  if (!H.allFinite()) return H;  // NaN in, NaN out (as the eigendecomposition did), no rotations on NaN
-  Eigen::Vector3d l = symmetric_eigenvalues(H);
+  if (a00 > 0.0 && m2 > 1e-12 * m2_size && det > 1e-12 * det_size) return false;
+  return H.allFinite();
+}
+
+/// The projection of H given its eigenvalues l (any order).
+Eigen::Matrix3d project(const Eigen::Matrix3d& H, Eigen::Vector3d l) {
   // l0 >= l1 >= l2
   if (l[1] > l[0]) std::swap(l[0], l[1]);
   if (l[2] > l[1]) std::swap(l[1], l[2]);
@@ -143,15 +204,57 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   // value: H - l2 Q2; two: l0 Q0. Both denominators are at least |the negative value| and the positive one, so an
   // eigenvalue's rounding moves the result by about that rounding (no eigenvector, which would be ill-conditioned
   // for close eigenvalues).
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  if (l[1] >= 0.0) {
-    const Eigen::Matrix3d Q = (H - l[0] * I) * (H - l[1] * I) / ((l[2] - l[0]) * (l[2] - l[1]));
-    Eigen::Matrix3d P = H - l[2] * Q;
-    return (0.5 * (P + P.transpose())).eval();
+  // Plain loops in the operation order of the Eigen expressions they replaced (Q = (H - x I) (H - y I) / den,
+  // P = H - l2 Q or l0 Q, 0.5 (P + P^T); Eigen sums row 2 of the 3x3 product, after its 2-row packet, as
+  // a0 + (a1 + a2); found by a bitwise comparison against Eigen on 200000 random matrices): the same bits without
+  // Eigen's temporaries (~250 instructions a matrix, callgrind).
+  const bool one = l[1] >= 0.0;
+  const double x = one ? l[0] : l[1], y = one ? l[1] : l[2];
+  const double den = one ? (l[2] - l[0]) * (l[2] - l[1]) : (l[0] - l[1]) * (l[0] - l[2]);
+  // Columns 0 and 1 in an SSE2 register, column 2 scalar (the same operations per entry).
+  double A[3][3], B01[3][2], B2[3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double d = i == j ? 1.0 : 0.0;  // x I's entries are x * 1 and x * 0 (a signed zero)
+      A[i][j] = H(i, j) - x * d;
+      if (j < 2) B01[i][j] = H(i, j) - y * d;
+      else B2[i] = H(i, j) - y * d;
+    }
+  const V2 b[3] = {{B01[0][0], B01[0][1]}, {B01[1][0], B01[1][1]}, {B01[2][0], B01[2][1]}};
+  const V2 vden = V2{} + den, l2 = V2{} + l[2], l0 = V2{} + l[0];
+  double P[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const V2 p0 = A[i][0] * b[0], p1 = A[i][1] * b[1], p2 = A[i][2] * b[2];
+    const V2 q = (i < 2 ? (p0 + p1) + p2 : p0 + (p1 + p2)) / vden;
+    const V2 h = {H(i, 0), H(i, 1)};
+    const V2 p = one ? h - l2 * q : l0 * q;
+    const double s0 = A[i][0] * B2[0], s1 = A[i][1] * B2[1], s2 = A[i][2] * B2[2];
+    const double q2 = (i < 2 ? (s0 + s1) + s2 : s0 + (s1 + s2)) / den;
+    P[i][0] = p[0], P[i][1] = p[1], P[i][2] = one ? H(i, 2) - l[2] * q2 : l[0] * q2;
   }
-  const Eigen::Matrix3d Q = (H - l[1] * I) * (H - l[2] * I) / ((l[0] - l[1]) * (l[0] - l[2]));
-  const Eigen::Matrix3d P = l[0] * Q;
-  return (0.5 * (P + P.transpose())).eval();
+  Eigen::Matrix3d S;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) S(i, j) = 0.5 * (P[i][j] + P[j][i]);
+  return S;
+}
+
+}  // namespace
+
+Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
+  return needs_eigenvalues(H) ? project(H, symmetric_eigenvalues(H)) : H;
+}
+
+void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B) {
+  const bool a = needs_eigenvalues(A), b = needs_eigenvalues(B);
+  if (a && b) {
+    Eigen::Vector3d la, lb;
+    symmetric_eigenvalues2(A, B, la, lb);
+    A = project(A, la);
+    B = project(B, lb);
+    return;
+  }
+  if (a) A = project(A, symmetric_eigenvalues(A));
+  if (b) B = project(B, symmetric_eigenvalues(B));
 }
 
 SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {
@@ -342,11 +445,10 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
   return p;
 }
 
-Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
+Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
                                           InstructionSet isa) {
-  const OwnedShapeView view(shape);
-  const auto core = kernels::make_core<double>(view.view);
+  const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d p = kernels::support(core, d, hint);
@@ -376,21 +478,22 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
       dc[2 * k] = uc + ez;
       dc[2 * k + 1] = uc - ez;
     }
-    std::fill(dc + n, dc + n4, 0.0);
+    if (n4 > n) std::fill(dc + n, dc + n4, 0.0);  // GCC called memset for the empty fill (M = 4: ~120 a pair)
   }
-  if (shape.type == ShapeType::convex && !kernels::hull_climbs(view.hull) && view.hull.vertex_count > 0) {
+  if (view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
+      view.hull->vertex_count > 0) {
     // A scanned hull (kernels::hull_support's small-hull path): the same first maximum of the same dot products
     // (hull_dot's expression in double), four directions at a time in two SSE2 registers instead of a call and a
     // scalar scan per direction (~170 instructions per sample on an 8-vertex hull). max(di, best) is di > best ?
     // di : best (best when either is NaN, as the scalar '>'). Intrinsics: GCC scalarised the vector-extension
     // selects of this loop through the stack.
-    const double* v = view.hull.vertices;
-    const std::uint32_t count = view.hull.vertex_count;
+    const double* v = view.hull->vertices;
+    const std::uint32_t count = view.hull->vertex_count;
     // Each vertex's coordinates and index broadcast once per call (scanned hulls have < kHillClimbMinVertices = 32
     // vertices when built by Shape::convex; a larger hull without blocks broadcasts in the loop).
     constexpr std::uint32_t kKept = 32;
     __m128d kept[4 * kKept];
-    const bool keep = count <= kKept;
+    const bool keep = count <= kKept && n4 > 4;  // one group of four directions (M <= 4) reads them once
     if (keep) {
       for (std::uint32_t i = 0; i < count; ++i) {
         for (int c = 0; c < 3; ++c) kept[4 * i + c] = _mm_set1_pd(v[3 * std::size_t(i) + c]);
@@ -444,6 +547,21 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
         for (int r = 0; r < 3; ++r) q[3 * j + r] = point[r] - s0[r];
       }
     }
+  } else if (view.type == ShapeType::ellipsoid && core.radius == 0.0) {
+    // kernels::support()'s ellipsoid, two directions per SSE2 register with its operations in its order (rd = r .* d,
+    // m = sqrt((rd_x^2 + rd_y^2) + rd_z^2), (r .* rd) / m, zero where m == 0): the same bits without a call per
+    // sample (~47 instructions each, callgrind). The directions are padded with zeros to n4.
+    const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
+    for (std::size_t j = 0; j < n; j += 2) {
+      V2 dx, dy, dz;
+      std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy), std::memcpy(&dz, d[2] + j, sizeof dz);
+      const V2 ax = rx * dx, ay = ry * dy, az = rz * dz;
+      const V2 m = _mm_sqrt_pd((ax * ax + ay * ay) + az * az);
+      const M2 zero = m == 0.0;
+      const V2 p[3] = {zero ? V2{} : (rx * ax) / m, zero ? V2{} : (ry * ay) / m, zero ? V2{} : (rz * az) / m};
+      for (std::size_t l = 0; l < 2 && j + l < n; ++l)
+        for (int r = 0; r < 3; ++r) q[3 * (j + l) + r] = p[r][l] - s0[r];
+    }
   } else {
     for (std::size_t j = 0; j < n; ++j) {
       const Eigen::Vector3d p = support(Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));
@@ -474,8 +592,7 @@ Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vecto
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
-  H = (0.5 * (H + H.transpose())).eval();
-  return psd_projection(H);
+  return (0.5 * (H + H.transpose())).eval();
 }
 
 }  // namespace batchcol::detail

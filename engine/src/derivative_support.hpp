@@ -73,13 +73,19 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
 /// rounding of the eigendecomposition's V max(L, 0) V^T.
 Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H);
 
-/// The smoothed support-map Jacobian at unit local direction u: 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with
-/// z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k} (the baseline S(u) cancels within a pair),
-/// symmetrised and projected onto the positive semidefinite cone (the Hessian of the smoothed convex support
-/// function is symmetric PSD; the projection removes sampling noise that could make the implicit-function matrix
-/// singular, a bias that vanishes as M grows). Noise keyed by (seed, pair, sample, stream), drawn by `isa`'s
-/// kernels (resolved; every set gives the same bits).
-Eigen::Matrix3d smoothed_support_jacobian(const Shape& shape, const Eigen::Vector3d& u, double e, int samples,
+/// Both psd_projection()s of a pair's two shapes (smoothed1), in place, with the same bits: where both need
+/// eigenvalues (almost always at small M: a 4-sample estimate has rank <= 2 before symmetrisation) their Jacobi
+/// sweeps share SSE2 registers.
+void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B);
+
+/// The smoothed support-map Jacobian at unit local direction u before its projection (psd_projection()):
+/// 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k}
+/// (the baseline S(u) cancels within a pair), symmetrised. The Hessian of the smoothed convex support function is
+/// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
+/// implicit-function matrix singular, a bias that vanishes as M grows. Noise keyed by (seed, pair, sample,
+/// stream), drawn by `isa`'s kernels (resolved; every set gives the same bits). `view`: the shape's plain record
+/// (ShapeTableAccess::view()).
+Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
                                           InstructionSet isa);
 

@@ -254,10 +254,14 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     const auto direction_noise = [&](const Shape& s) {
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
-    g.H_a = R_a * smoothed_support_jacobian(a, u_a, direction_noise(a), o.samples, o.seed, i, 1, isa) *
-            R_a.transpose();
-    g.H_b = R_b * smoothed_support_jacobian(b, u_b, direction_noise(b), o.samples, o.seed, i, 2, isa) *
-            R_b.transpose();
+    const auto view = [&](std::uint32_t s) { return ShapeTableAccess::view(shapes, s); };
+    Eigen::Matrix3d S_a = smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples,
+                                                    o.seed, i, 1, isa);
+    Eigen::Matrix3d S_b = smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples,
+                                                    o.seed, i, 2, isa);
+    psd_projection_pair(S_a, S_b);
+    g.H_a = R_a * S_a * R_a.transpose();
+    g.H_b = R_b * S_b * R_b.transpose();
   }
   double* slot = nullptr;
   if (o.method == DerivativeMethod::analytic && polytope_pair(g)) {

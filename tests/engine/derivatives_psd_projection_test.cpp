@@ -5,7 +5,9 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 namespace batchcol::testing {
@@ -52,6 +54,105 @@ TEST(DerivativesPsdProjection, MatchesTheEigendecomposition) {
   std::printf("psd_projection vs eigendecomposition: %d matrices (%d with a negative eigenvalue), max |P - E| / |H| "
               "%.2e\n", cases, negative, worst);
   EXPECT_GT(negative, cases / 4);
+}
+
+// The projection as it was written with Eigen expressions (main until 2026-11-26): Jacobi eigenvalues, then the
+// spectral projectors as Eigen 3x3 products. psd_projection() now spells the projectors as plain loops in Eigen's
+// operation order; this checks that order bit for bit (a wrong summation order differs in ~35% of the matrices).
+Eigen::Matrix3d eigen_expressions(const Eigen::Matrix3d& H) {
+  double a00 = H(0, 0), a11 = H(1, 1), a22 = H(2, 2), a01 = H(0, 1), a02 = H(0, 2), a12 = H(1, 2);
+  const auto rotate = [](double& app, double& aqq, double& apq, double& arp, double& arq) {
+    if (apq == 0.0) return;
+    const double theta = (aqq - app) / (2.0 * apq), at = std::abs(theta);
+    const double t = std::copysign(at > 1e150 ? 0.5 / at : 1.0 / (at + std::sqrt(at * at + 1.0)), theta);
+    const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+    app -= t * apq;
+    aqq += t * apq;
+    apq = 0.0;
+    const double rp = arp, rq = arq;
+    arp = c * rp - s * rq;
+    arq = s * rp + c * rq;
+  };
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const double off = std::max(std::max(std::abs(a01), std::abs(a02)), std::abs(a12));
+    const double diagonal = std::max(std::max(std::abs(a00), std::abs(a11)), std::abs(a22));
+    if (!(off > 1e-18 * diagonal)) break;
+    rotate(a00, a11, a01, a02, a12);
+    rotate(a00, a22, a02, a01, a12);
+    rotate(a11, a22, a12, a01, a02);
+  }
+  Eigen::Vector3d l(a00, a11, a22);
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
+  if (l[2] > l[1]) std::swap(l[1], l[2]);
+  if (l[1] > l[0]) std::swap(l[0], l[1]);
+  if (l[2] >= 0.0) return H;
+  if (l[0] <= 0.0) return Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  if (l[1] >= 0.0) {
+    const Eigen::Matrix3d Q = (H - l[0] * I) * (H - l[1] * I) / ((l[2] - l[0]) * (l[2] - l[1]));
+    Eigen::Matrix3d P = H - l[2] * Q;
+    return (0.5 * (P + P.transpose())).eval();
+  }
+  const Eigen::Matrix3d Q = (H - l[1] * I) * (H - l[2] * I) / ((l[0] - l[1]) * (l[0] - l[2]));
+  const Eigen::Matrix3d P = l[0] * Q;
+  return (0.5 * (P + P.transpose())).eval();
+}
+
+TEST(DerivativesPsdProjection, SameBitsAsTheEigenExpressions) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int projected = 0;
+  for (int trial = 0; trial < 50000; ++trial) {
+    Eigen::Matrix3d H;
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) H(r, c) = H(c, r) = unit(rng) * std::pow(10.0, 2 * unit(rng));
+    if (trial % 4 == 0) H(rng() % 3, rng() % 3) = 0.0;  // signed zeros through x I's 0 entries
+    H = (0.5 * (H + H.transpose())).eval();
+    const Eigen::Matrix3d P = detail::psd_projection(H), E = eigen_expressions(H);
+    ASSERT_EQ(std::memcmp(P.data(), E.data(), sizeof P), 0) << "H =\n" << H;
+    projected += P != H;
+  }
+  EXPECT_GT(projected, 25000);  // most random symmetric matrices have a negative eigenvalue
+}
+
+// psd_projection_pair() (smoothed1's two shapes, their Jacobi sweeps in one SSE2 register) gives each matrix the bits
+// of psd_projection(): lanes that take different numbers of sweeps, one lane positive definite or not finite, rank
+// <= 2 estimates (sums of two outer products, symmetrised, as at M = 4), zero off-diagonal entries.
+TEST(DerivativesPsdProjection, PairGivesTheBitsOfEachAlone) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto random = [&](int kind) {
+    Eigen::Matrix3d H;
+    if (kind == 0) {  // rank <= 2 before symmetrisation
+      const Eigen::Vector3d a = Eigen::Vector3d::Random(), b = Eigen::Vector3d::Random();
+      const Eigen::Vector3d c(unit(rng), unit(rng), unit(rng)), d(unit(rng), unit(rng), unit(rng));
+      H = a * c.transpose() + b * d.transpose();
+    } else if (kind == 1) {  // positive definite
+      const Eigen::Matrix3d A = Eigen::Matrix3d::Random();
+      H = A * A.transpose() + 0.1 * Eigen::Matrix3d::Identity();
+    } else if (kind == 2) {  // diagonal (off-diagonal zeros: no rotation) or with one zero pair
+      H = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).asDiagonal();
+      if (rng() % 2) H(0, 1) = H(1, 0) = unit(rng);
+    } else if (kind == 3) {  // not finite
+      H = Eigen::Matrix3d::Random();
+      H(rng() % 3, rng() % 3) = rng() % 2 ? std::nan("") : INFINITY;
+    } else {  // spread eigenvalues (more sweeps in one lane)
+      H = Eigen::Matrix3d::Random();
+      H.row(rng() % 3) *= 1e8;
+    }
+    return (0.5 * (H + H.transpose())).eval();
+  };
+  int rotated = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Eigen::Matrix3d A = random(trial % 5 == 4 ? 0 : int(rng() % 5)), B = random(int(rng() % 5));
+    Eigen::Matrix3d pa = A, pb = B;
+    detail::psd_projection_pair(pa, pb);
+    const Eigen::Matrix3d ea = detail::psd_projection(A), eb = detail::psd_projection(B);
+    ASSERT_EQ(std::memcmp(pa.data(), ea.data(), sizeof pa), 0) << "A =\n" << A << "\nB =\n" << B;
+    ASSERT_EQ(std::memcmp(pb.data(), eb.data(), sizeof pb), 0) << "A =\n" << A << "\nB =\n" << B;
+    rotated += pa != A && pb != B;
+  }
+  EXPECT_GT(rotated, 5000);  // both lanes projected (the shared sweeps) in a good part of the trials
 }
 
 TEST(DerivativesPsdProjection, KeepsNanAndSpecialCases) {
