@@ -148,4 +148,17 @@ constexpr bool side_start_pair(ShapeType a, ShapeType b) {
   return axial_a && axial_b && (a == ShapeType::cylinder || b == ShapeType::cylinder);
 }
 
+/// Cores with a rim (a circle on the boundary: a cylinder's two, a cone's base) and cores with a lateral surface
+/// along their axis (a cylinder's side, a cone's slant, a capsule core's segment as a side of radius 0).
+constexpr bool rim_core(ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; }
+constexpr bool lateral_core(ShapeType t) { return rim_core(t) || t == ShapeType::capsule; }
+/// Pair types whose double distance / witness lanes may start from a rim-lateral contact point (wide_gjk.inl's
+/// rim_candidate()): a rim of one core against the lateral surface of the other.
+constexpr bool rim_start_pair(ShapeType a, ShapeType b) {
+  return (rim_core(a) && lateral_core(b)) || (rim_core(b) && lateral_core(a));
+}
+/// Newton steps on the rim angle per rim-lateral candidate (mean iterations, close witness double cylinder-cylinder,
+/// 20000 pairs, without rim starts 17.70: 1 step 11.15, 2 steps 8.96, 3 steps 8.22).
+constexpr int kRimNewtonSteps = 3;
+
 }  // namespace batchcol::kernels

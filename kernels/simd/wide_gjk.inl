@@ -638,6 +638,11 @@ template <class T> struct WideGjk {
     std::int64_t pair[W];      // pair index of each lane, -1 when empty
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
     int newton_pair = -1;     // newton_pair_type(A.type, B.type), set by the first refill of the run; -1: not yet
+    // rim_start_pair() runs of double: each refilled lane's rim_candidate() (NaN: none), which start() takes as the
+    // first point where it is closer than the first support point (and side_start()'s). `rim_given`: the source
+    // wrote them at refill (WideGjkPairs, from its W-pair set-up); else start() computes them.
+    bool rim_given = false;
+    V3 rim_a, rim_b;
   };
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
@@ -655,6 +660,12 @@ template <class T> struct WideGjk {
     L.x = pick(m, sw, L.x);
     L.last_s = pick(m, sw, L.last_s);
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
+    if constexpr (std::is_same_v<T, double>) {
+      if (side && rim_start_pair(L.A.type, L.B.type)) {
+        if (!L.rim_given) rim_candidate(L.A.type, L.B.type, L.R, L.t, L.A.s0, L.A.s1, L.B.s0, L.B.s1, L.rim_a, L.rim_b);
+        take_start(L, m & ~L.boolean_only, L.rim_a, L.rim_b);
+      }
+    }
     L.fresh = 0;
   }
 
@@ -707,6 +718,127 @@ template <class T> struct WideGjk {
     L.x = pick(ok, x, L.x);
     L.last_s = pick(ok, x, L.last_s);
     L.momentum &= ~ok;
+  }
+
+  /// The point pa - pb of D (pa on A, pb on B, A's frame) replaces lane's first point in `ok` where it is closer
+  /// to the origin (side_start()'s rule; NaN points never are), and the lane's first step is a plain one.
+  AI static void take_start(Lanes& L, mask ok, const V3& pa, const V3& pb) {
+    const V3 x = sub(pa, pb);
+    ok &= norm2(x) < norm2(L.x);
+    if (!any(ok)) return;
+    L.w[0] = pick(ok, x, L.w[0]);
+    L.a[0] = pick(ok, pa, L.a[0]);  // slot[0] = 0 (start_lane())
+    L.b[0] = pick(ok, pb, L.b[0]);
+    L.x = pick(ok, x, L.x);
+    L.last_s = pick(ok, x, L.last_s);
+    L.momentum &= ~ok;
+  }
+
+  /// A rim of core X against the lateral surface of core Y, in X's frame: the rim is the circle of radius r at
+  /// height zr on X's axis (0, 0, 1); Y has its centre at c, its unit axis b, radius ry (0: a capsule's segment)
+  /// and half-height hy, and is a cone (apex at c + hy b, base rim at c - hy b) or else a cylinder. The rim point
+  /// px(theta) = (r cos theta, r sin theta, zr) nearest to Y's lateral surface, by kRimNewtonSteps Newton steps on
+  /// theta, and its foot py on that surface; `ok` keeps the lanes whose foot lies on the surface (inside the side
+  /// or the slant) with px outside it. Then px - py is a point of D, and where the pair's optimum is this
+  /// rim-lateral contact it is the optimum (up to the Newton steps' error): GJK's first plain step certifies it.
+  /// Minimised: a cylinder's squared distance to its axis line, phi = |v|^2 - <v, b>^2 (v = px - c); a cone's
+  /// signed distance to the slant's line in the (rho, z) half-plane times its length, 2 hy rho + ry <v, b> (rho
+  /// = sqrt(phi)). With (C, S) = (cos, sin) theta, v' = r (-S, C, 0), v'' = r (-C, -S, 0); phi' / 2 = g = <v, v'>
+  /// - <v, b> <v', b>, phi'' / 2 = h = |v'|^2 + <v, v''> - <v', b>^2 - <v, b> <v'', b>, rho' = g / rho, rho'' =
+  /// (h - rho'^2) / rho. A step turns (C, S) by dt to (C - dt S, S + dt C) / sqrt(1 + dt^2) (angle atan(dt): an
+  /// O(dt^3) error, below Newton's quadratic one); where the second derivative is not positive it does not move.
+  /// Start: the direction (in X's xy plane) of Y's axis point nearest to the rim's centre.
+  /// Why: GJK's support points on a rim bisect the rim angle (on a circle against a point the chord's normal, so
+  /// the next support, is at the mean of its ends' angles), a linear rate of 1/2: cylinder-cylinder rim vs side
+  /// took 20.4 iterations, cone-cone rim vs slant 19.2 (bench/results/history/narrowphase-sessions.md).
+  AI static void rim_lateral(real r, real zr, const V3& c, const V3& b, real ry, real hy, bool cone, V3& px, V3& py,
+                             mask& ok) {
+    const real zero = splat(T(0)), one = splat(T(1));
+    const V3 q = add(c, scale(dot(sub(V3{zero, zero, zr}, c), b), b));
+    const real inv0 = one / wsqrt<T>(q.x * q.x + q.y * q.y);
+    real C = q.x * inv0, S = q.y * inv0;
+    const real kr = T(2) * hy;
+    for (int it = 0; it < kRimNewtonSteps; ++it) {
+      const V3 v = {r * C - c.x, r * S - c.y, zr - c.z};
+      const V3 v1 = {-(r * S), r * C, zero}, v2 = {-(r * C), -(r * S), zero};
+      const real vb = dot(v, b), v1b = dot(v1, b), v2b = dot(v2, b);
+      const real g = dot(v, v1) - vb * v1b;
+      const real h = (dot(v1, v1) + dot(v, v2)) - (v1b * v1b + vb * v2b);
+      real dt;
+      if (cone) {
+        const real ir = one / wsqrt<T>(dot(v, v) - vb * vb);
+        const real r1 = g * ir, r2 = (h - r1 * r1) * ir;
+        const real f1 = kr * r1 + ry * v1b, f2 = kr * r2 + ry * v2b;
+        dt = select(f2 > zero, -f1 / f2, zero);
+      } else {
+        dt = select(h > zero, -g / h, zero);
+      }
+      const real C1 = C - dt * S, S1 = S + dt * C;
+      const real inv = one / wsqrt<T>(C1 * C1 + S1 * S1);
+      C = C1 * inv;
+      S = S1 * inv;
+    }
+    px = {r * C, r * S, zr};
+    const V3 v = sub(px, c);
+    const real vb = dot(v, b);
+    const V3 e = sub(v, scale(vb, b));
+    const real rho = norm(e);
+    if (cone) {  // the foot on the slant from (rho, z) = (0, hy) to (ry, -hy), at sg of its length
+      const real sg = (rho * ry - kr * (vb - hy)) / (ry * ry + kr * kr);
+      ok &= (sg >= zero) & (sg <= one) & (kr * rho + ry * (vb - hy) > zero) & (rho > zero);
+      py = add(add(c, scale(hy - kr * sg, b)), scale((sg * ry) / rho, e));
+    } else {
+      ok &= (vb <= hy) & (vb >= -hy) & (rho > ry);
+      py = add(add(c, scale(vb, b)), scale(ry / rho, e));
+    }
+  }
+  /// The closest of the rim-lateral points of D (rim_lateral()) of W pairs of a rim_start_pair() type: A's rims
+  /// against B's lateral surface (A's frame), then B's against A's (B's frame: A's centre -R^T t, axis R^T e_z;
+  /// mapped back by R and t), a cylinder's rim at +h before -h; a later one only where strictly closer. R
+  /// (row-major), t: B's pose in A's frame; a0, a1 / b0, b1: the cores' radius and half-height (a capsule's
+  /// half-length). pa, pb: A's and B's points in A's frame, NaN where no candidate is valid.
+  /// Computed where the pairs are set up, W at a time (WideGjkPairs' fill_slots()): per refilled lane its ~50
+  /// divisions and square roots made cylinder-cylinder slower in wall time although 34% fewer instructions.
+  __attribute__((noinline)) static void rim_candidate(ShapeType ta, ShapeType tb, const real* R, const real* t,
+                                                      real a0, real a1, real b0, real b1, V3& pa, V3& pb) {
+    const real zero = splat(T(0)), nan = splat(std::numeric_limits<T>::quiet_NaN());
+    pa = pb = {nan, nan, nan};
+    mask has = splat_mask(0);
+    real best{};
+    const auto keep = [&](mask ok, const V3& qa, const V3& qb) {
+      const real n2 = norm2(sub(qa, qb));
+      const mask take = ok & (~has | (n2 < best));
+      pa = pick(take, qa, pa);
+      pb = pick(take, qb, pb);
+      best = select(take, n2, best);
+      has |= take;
+    };
+    if (rim_core(ta) && lateral_core(tb)) {
+      const V3 c = {t[0], t[1], t[2]}, b = {R[2], R[5], R[8]};
+      const real ry = tb == ShapeType::capsule ? zero : b0;
+      for (int sg = ta == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
+        V3 qa, qb;
+        mask ok = splat_mask(-1);
+        rim_lateral(a0, T(sg) * a1, c, b, ry, b1, tb == ShapeType::cone, qa, qb, ok);
+        keep(ok, qa, qb);
+      }
+    }
+    if (rim_core(tb) && lateral_core(ta)) {
+      const V3 c = {-((R[0] * t[0] + R[3] * t[1]) + R[6] * t[2]), -((R[1] * t[0] + R[4] * t[1]) + R[7] * t[2]),
+                    -((R[2] * t[0] + R[5] * t[1]) + R[8] * t[2])};
+      const V3 a = {R[6], R[7], R[8]};
+      const real ry = ta == ShapeType::capsule ? zero : a0;
+      const auto back = [&](const V3& q) {
+        return V3{((R[0] * q.x + R[1] * q.y) + R[2] * q.z) + t[0], ((R[3] * q.x + R[4] * q.y) + R[5] * q.z) + t[1],
+                  ((R[6] * q.x + R[7] * q.y) + R[8] * q.z) + t[2]};
+      };
+      for (int sg = tb == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
+        V3 qb, qa;
+        mask ok = splat_mask(-1);
+        rim_lateral(b0, T(sg) * b1, c, a, ry, a1, ta == ShapeType::cone, qb, qa, ok);
+        keep(ok, back(qa), back(qb));
+      }
+    }
   }
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).

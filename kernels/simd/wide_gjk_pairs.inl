@@ -36,6 +36,7 @@ template <class T> struct WideGjkPairs {
     T size_a[3][N], size_b[3][N], radius_a[N], radius_b[N];
     T radii[N], scale[N], floor[N], tolerance[N], core_margin[N];
     T init[3][N];
+    T rim[6][N];  // rim runs (Source::rim): WideGjk::rim_candidate()'s points of A and B, A's frame
   };
   struct Chunk : Slots<kChunk> {
     static_assert(kChunk <= 64, "one bit per slot");
@@ -128,6 +129,8 @@ template <class T> struct WideGjkPairs {
     std::size_t fallbacks = 0;
     std::size_t read = 0;  // pairs[0 .. read) went into a chunk
     bool witness = options.level >= QueryLevel::witness;
+    /// Double distance / witness runs of a rim_start_pair() type: the slots carry rim_candidate()'s start points.
+    bool rim = std::is_same_v<T, double> && options.level != QueryLevel::boolean && rim_start_pair(type_a, type_b);
     /// The same for every pair of the run (gjk_limits() and the solver): set once per run in every lane by
     /// start_run(); a refill sets only what differs per pair (momentum too: the loop clears it per lane).
     Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
@@ -150,6 +153,7 @@ template <class T> struct WideGjkPairs {
       L.relative = G::splat(T(options.relative_tolerance));
       L.normalize = G::truth(normalize);
       L.boolean_only = G::truth(options.level == QueryLevel::boolean);
+      L.rim_given = rim;
     }
 
     /// The next kChunk pairs, W per register: poses validated and B's pose in A's frame (prepare_pair's rule and
@@ -215,6 +219,14 @@ template <class T> struct WideGjkPairs {
         put(chunk.init[0] + s, nonzero ? init[0] : splat_t(T(1)));
         put(chunk.init[1] + s, nonzero ? init[1] : splat_t(T(0)));
         put(chunk.init[2] + s, nonzero ? init[2] : splat_t(T(0)));
+        if constexpr (std::is_same_v<T, double>) {
+          if (rim) {
+            typename G::V3 qa, qb;
+            G::rim_candidate(type_a, type_b, R, t, A.size[0], A.size[1], B.size[0], B.size[1], qa, qb);
+            const tvec q[6] = {qa.x, qa.y, qa.z, qb.x, qb.y, qb.z};
+            for (int c = 0; c < 6; ++c) put(chunk.rim[c] + s, q[c]);
+          }
+        }
 
         const std::uint32_t valid = lane_bits(pa.valid & pb.valid) & b.live;
         mark(s, valid);
@@ -243,6 +255,10 @@ template <class T> struct WideGjkPairs {
       side(L.A, c.size_a, c.shape_a, s, l);
       side(L.B, c.size_b, c.shape_b, s, l);
       G::reset_search(L, l, Vec3<T>(c.init[0][s], c.init[1][s], c.init[2][s]));
+      if (rim) {
+        G::set_lane(L.rim_a, l, Vec3<T>(c.rim[0][s], c.rim[1][s], c.rim[2][s]));
+        G::set_lane(L.rim_b, l, Vec3<T>(c.rim[3][s], c.rim[4][s], c.rim[5][s]));
+      }
       L.momentum[l] = momentum;
       L.tolerance[l] = c.tolerance[s];
       L.touch[l] = c.floor[s];  // gjk_limits(): touch = floor

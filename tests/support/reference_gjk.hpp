@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cassert>
 #include <limits>
+#include <type_traits>
 
 namespace batchcol::test_reference {
 
@@ -232,6 +233,97 @@ template <class T> bool side_start(const MinkowskiDifference<T>& D, SupportPoint
   return true;
 }
 
+/// wide_gjk.inl's rim_lateral() (the reasoning is there), with its operations: a rim of X (radius r, height zr, X's
+/// frame) against Y's lateral surface (centre c, unit axis b, radius ry, half-height hy, cone or cylinder); false
+/// where the foot py is not on the surface or px not outside it.
+template <class T>
+bool rim_lateral(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool cone, Vec3<T>& px, Vec3<T>& py) {
+  const Vec3<T> q = wadd(c, wscale(dot3(wsub(Vec3<T>(T(0), T(0), zr), c), b), b));
+  const T inv0 = T(1) / std::sqrt(q.x() * q.x() + q.y() * q.y());
+  T C = q.x() * inv0, S = q.y() * inv0;
+  const T kr = T(2) * hy;
+  for (int it = 0; it < kRimNewtonSteps; ++it) {
+    const Vec3<T> v(r * C - c.x(), r * S - c.y(), zr - c.z());
+    const Vec3<T> v1(-(r * S), r * C, T(0)), v2(-(r * C), -(r * S), T(0));
+    const T vb = dot3(v, b), v1b = dot3(v1, b), v2b = dot3(v2, b);
+    const T g = dot3(v, v1) - vb * v1b;
+    const T h = (dot3(v1, v1) + dot3(v, v2)) - (v1b * v1b + vb * v2b);
+    T dt;
+    if (cone) {
+      const T ir = T(1) / std::sqrt(dot3(v, v) - vb * vb);
+      const T r1 = g * ir, r2 = (h - r1 * r1) * ir;
+      const T f1 = kr * r1 + ry * v1b, f2 = kr * r2 + ry * v2b;
+      dt = f2 > T(0) ? -f1 / f2 : T(0);
+    } else {
+      dt = h > T(0) ? -g / h : T(0);
+    }
+    const T C1 = C - dt * S, S1 = S + dt * C;
+    const T inv = T(1) / std::sqrt(C1 * C1 + S1 * S1);
+    C = C1 * inv;
+    S = S1 * inv;
+  }
+  px = Vec3<T>(r * C, r * S, zr);
+  const Vec3<T> v = wsub(px, c);
+  const T vb = dot3(v, b);
+  const Vec3<T> e = wsub(v, wscale(vb, b));
+  const T rho = std::sqrt(dot3(e, e));
+  if (cone) {
+    const T sg = (rho * ry - kr * (vb - hy)) / (ry * ry + kr * kr);
+    py = wadd(wadd(c, wscale(hy - kr * sg, b)), wscale((sg * ry) / rho, e));
+    return sg >= T(0) && sg <= T(1) && kr * rho + ry * (vb - hy) > T(0) && rho > T(0);
+  }
+  py = wadd(wadd(c, wscale(vb, b)), wscale(ry / rho, e));
+  return vb <= hy && vb >= -hy && rho > ry;
+}
+
+/// wide_gjk.inl's rim_candidate() for one pair: the closest valid rim-lateral point of D (false: none).
+template <class T> bool rim_candidate(const MinkowskiDifference<T>& D, SupportPoint<T>& p) {
+  const ShapeType ta = D.A->type, tb = D.B->type;
+  const T a0 = D.A->size.x(), a1 = D.A->size.y(), b0 = D.B->size.x(), b1 = D.B->size.y();
+  const auto& R = D.b_in_a.R;
+  const Vec3<T>& t = D.b_in_a.t;
+  bool has = false;
+  T best = T(0);
+  const auto keep = [&](bool ok, const Vec3<T>& qa, const Vec3<T>& qb) {
+    const Vec3<T> w = wsub(qa, qb);
+    const T n2 = dot3(w, w);
+    if (ok && (!has || n2 < best)) {
+      p.a = qa;
+      p.b = qb;
+      best = n2;
+      has = true;
+    }
+  };
+  if (rim_core(ta) && lateral_core(tb)) {
+    const Vec3<T> c = t, b(R(0, 2), R(1, 2), R(2, 2));
+    const T ry = tb == ShapeType::capsule ? T(0) : b0;
+    for (int sg = ta == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
+      Vec3<T> qa, qb;
+      const bool ok = rim_lateral(a0, T(sg) * a1, c, b, ry, b1, tb == ShapeType::cone, qa, qb);
+      keep(ok, qa, qb);
+    }
+  }
+  if (rim_core(tb) && lateral_core(ta)) {
+    const Vec3<T> c(-((R(0, 0) * t.x() + R(1, 0) * t.y()) + R(2, 0) * t.z()),
+                    -((R(0, 1) * t.x() + R(1, 1) * t.y()) + R(2, 1) * t.z()),
+                    -((R(0, 2) * t.x() + R(1, 2) * t.y()) + R(2, 2) * t.z()));
+    const Vec3<T> a(R(2, 0), R(2, 1), R(2, 2));
+    const T ry = ta == ShapeType::capsule ? T(0) : a0;
+    const auto back = [&](const Vec3<T>& q) {
+      return Vec3<T>(((R(0, 0) * q.x() + R(0, 1) * q.y()) + R(0, 2) * q.z()) + t.x(),
+                     ((R(1, 0) * q.x() + R(1, 1) * q.y()) + R(1, 2) * q.z()) + t.y(),
+                     ((R(2, 0) * q.x() + R(2, 1) * q.y()) + R(2, 2) * q.z()) + t.z());
+    };
+    for (int sg = tb == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
+      Vec3<T> qb, qa;
+      const bool ok = rim_lateral(b0, T(sg) * b1, c, a, ry, a1, ta == ShapeType::cone, qb, qa);
+      keep(ok, back(qa), back(qb));
+    }
+  }
+  if (has) p.w = wsub(p.a, p.b);
+  return has;
+}
+
 template <class T>
 GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, const GjkParams<T>& params) {
   GjkResult<T> r;
@@ -254,6 +346,18 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       x = p.w;
       last_s = x;
       momentum = false;
+    }
+  }
+  // Rim-lateral pairs (double): the closest rim-lateral point of D where it is closer (wide_gjk.inl's start()).
+  if constexpr (std::is_same_v<T, double>) {
+    if (!params.boolean_only && rim_start_pair(D.A->type, D.B->type)) {
+      SupportPoint<T> p;
+      if (rim_candidate(D, p) && norm2(p.w) < norm2(x)) {
+        S.v[0] = p;
+        x = p.w;
+        last_s = x;
+        momentum = false;
+      }
     }
   }
   T lower_bound = -std::numeric_limits<T>::infinity();
