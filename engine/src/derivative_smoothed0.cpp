@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cstring>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 // The vector types of derivative_finish_lanes.inl cross no call boundary between instruction sets (each set's code
@@ -66,6 +67,7 @@ struct PairPlan {
   ShapeType type_a = ShapeType::sphere, type_b = ShapeType::sphere;
   bool wide = false;  // the type pair runs through gjk_samples
   kernels::simd::SamplePlan samples;
+  kernels::simd::WarmSimplex warm;  // convex-convex pairs: the samples' starting simplex (warm_simplex())
 };
 
 struct Context {
@@ -82,6 +84,75 @@ struct Context {
 bool wide_type_pair(ShapeType a, ShapeType b, const QueryOptions& q) {
   const auto plain = [](ShapeType t) { return t != ShapeType::triangle && t != ShapeType::halfspace; };
   return plain(a) && plain(b) && !kernels::may_have_closed_form(a, b, q);
+}
+
+/// warm_simplex()'s feature tolerance, relative to the pair's size (the hulls' bounding radii).
+constexpr double kFeatureTolerance = 1e-9;
+
+/// The nominal answer's simplex of a hull pair (A's frame: B's vertices under R0, t0), for the samples' warm start:
+/// the vertices of A's hull on its supporting plane at the nominal normal n (A towards B) and B's on its own, within
+/// kFeatureTolerance of the support value, combined as GJK's simplex holds them: vertex-vertex, vertex-edge, vertex-
+/// face (one pair per vertex of the larger feature), or edge-edge, where the closest point lies in one of the two
+/// triangles of the parallelogram of the four vertex pairs (chosen by the witness points' edge parameters s on A's
+/// edge and u on B's: s >= u the triangle (a1 b1, a2 b1, a2 b2), else (a1 b1, a1 b2, a2 b2)). Other features
+/// (a quad face, ties) get no warm start. A wrong guess costs iterations only: the samples' GJK certifies its
+/// answer by the duality gap from whatever simplex it starts.
+kernels::simd::WarmSimplex warm_simplex(const HullView& ha, const HullView& hb, const kernels::simd::SamplePlan& sp,
+                                        const double (&g0)[10], double size) {
+  kernels::simd::WarmSimplex ws;
+  const double n[3] = {g0[7], g0[8], g0[9]};
+  // Relative to the pair's size: far above the nominal normal's rounding (~1e-16 |x| on an exact feature), far
+  // below the gaps between a random hull's support values.
+  const double tol = kFeatureTolerance * size;
+  const auto dot = [](const double* p, const double* q) { return (p[0] * q[0] + p[1] * q[1]) + p[2] * q[2]; };
+  const auto a_at = [&](std::uint32_t i, double* p) { for (int e = 0; e < 3; ++e) p[e] = ha.vertices[3 * i + e]; };
+  const auto b_at = [&](std::uint32_t j, double* p) {
+    const double* v = hb.vertices + 3 * j;
+    for (int e = 0; e < 3; ++e) p[e] = ((sp.R0[3 * e] * v[0] + sp.R0[3 * e + 1] * v[1]) + sp.R0[3 * e + 2] * v[2]) + sp.t0[e];
+  };
+  // A's vertices maximise <v, n>; B's minimise <R0 v + t0, n> = <v, R0^T n> + const, so B's are scored in its own
+  // frame against m = -R0^T n (the constant does not change which are within tol of the best).
+  const double m[3] = {-((sp.R0[0] * n[0] + sp.R0[3] * n[1]) + sp.R0[6] * n[2]),
+                       -((sp.R0[1] * n[0] + sp.R0[4] * n[1]) + sp.R0[7] * n[2]),
+                       -((sp.R0[2] * n[0] + sp.R0[5] * n[1]) + sp.R0[8] * n[2])};
+  // Up to 4 vertices within tol of the best (4: too many for a warm simplex).
+  const auto feature = [&](const HullView& h, const double* d, std::uint32_t* f) {
+    double score[kernels::kHillClimbMinVertices];
+    double best = -std::numeric_limits<double>::infinity();
+    for (std::uint32_t i = 0; i < h.vertex_count; ++i) {
+      score[i] = dot(h.vertices + 3 * i, d);
+      best = std::max(best, score[i]);
+    }
+    std::uint32_t k = 0;
+    for (std::uint32_t i = 0; i < h.vertex_count && k < 4; ++i)
+      if (score[i] >= best - tol) f[k++] = i;
+    return k;
+  };
+  std::uint32_t fa[4], fb[4];
+  const std::uint32_t ka = feature(ha, n, fa);
+  const std::uint32_t kb = feature(hb, m, fb);
+  if (ka == 1 && kb <= 3) {
+    ws.count = kb;
+    for (std::uint32_t q = 0; q < kb; ++q) ws.a[q] = fa[0], ws.b[q] = fb[q];
+  } else if (kb == 1 && ka <= 3) {
+    ws.count = ka;
+    for (std::uint32_t q = 0; q < ka; ++q) ws.a[q] = fa[q], ws.b[q] = fb[0];
+  } else if (ka == 2 && kb == 2) {
+    double a1[3], a2[3], b1[3], b2[3], ea[3], eb[3], da[3], db[3];
+    a_at(fa[0], a1), a_at(fa[1], a2), b_at(fb[0], b1), b_at(fb[1], b2);
+    for (int e = 0; e < 3; ++e) {
+      ea[e] = a2[e] - a1[e], eb[e] = b2[e] - b1[e];
+      da[e] = g0[1 + e] - a1[e], db[e] = g0[4 + e] - b1[e];
+    }
+    const double s = dot(da, ea) / dot(ea, ea), u = dot(db, eb) / dot(eb, eb);
+    if (!std::isfinite(s) || !std::isfinite(u)) return ws;
+    ws.count = 3;
+    ws.a[0] = fa[0], ws.b[0] = fb[0];
+    ws.a[2] = fa[1], ws.b[2] = fb[1];
+    if (s >= u) ws.a[1] = fa[1], ws.b[1] = fb[0];
+    else ws.a[1] = fa[0], ws.b[1] = fb[1];
+  }
+  return ws;
 }
 
 /// Ra^T v, in the order of Eigen's R_a.transpose() * v: (Ra(0,r) v0 + Ra(1,r) v1) + Ra(2,r) v2.
@@ -175,6 +246,15 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
     sp.predict = finite;
   }
   if (!sp.predict) std::fill_n(sp.P, 18, 0.0);
+  p.warm = {};
+  if (p.wide && p.type_a == ShapeType::convex && p.type_b == ShapeType::convex) {
+    const HullView& ha = c.view.shape_hull[c.batch.shape_a[i]];
+    const HullView& hb = c.view.shape_hull[c.batch.shape_b[i]];
+    // Small hulls only: the feature scan reads every vertex (large hulls' samples climb from a start cell).
+    if (ha.vertex_count < kernels::kHillClimbMinVertices && hb.vertex_count < kernels::kHillClimbMinVertices)
+      p.warm = warm_simplex(ha, hb, sp, p.g0, c.view.bounding_radii[c.batch.shape_a[i]] +
+                                                   c.view.bounding_radii[c.batch.shape_b[i]]);
+  }
   sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // CounterRng's (seed, pair) half of the key
   sp.translation = p.s.translation;
   sp.rotation = p.s.rotation;
@@ -188,6 +268,7 @@ struct Block {
   std::size_t capacity = 0, count = 0;
   std::vector<double> data, values;
   std::vector<std::uint32_t> shape_a, shape_b, fallback;
+  std::vector<const kernels::simd::WarmSimplex*> warm;  // per sample: its pair's simplex (convex-convex), or null
   std::vector<Status> status;
   double* at(int array) { return data.data() + static_cast<std::size_t>(array) * capacity; }
   double* row(std::size_t k) { return values.data() + kRow * k; }
@@ -197,6 +278,7 @@ struct Block {
     values.assign(kRow * n, 0.0);  // the padding stays 0
     shape_a.resize(n);
     shape_b.resize(n);
+    warm.resize(n);
     fallback.resize(n);
     status.resize(n);
   }
@@ -286,6 +368,7 @@ template <class T> void solve_samples(const Context& c, Block& b, std::size_t fi
   in.shape_a = b.shape_a.data() + first;
   in.shape_b = b.shape_b.data() + first;
   in.samples = count;
+  in.warm = b.warm.data() + first;
   for (int e = 0; e < 9; ++e) in.R[e] = b.at(Block::kR) + e * cap + first;
   for (int e = 0; e < 3; ++e) {
     in.t[e] = b.at(Block::kT) + e * cap + first;
@@ -501,6 +584,13 @@ template <class T> void run_pairs(const Context& c, std::size_t begin, std::size
         ++i;
         planned = false;
       }
+    }
+    // The hull spans' warm simplices (the kernel reads them for convex-convex runs only), now that `plans` no
+    // longer grows in this block.
+    for (const Span& sp : spans) {
+      const PairPlan& p = plans[sp.plan];
+      if (p.type_a == ShapeType::convex && p.type_b == ShapeType::convex)
+        std::fill_n(block.warm.data() + sp.first, sp.count, p.warm.count > 0 ? &p.warm : nullptr);
     }
     // Runs of one type pair through the kernel (or the scalar path).
     for (std::size_t s = 0; s < spans.size();) {

@@ -59,6 +59,13 @@ std::size_t gjk_pairs<float>(InstructionSet, const PairView&, ShapeType, ShapeTy
 /// engine/src/derivative_smoothed0.cpp): sample s has the shapes shape_a[s], shape_b[s] (a pair's samples are
 /// consecutive: the cores are read once per run of equal shapes), B's pose in A's frame (R row-major, t) and the
 /// first GJK direction in A's frame (not finite or zero: the cores' centres' difference, as without warm start).
+/// A hull pair's starting simplex for its samples (convex-convex only): `count` (0: none; 1-3) vertex pairs,
+/// vertex a[m] of A's hull minus vertex b[m] of B's under the sample's pose; the samples' GJK starts from the
+/// origin's projection on them instead of one support point.
+struct WarmSimplex {
+  std::uint32_t count = 0;
+  std::uint32_t a[3] = {}, b[3] = {};
+};
 struct SampleBatch {
   const std::uint32_t* shape_a = nullptr;
   const std::uint32_t* shape_b = nullptr;
@@ -66,6 +73,8 @@ struct SampleBatch {
   const double* R[9] = {};
   const double* t[3] = {};
   const double* direction[3] = {};
+  /// Per sample, its pair's WarmSimplex or null (a null array: none); read for convex-convex runs only.
+  const WarmSimplex* const* warm = nullptr;
 };
 /// Each sample's answer in A's frame (written for every sample not handed back).
 struct SampleResults {
