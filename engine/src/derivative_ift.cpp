@@ -2,11 +2,16 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <immintrin.h>  // the lanes' square roots (SSE2 here; AVX2 / AVX-512 under their target pragmas)
+
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <type_traits>
 #include <utility>
+
+// 64-byte vectors in the AVX-512 / AVX2 blocks (derivative_lanes.inl): internal, inlined, no ABI crossing.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace batchcol::detail {
 namespace {
@@ -60,67 +65,6 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
 // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
 using V = double __attribute__((vector_size(16)));
 
-V load(const double* p) {
-  V v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-// Lanes l, l + 1 of the three rows of a lane array (a vector per lane).
-template <std::size_t N> void load3(const double (&rows)[3][N], std::size_t l, V (&v)[3]) {
-  for (int i = 0; i < 3; ++i) v[i] = load(&rows[i][l]);
-}
-
-// Writes the 120 entries of a register of lanes through put(e, value): the distance gradients by the envelope
-// theorem from n, x_a, x_b, and for each entry (i, j) of the 3x6 derivatives with respect to the twist of a, given
-// by entry(i, j, wa, wb, dn) (dx_a/dxi_a, dx_b/dxi_a, dn/dxi_a), those and the twist of b's by the rigid-motion
-// identity (write_from_twist_a()'s order and formulas).
-// kNormalB: only normal_wrt_b (the 18 entries from store_at::normal_b), the smoothed0 samples' first-order start
-// (dn/dxi_b); the other entries are neither computed nor written.
-template <bool kNormalB = false, class Put, class Entry>
-void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
-  // put() for the entries kNormalB keeps: after unrolling, e is a constant and the test folds away.
-  const auto keep = [&](int e, const V& v) {
-    if (!kNormalB || e >= store_at::normal_b) put(e, v);
-  };
-  keep(0, -n[0]), keep(1, -n[1]), keep(2, -n[2]);
-  keep(3, n[1] * xa[2] - n[2] * xa[1]), keep(4, n[2] * xa[0] - n[0] * xa[2]), keep(5, n[0] * xa[1] - n[1] * xa[0]);
-  keep(6, n[0]), keep(7, n[1]), keep(8, n[2]);
-  keep(9, xb[1] * n[2] - xb[2] * n[1]), keep(10, xb[2] * n[0] - xb[0] * n[2]), keep(11, xb[0] * n[1] - xb[1] * n[0]);
-  // Unrolled: with (i, j) constants the case tests vanish and the operands stay in registers; rolled, GCC kept
-  // this a loop over stack arrays with the tests inside (~2.8x the instructions of the PolytopeLanes solve).
-#pragma GCC unroll 3
-  for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 6
-    for (int j = 0; j < 6; ++j) {
-      const int e = 6 * i + j;
-      V wa, wb, dn;
-      entry(i, j, wa, wb, dn);
-      keep(store_at::witness_a_a + e, wa);
-      keep(store_at::witness_b_a + e, wb);
-      keep(store_at::normal_a + e, dn);
-      // The twist of b: the rigid motions [I, -[x]x] (points) and [0, -[n]x] (normal) minus the above.
-      if (j < 3) {
-        const double one = i == j ? 1.0 : 0.0;
-        keep(store_at::witness_a_b + e, one - wa), keep(store_at::witness_b_b + e, one - wb);
-        keep(store_at::normal_b + e, 0.0 - dn);
-      } else if (j - 3 == i) {
-        keep(store_at::witness_a_b + e, 0.0 - wa), keep(store_at::witness_b_b + e, 0.0 - wb);
-        keep(store_at::normal_b + e, 0.0 - dn);
-      } else {
-        const int k = j - 3, other = 3 - i - k;
-        // -[x]x(i, k) = eps(i, k, other) x_other
-        if ((i + 1) % 3 == k) {
-          keep(store_at::witness_a_b + e, xa[other] - wa), keep(store_at::witness_b_b + e, xb[other] - wb);
-          keep(store_at::normal_b + e, n[other] - dn);
-        } else {
-          keep(store_at::witness_a_b + e, -xa[other] - wa), keep(store_at::witness_b_b + e, -xb[other] - wb);
-          keep(store_at::normal_b + e, -n[other] - dn);
-        }
-      }
-    }
-}
-
 // Runs body(l, both, put) for every register of two lanes l, l + 1 < count (both: the second lane is used), put(e,
 // v) writing entry e of the register to out[e][column[lane]]. Compiled twice, so that the common case (a full block
 // of whole registers to consecutive columns) has a fixed trip count, whole-vector stores and no per-store test.
@@ -151,7 +95,48 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
   else run(std::false_type{});
 }
 
+// A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path.
+template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
+  bool in_order = count == kLanes;
+  for (std::size_t l = 0; l < count; ++l) in_order = in_order && column[l] == l;
+  return in_order;
+}
+
 }  // namespace
+
+// The lanes' bodies (derivative_lanes.inl): two lanes per SSE2 register for any block, and a whole block of eight
+// lanes in one AVX-512 register (two AVX2 registers) for the wide sets. PolytopeLanes::solve() in SSE2 was ~500
+// instructions per hull pair (callgrind, AVX2 build), a third of the analytic derivative's own cost.
+// Each set's sqrt_lanes() (the .inl's lanes' square roots: IEEE square roots are correctly rounded, so every lane
+// gets std::sqrt()'s bits; GCC emitted one scalar sqrt per lane with the lane moves for the element-wise form).
+namespace {
+using V8 = double __attribute__((vector_size(64)));
+}  // namespace
+namespace lanes_base {
+inline __attribute__((always_inline)) V sqrt_lanes(const V& x) { return (V)_mm_sqrt_pd((__m128d)x); }
+#include "derivative_lanes.inl"
+}  // namespace lanes_base
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
+namespace lanes_avx512 {
+inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
+  // The masked form: _mm512_sqrt_pd()'s undefined source trips GCC 12's -Wuninitialized.
+  return (V8)_mm512_mask_sqrt_pd((__m512d)x, 0xFF, (__m512d)x);
+}
+#include "derivative_lanes.inl"
+}  // namespace lanes_avx512
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace lanes_avx2 {
+inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
+  const __m256d lo = _mm256_sqrt_pd(__m256d{x[0], x[1], x[2], x[3]});
+  const __m256d hi = _mm256_sqrt_pd(__m256d{x[4], x[5], x[6], x[7]});
+  return V8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
+}
+#include "derivative_lanes.inl"
+}  // namespace lanes_avx2
+#pragma GCC pop_options
 
 // Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
 // symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
@@ -162,80 +147,26 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
 // pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
 // whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
 // per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
-void SmoothLanes::solve(double* const* out, bool normal_b_only) const {
+void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa) const {
   if (normal_b_only) {
-    if (curved) solve_lanes<true, true>(out);
-    else solve_lanes<true, false>(out);
+    if (curved) solve_lanes<true, true>(out, isa);
+    else solve_lanes<true, false>(out, isa);
   } else {
-    if (curved) solve_lanes<false, true>(out);
-    else solve_lanes<false, false>(out);
+    if (curved) solve_lanes<false, true>(out, isa);
+    else solve_lanes<false, false>(out, isa);
   }
 }
 
-template <bool kNormalB, bool kCurved> void SmoothLanes::solve_lanes(double* const* out) const {
+template <bool kNormalB, bool kCurved> void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa) const {
+  if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
+    return lanes_avx512::smooth_block<V8, kNormalB, kCurved>(*this, out);
+  if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
+    return lanes_avx2::smooth_block<V8, kNormalB, kCurved>(*this, out);
   run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
-    const V d = load(&sd[l]);
-    V n[3], xa[3], xb[3];
-    load3(this->n, l, n), load3(this->xa, l, xa), load3(this->xb, l, xb);
-    // The support-map Jacobians (world_support_jacobian()'s formula and order of operations; it is even in n).
-    const auto curvature = [&](const Side& side, V (&H)[3][3]) {
-      if constexpr (!kCurved) {  // every lane's H is its H0 (see `curved`): ~150 instructions a side fewer
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) H[i][j] = load(&side.H0[3 * i + j][l]) + 0.0;
-        return;
-      }
-      V R[3][3], B[3][3], Bn[3];
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) R[i][k] = load(&side.R[3 * i + k][l]);
-      const V D[3] = {load(&side.radii2[0][l]), load(&side.radii2[1][l]), load(&side.radii2[2][l])};
-      for (int i = 0; i < 3; ++i)
-        for (int j = i; j < 3; ++j)
-          B[i][j] = B[j][i] = R[i][0] * D[0] * R[j][0] + R[i][1] * D[1] * R[j][1] + R[i][2] * D[2] * R[j][2];
-      for (int i = 0; i < 3; ++i) Bn[i] = B[i][0] * n[0] + B[i][1] * n[1] + B[i][2] * n[2];
-      const V m2 = n[0] * Bn[0] + n[1] * Bn[1] + n[2] * Bn[2];
-      const V m = {std::sqrt(m2[0]), std::sqrt(m2[1])};
-      const V zero = {0.0, 0.0};
-      const V inv_m = m2 > 0.0 ? 1.0 / m : zero, inv_m3 = inv_m * inv_m * inv_m;
-      const V r = load(&side.round[l]);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          H[i][j] = load(&side.H0[3 * i + j][l]) + B[i][j] * inv_m - Bn[i] * Bn[j] * inv_m3 +
-                    r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
-    };
-    V Ha[3][3], Hb[3][3];
-    curvature(a, Ha);
-    curvature(b, Hb);
-    // K = M0^-1 from the upper triangle (M0 is symmetric up to the rounding of the world-frame rotations).
-    const V m00 = d + Ha[0][0] + Hb[0][0], m11 = d + Ha[1][1] + Hb[1][1], m22 = d + Ha[2][2] + Hb[2][2];
-    const V m01 = Ha[0][1] + Hb[0][1], m02 = Ha[0][2] + Hb[0][2], m12 = Ha[1][2] + Hb[1][2];
-    const V c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
-    const V c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
-    const V inv = 1.0 / (m00 * c00 + m01 * c01 + m02 * c02);
-    const V K[3][3] = {{c00 * inv, c01 * inv, c02 * inv}, {c01 * inv, c11 * inv, c12 * inv},
-                       {c02 * inv, c12 * inv, c22 * inv}};
-    // Fa_w: row i of H_a [n]x is (row i of H_a) x n; minus [x_a]x.
-    V F[3][3];
-    for (int i = 0; i < 3; ++i) {
-      F[i][0] = Ha[i][1] * n[2] - Ha[i][2] * n[1];
-      F[i][1] = Ha[i][2] * n[0] - Ha[i][0] * n[2];
-      F[i][2] = Ha[i][0] * n[1] - Ha[i][1] * n[0];
-    }
-    F[0][1] += xa[2], F[0][2] -= xa[1], F[1][0] -= xa[2], F[1][2] += xa[0], F[2][0] += xa[1], F[2][1] -= xa[0];
-    V Y[3][6];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        Y[i][j] = K[i][j];
-        Y[i][3 + j] = K[i][0] * F[0][j] + K[i][1] * F[1][j] + K[i][2] * F[2][j];
-      }
-    V nY[6];
-    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    put_outputs<kNormalB>(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
-      wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
-      wa = wb + d * Y[i][j];
-      dn = n[i] * nY[j] - Y[i][j];
-    });
+    lanes_base::smooth_lanes<kNormalB, kCurved, V>(*this, l, put);
   });
 }
+
 
 // PolytopeLanes: polytope_jacobians()'s closed forms with their case-dependent parts in P, G and W (see the header):
 //   no flats: P = G = W = 0 (y = F / sd, both points rigid);   a has none: G = 0, W = I (dx_b = P F);
@@ -284,43 +215,15 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
   return true;
 }
 
-void PolytopeLanes::solve(double* const* out) const {
-  run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
-    const V d = load(&sd[l]);
-    V n[3], xa[3], xb[3];
-    load3(this->n, l, n), load3(this->xa, l, xa), load3(this->xb, l, xb);
-    const V inv = 1.0 / d;
-    // Y = y and R = F - sd y = [P, -[x_a]x + (I - P) [x_a]x - sd G]; row i of M [x]x is (row i of M) x x.
-    V Y[3][6], R[3][6];
-    for (int i = 0; i < 3; ++i) {
-      V Ip[3], Gi[3];
-      for (int j = 0; j < 3; ++j) {
-        const V p = load(&P[3 * i + j][l]);
-        Ip[j] = (i == j ? 1.0 : 0.0) - p;
-        Gi[j] = load(&G[3 * i + j][l]);
-        Y[i][j] = Ip[j] * inv;
-        R[i][j] = p;
-      }
-      const V c[3] = {Ip[1] * xa[2] - Ip[2] * xa[1], Ip[2] * xa[0] - Ip[0] * xa[2], Ip[0] * xa[1] - Ip[1] * xa[0]};
-      for (int j = 0; j < 3; ++j) {
-        Y[i][3 + j] = Gi[j] - c[j] * inv;
-        R[i][3 + j] = c[j] - d * Gi[j];
-      }
-    }
-    // -[x_a]x: x_2 at (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
-    R[0][4] += xa[2], R[0][5] -= xa[1], R[1][3] -= xa[2], R[1][5] += xa[0], R[2][3] += xa[1], R[2][4] -= xa[0];
-    V Wr[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) Wr[i][j] = load(&W[3 * i + j][l]);
-    V nY[6];
-    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    put_outputs(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
-      wb = Wr[i][0] * R[0][j] + Wr[i][1] * R[1][j] + Wr[i][2] * R[2][j];
-      wa = wb + d * Y[i][j];
-      dn = n[i] * nY[j] - Y[i][j];
-    });
-  });
+void PolytopeLanes::solve(double* const* out, InstructionSet isa) const {
+  if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
+    return lanes_avx512::polytope_block<V8>(*this, out);
+  if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
+    return lanes_avx2::polytope_block<V8>(*this, out);
+  run_lanes<kLanes>(count, column, out,
+                    [&](std::size_t l, const auto& put) { lanes_base::polytope_lanes<V>(*this, l, put); });
 }
+
 
 void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,
                       const CurvedSide* curved_b) {

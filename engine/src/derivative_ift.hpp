@@ -26,6 +26,8 @@
 // Dependent flats (face-face, parallel edges, an edge on a face) make the witness points non-unique: no derivative.
 #pragma once
 
+#include "batchcol/types.hpp"
+
 #include <Eigen/Core>
 
 #include <cstddef>
@@ -124,10 +126,12 @@ struct SmoothLanes {
   /// to column 0 of entry e: a block buffer's row or the output array itself). Whole registers are stored when
   /// the columns are 0, 1, 2, ... (a block of smooth pairs only), single lanes otherwise.
   /// normal_b_only: only normal_wrt_b's 18 entries (the other rows of `out` are left as they were).
-  void solve(double* const* out, bool normal_b_only = false) const;
+  /// isa: a whole block (count == kLanes, columns 0, 1, 2, ...) runs in one 8-lane register of that set (AVX-512,
+  /// AVX2); the same bits on every set.
+  void solve(double* const* out, bool normal_b_only = false, InstructionSet isa = InstructionSet::scalar) const;
 
  private:
-  template <bool kNormalB, bool kCurved> void solve_lanes(double* const* out) const;
+  template <bool kNormalB, bool kCurved> void solve_lanes(double* const* out, InstructionSet isa) const;
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two
@@ -151,7 +155,7 @@ struct PolytopeLanes {
   /// edges): the general path decides.
   bool add(std::size_t column, const PairGeometry& g);
   /// As SmoothLanes::solve().
-  void solve(double* const* out) const;
+  void solve(double* const* out, InstructionSet isa = InstructionSet::scalar) const;
 };
 
 /// True when the pair can take PolytopeLanes (no curvature, separated, at most two flats).

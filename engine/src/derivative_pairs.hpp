@@ -79,6 +79,8 @@ class StoreBlock {
   /// Smooth pairs write normal_wrt_b only (the smoothed0 samples' predictor reads nothing else); the other pairs
   /// still write all their entries.
   bool normal_b_only = false;
+  /// The set whose registers solve whole blocks (SmoothLanes / PolytopeLanes::solve()); the same bits on every set.
+  InstructionSet isa = InstructionSet::scalar;
 
  private:
   alignas(64) double buf_[kEntries][kStride] = {};

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -383,9 +384,17 @@ int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vect
     }
     return false;
   };
-  if (count <= kKept) {  // the kept heights (a separate loop: the compiler recomputed them in a shared one)
-    for (k = 0; k < count; ++k)
-      if (kept[k] >= floor && exposed(k)) return 2;
+  if (count <= kKept) {
+    // The kept heights' test two at a time into a bit mask (ordered compares: a NaN height is not exposed, as
+    // below), then the exposed vertices in index order: the test and branch per vertex cost ~50 instructions per
+    // 8-vertex hull (callgrind, analytic hull pairs), while a hull exposes 1-3 of its vertices.
+    const __m128d f = _mm_set1_pd(floor);
+    std::uint32_t mask = 0;
+    for (k = 0; k + 1 < count; k += 2)
+      mask |= std::uint32_t(_mm_movemask_pd(_mm_cmpge_pd(_mm_loadu_pd(&kept[k]), f))) << k;
+    if (k < count && kept[k] >= floor) mask |= std::uint32_t{1} << k;
+    for (; mask != 0; mask &= mask - 1)
+      if (exposed(std::size_t(__builtin_ctz(mask)))) return 2;
   } else {
     for (k = 0; k < count; ++k)
       if ((k < kKept ? kept[k] : height(k)) >= floor && exposed(k)) return 2;

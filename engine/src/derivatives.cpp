@@ -66,9 +66,9 @@ void StoreBlock::flush() {
   double* rows[kEntries];
   entry_rows(d, first_, rows);
   if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
-    smooth_.solve(rows, normal_b_only);
+    smooth_.solve(rows, normal_b_only, isa);
   } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
-    polytope_.solve(rows);
+    polytope_.solve(rows, isa);
   } else {
     if (smooth_.count > 0 || polytope_.count > 0) {
       double* buffer_rows[kEntries];
@@ -350,6 +350,7 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
   detail::for_pairs(threads, batch.size(), [&](std::size_t begin, std::size_t end) {
     detail::StoreBlock out(derivatives);
     out.normal_b_only = normal_b_only;
+    out.isa = isa;
     for (std::size_t i = begin; i < end; ++i) differentiate_pair(shapes, batch, results, options, isa, i, out);
   });
 }
