@@ -958,6 +958,10 @@ template <class T> struct WideGjk {
 
   /// reset_search() for the lanes of `bits` at once, `init` their (non-zero) initial directions: the same values,
   /// one masked blend per field (the batch-array boolean refill, WideGjkPairs' load_lanes()). Keep the two alike.
+  /// Its only callers are boolean loops (loop()'s `batch`), which never read the Newton fields (no Newton step;
+  /// finish()'s newton_steps stays the zero a Lanes starts with): they are left as they are (three blends and a
+  /// test per refill). (reset_search() keeps them: skipping them there by a run flag cost the witness rows the
+  /// flag's test, +4-5 instructions per pair, callgrind AVX2.)
   AI static void reset_search_lanes(Lanes& L, std::uint32_t bits, const V3& init) {
     const mask m = lanes_of(bits), none = splat_mask(0);
     const real zero = splat(T(0));
@@ -970,10 +974,6 @@ template <class T> struct WideGjk {
     L.lower = select(m, splat(-std::numeric_limits<T>::infinity()), L.lower);
     L.k = select(m, none, L.k);
     L.stale = select(m, none, L.stale);
-    if (L.newton_pair < 0) [[unlikely]] L.newton_pair = newton_pair_type(L.A.type, L.B.type) ? 1 : 0;
-    L.newton = select(m, splat_mask(-Int(L.newton_pair)), L.newton);
-    L.newton_next = select(m, none, L.newton_next);
-    L.newton_steps = select(m, none, L.newton_steps);
   }
 
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {

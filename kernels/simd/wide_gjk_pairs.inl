@@ -271,10 +271,10 @@ template <class T> struct WideGjkPairs {
       const Chunk& c = chunk;
       LanePair& lp = lane[l];
       lp.pair = c.pair[s];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) lp.Ra[j][i] = c.Ra[3 * i + j][s];
-      if (witness)
-        for (int i = 0; i < 3; ++i) lp.ta[i] = c.ta[i][s];
+      // Whole vectors, built in registers and stored once each: element stores (GCC merged them into a 16-byte and
+      // an 8-byte store per column) make put_world()'s 32-byte loads of them wait on a failed store forward.
+      for (int j = 0; j < 3; ++j) lp.Ra[j] = d4{c.Ra[j][s], c.Ra[3 + j][s], c.Ra[6 + j][s], 0.0};
+      if (witness) lp.ta = d4{c.ta[0][s], c.ta[1][s], c.ta[2][s], 0.0};
       lp.radius_a = c.radius_a[s];
       lp.radius_b = c.radius_b[s];
       lp.radii = c.radii[s];
