@@ -665,8 +665,8 @@ template <class T> struct WideGjk {
       if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
         if (!L.rim_given) {
           if (box_ellipsoid_pair(L.A.type, L.B.type)) {
-            const real sa[3] = {L.A.s0, L.A.s1, L.A.s2}, sb[3] = {L.B.s0, L.B.s1, L.B.s2};
-            box_ellipsoid_candidate(L.A.type, L.R, L.t, sa, sb, L.rim_a, L.rim_b);
+            box_ellipsoid_candidate(L.A.type, L.R, L.t, L.A.s0, L.A.s1, L.A.s2, L.B.s0, L.B.s1, L.B.s2, L.rim_a,
+                                    L.rim_b);
           } else {
             rim_candidate(L.A.type, L.B.type, L.R, L.t, L.A.s0, L.A.s1, L.B.s0, L.B.s1, L.rim_a, L.rim_b);
           }

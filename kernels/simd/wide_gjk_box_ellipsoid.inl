@@ -148,9 +148,13 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
 /// box_ellipsoid_point() for W pairs of a box_ellipsoid_pair() type, A's frame: R (row-major), t: B's pose in A's
 /// frame; sa, sb: the cores' sizes (a box's half extents, an ellipsoid's radii). With the box as B the ellipsoid's
 /// pose in B's frame is (R^T, -R^T t), and the points are mapped back by R and t. Computed where the pairs are set
-/// up, W at a time (WideGjkPairs' fill_slots()), as rim_candidate().
-__attribute__((noinline)) static void box_ellipsoid_candidate(ShapeType ta, const real* R, const real* t,
-                                                              const real* sa, const real* sb, V3& pa, V3& pb) {
+/// up, W at a time (WideGjkPairs' fill_slots()), as rim_candidate(). The sizes by value: passing fill_slots()'s
+/// size arrays by address made it keep its sides' values in memory in every run, boolean runs included (+6
+/// instructions per pair in run_certified(), boolean box-ellipsoid and box-cylinder double, callgrind AVX2).
+__attribute__((noinline)) static void box_ellipsoid_candidate(ShapeType ta, const real* R, const real* t, real a0,
+                                                              real a1, real a2, real b0, real b1, real b2, V3& pa,
+                                                              V3& pb) {
+  const real sa[3] = {a0, a1, a2}, sb[3] = {b0, b1, b2};
   if (ta == ShapeType::box) {
     box_ellipsoid_point(R, V3{t[0], t[1], t[2]}, sb, sa, pa, pb);
     return;
