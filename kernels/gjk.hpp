@@ -160,5 +160,15 @@ constexpr bool rim_start_pair(ShapeType a, ShapeType b) {
 /// Newton steps on the rim angle per rim-lateral candidate (mean iterations, close witness double cylinder-cylinder,
 /// 20000 pairs, without rim starts 17.70: 1 step 11.15, 2 steps 8.96, 3 steps 8.22).
 constexpr int kRimNewtonSteps = 3;
+/// Pair types whose double distance / witness lanes may start from a box-ellipsoid closed-form point
+/// (kernels/simd/wide_gjk_box_ellipsoid.inl): the nearest box face, edge or vertex against the ellipsoid.
+constexpr bool box_ellipsoid_pair(ShapeType a, ShapeType b) {
+  return (a == ShapeType::box && b == ShapeType::ellipsoid) || (a == ShapeType::ellipsoid && b == ShapeType::box);
+}
+/// Pair types with any closed-form start candidate (start() takes the lane's rim_a / rim_b).
+constexpr bool start_candidate_pair(ShapeType a, ShapeType b) { return rim_start_pair(a, b) || box_ellipsoid_pair(a, b); }
+/// Newton steps on the edge angle and on the vertex's Lagrange multiplier (box_ellipsoid_point()).
+constexpr int kBoxEdgeNewtonSteps = 3;
+constexpr int kBoxVertexNewtonSteps = 3;
 
 }  // namespace batchcol::kernels

@@ -638,7 +638,8 @@ template <class T> struct WideGjk {
     std::int64_t pair[W];      // pair index of each lane, -1 when empty
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
     int newton_pair = -1;     // newton_pair_type(A.type, B.type), set by the first refill of the run; -1: not yet
-    // rim_start_pair() runs of double: each refilled lane's rim_candidate() (NaN: none), which start() takes as the
+    // start_candidate_pair() runs of double: each refilled lane's rim_candidate() or box_ellipsoid_candidate() (NaN:
+    // none), which start() takes as the
     // first point where it is closer than the first support point (and side_start()'s). `rim_given`: the source
     // wrote them at refill (WideGjkPairs, from its W-pair set-up); else start() computes them.
     bool rim_given = false;
@@ -661,8 +662,15 @@ template <class T> struct WideGjk {
     L.last_s = pick(m, sw, L.last_s);
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     if constexpr (std::is_same_v<T, double>) {
-      if (side && rim_start_pair(L.A.type, L.B.type)) {
-        if (!L.rim_given) rim_candidate(L.A.type, L.B.type, L.R, L.t, L.A.s0, L.A.s1, L.B.s0, L.B.s1, L.rim_a, L.rim_b);
+      if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
+        if (!L.rim_given) {
+          if (box_ellipsoid_pair(L.A.type, L.B.type)) {
+            box_ellipsoid_candidate(L.A.type, L.R, L.t, L.A.s0, L.A.s1, L.A.s2, L.B.s0, L.B.s1, L.B.s2, L.rim_a,
+                                    L.rim_b);
+          } else {
+            rim_candidate(L.A.type, L.B.type, L.R, L.t, L.A.s0, L.A.s1, L.B.s0, L.B.s1, L.rim_a, L.rim_b);
+          }
+        }
         take_start(L, m & ~L.boolean_only, L.rim_a, L.rim_b);
       }
     }
@@ -840,6 +848,8 @@ template <class T> struct WideGjk {
       }
     }
   }
+
+#include "kernels/simd/wide_gjk_box_ellipsoid.inl"
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
   struct SideStart {

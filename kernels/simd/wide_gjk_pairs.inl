@@ -36,7 +36,7 @@ template <class T> struct WideGjkPairs {
     T size_a[3][N], size_b[3][N], radius_a[N], radius_b[N];
     T radii[N], scale[N], floor[N], tolerance[N], core_margin[N];
     T init[3][N];
-    T rim[6][N];  // rim runs (Source::rim): WideGjk::rim_candidate()'s points of A and B, A's frame
+    T rim[6][N];  // rim / box-ellipsoid runs (Source::rim, box_ell): the start candidate's points of A and B, A's frame
   };
   struct Chunk : Slots<kChunk> {
     static_assert(kChunk <= 64, "one bit per slot");
@@ -129,8 +129,11 @@ template <class T> struct WideGjkPairs {
     std::size_t fallbacks = 0;
     std::size_t read = 0;  // pairs[0 .. read) went into a chunk
     bool witness = options.level >= QueryLevel::witness;
-    /// Double distance / witness runs of a rim_start_pair() type: the slots carry rim_candidate()'s start points.
-    bool rim = std::is_same_v<T, double> && options.level != QueryLevel::boolean && rim_start_pair(type_a, type_b);
+    /// Double distance / witness runs of a start_candidate_pair() type: the slots carry start points,
+    /// rim_candidate()'s or (box_ell) box_ellipsoid_candidate()'s. One flag for both where the lanes read them:
+    /// a second test in load() cost boolean box-cylinder double +6 instructions per pair (callgrind, AVX2).
+    bool rim = std::is_same_v<T, double> && options.level != QueryLevel::boolean && start_candidate_pair(type_a, type_b);
+    bool box_ell = rim && box_ellipsoid_pair(type_a, type_b);
     /// The same for every pair of the run (gjk_limits() and the solver): set once per run in every lane by
     /// start_run(); a refill sets only what differs per pair (momentum too: the loop clears it per lane).
     Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
@@ -222,7 +225,11 @@ template <class T> struct WideGjkPairs {
         if constexpr (std::is_same_v<T, double>) {
           if (rim) {
             typename G::V3 qa, qb;
-            G::rim_candidate(type_a, type_b, R, t, A.size[0], A.size[1], B.size[0], B.size[1], qa, qb);
+            if (box_ell)
+              G::box_ellipsoid_candidate(type_a, R, t, A.size[0], A.size[1], A.size[2], B.size[0], B.size[1],
+                                        B.size[2], qa, qb);
+            else
+              G::rim_candidate(type_a, type_b, R, t, A.size[0], A.size[1], B.size[0], B.size[1], qa, qb);
             const tvec q[6] = {qa.x, qa.y, qa.z, qb.x, qb.y, qb.z};
             for (int c = 0; c < 6; ++c) put(chunk.rim[c] + s, q[c]);
           }

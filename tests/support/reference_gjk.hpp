@@ -18,6 +18,7 @@
 
 #include "kernels/gjk.hpp"
 #include "kernels/minkowski.hpp"
+#include "support/reference_box_ellipsoid.hpp"
 #include "support/reference_simplex_projection.hpp"
 
 #include <algorithm>
@@ -353,6 +354,16 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (!params.boolean_only && rim_start_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
       if (rim_candidate(D, p) && norm2(p.w) < norm2(x)) {
+        S.v[0] = p;
+        x = p.w;
+        last_s = x;
+        momentum = false;
+      }
+    }
+    // Box-ellipsoid pairs (double): the closest face / edge / vertex point of D where it is closer (the same).
+    if (!params.boolean_only && box_ellipsoid_pair(D.A->type, D.B->type)) {
+      SupportPoint<T> p;
+      if (box_ellipsoid_candidate(D, p) && norm2(p.w) < norm2(x)) {
         S.v[0] = p;
         x = p.w;
         last_s = x;
