@@ -3,6 +3,7 @@
 // known, and bitwise determinism over thread counts on batches of hulls only (whole lane blocks).
 #include "batchcol/batchcol.hpp"
 #include "support/derivative_reference.hpp"
+#include "support/same_results.hpp"
 
 #include <gtest/gtest.h>
 
@@ -78,10 +79,6 @@ TEST(DerivativesPolytope, HullFeaturesAreTheOnesTheNormalExposes) {
   EXPECT_NEAR(Ja(0, 0), 0.0, 1e-12);  // not off the face
 }
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
-}
-
 // Hulls only: every 8-pair block is a whole block of polytope lanes, written straight to the output arrays, and the
 // task ranges split the batch differently for each thread count.
 TEST(DerivativesPolytope, HullPairsBitwiseIdenticalForAnyThreadCount) {
@@ -100,15 +97,7 @@ TEST(DerivativesPolytope, HullPairsBitwiseIdenticalForAnyThreadCount) {
   for (std::size_t i = 0; i < batch.size(); ++i) defined += d[0].status[i] != DerivativeStatus::no_witness;
   EXPECT_GE(defined, 1150);
   for (int k = 1; k < 3; ++k) {
-    EXPECT_EQ(d[0].status, d[k].status);
-    EXPECT_TRUE(same_bits(d[0].distance_gradient_a.data, d[k].distance_gradient_a.data));
-    EXPECT_TRUE(same_bits(d[0].distance_gradient_b.data, d[k].distance_gradient_b.data));
-    EXPECT_TRUE(same_bits(d[0].witness_a_wrt_a.data, d[k].witness_a_wrt_a.data));
-    EXPECT_TRUE(same_bits(d[0].witness_a_wrt_b.data, d[k].witness_a_wrt_b.data));
-    EXPECT_TRUE(same_bits(d[0].witness_b_wrt_a.data, d[k].witness_b_wrt_a.data));
-    EXPECT_TRUE(same_bits(d[0].witness_b_wrt_b.data, d[k].witness_b_wrt_b.data));
-    EXPECT_TRUE(same_bits(d[0].normal_wrt_a.data, d[k].normal_wrt_a.data));
-    EXPECT_TRUE(same_bits(d[0].normal_wrt_b.data, d[k].normal_wrt_b.data));
+    expect_same_derivatives(d[0], d[k], "threads " + std::to_string(threads[k]));
   }
 }
 
@@ -140,27 +129,13 @@ TEST(DerivativesPolytope, WholeBlocksGiveTheSameBitsOnEveryInstructionSet) {
       for (const DerivativeStatus s : reference.status)
         solved += s == DerivativeStatus::smooth || s == DerivativeStatus::zero_curvature;
       EXPECT_GE(solved, int(batch->size() * 9 / 10));
-      for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
-        try {
-          resolve_instruction_set(isa);
-        } catch (const InputError&) {
-          continue;  // not on this CPU
-        }
+      for (InstructionSet isa : vector_isas_here()) {
         ++compared;
         q.isa = isa;
         DerivativeResults d;
         differentiate(shapes, *batch, q, *o, r, d);
         const std::string label = std::string(to_string(isa)) + (o == &analytic ? " analytic" : " smoothed1");
-        EXPECT_EQ(d.status, reference.status) << label;
-        EXPECT_TRUE(same_bits(d.distance_gradient_a.data, reference.distance_gradient_a.data)) << label;
-        EXPECT_TRUE(same_bits(d.distance_gradient_b.data, reference.distance_gradient_b.data)) << label;
-        for (const auto& [x, y] : {std::pair{&d.witness_a_wrt_a, &reference.witness_a_wrt_a},
-                                   std::pair{&d.witness_a_wrt_b, &reference.witness_a_wrt_b},
-                                   std::pair{&d.witness_b_wrt_a, &reference.witness_b_wrt_a},
-                                   std::pair{&d.witness_b_wrt_b, &reference.witness_b_wrt_b},
-                                   std::pair{&d.normal_wrt_a, &reference.normal_wrt_a},
-                                   std::pair{&d.normal_wrt_b, &reference.normal_wrt_b}})
-          EXPECT_TRUE(same_bits(x->data, y->data)) << label;
+        expect_same_derivatives(reference, d, label);
       }
     }
   std::printf("%d (batch, method, instruction set) runs compared with scalar\n", compared);

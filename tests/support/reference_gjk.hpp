@@ -338,37 +338,34 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
-  // Cylinder / capsule pairs: the closed-form side contact replaces the first support point where it is closer,
-  // and the first step is then a plain one (wide_gjk.inl's side_start()).
-  if (!params.boolean_only && side_start_pair(D.A->type, D.B->type)) {
-    SupportPoint<T> p;
-    if (side_start(D, p) && norm2(p.w) < norm2(x)) {
+  // A closed-form start point replaces the first support point where it is closer; the first step is then a plain
+  // one (wide_gjk.inl's start()).
+  const auto take_start = [&](bool found, const SupportPoint<T>& p) {
+    if (found && norm2(p.w) < norm2(x)) {
       S.v[0] = p;
       x = p.w;
       last_s = x;
       momentum = false;
     }
+  };
+  // Cylinder / capsule pairs: the closed-form side contact (wide_gjk.inl's side_start()).
+  if (!params.boolean_only && side_start_pair(D.A->type, D.B->type)) {
+    SupportPoint<T> p;
+    const bool found = side_start(D, p);
+    take_start(found, p);
   }
-  // Rim-lateral pairs (double): the closest rim-lateral point of D where it is closer (wide_gjk.inl's start()).
   if constexpr (std::is_same_v<T, double>) {
+    // Rim-lateral pairs (double): the closest rim-lateral point of D.
     if (!params.boolean_only && rim_start_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
-      if (rim_candidate(D, p) && norm2(p.w) < norm2(x)) {
-        S.v[0] = p;
-        x = p.w;
-        last_s = x;
-        momentum = false;
-      }
+      const bool found = rim_candidate(D, p);
+      take_start(found, p);
     }
-    // Box-ellipsoid pairs (double): the closest face / edge / vertex point of D where it is closer (the same).
+    // Box-ellipsoid pairs (double): the closest face / edge / vertex point of D.
     if (!params.boolean_only && box_ellipsoid_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
-      if (box_ellipsoid_candidate(D, p) && norm2(p.w) < norm2(x)) {
-        S.v[0] = p;
-        x = p.w;
-        last_s = x;
-        momentum = false;
-      }
+      const bool found = box_ellipsoid_candidate(D, p);
+      take_start(found, p);
     }
   }
   T lower_bound = -std::numeric_limits<T>::infinity();

@@ -29,4 +29,30 @@ inline void expect_same_results(const PairResults& want, const PairResults& got,
         << label;
 }
 
+/// The vector instruction sets this CPU runs (avx2, avx512), to compare each with the scalar one.
+inline std::vector<InstructionSet> vector_isas_here() {
+  std::vector<InstructionSet> isas;
+  for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
+    try {
+      resolve_instruction_set(isa);
+      isas.push_back(isa);
+    } catch (const InputError&) {
+      // not on this CPU
+    }
+  }
+  return isas;
+}
+
+/// Expects the status, both distance gradients and the six Jacobians of `got` bitwise equal to `want`'s.
+inline void expect_same_derivatives(const DerivativeResults& want, const DerivativeResults& got,
+                                    const std::string& label) {
+  EXPECT_EQ(want.status, got.status) << label;
+  EXPECT_TRUE(same_bits(want.distance_gradient_a.data, got.distance_gradient_a.data)) << label;
+  EXPECT_TRUE(same_bits(want.distance_gradient_b.data, got.distance_gradient_b.data)) << label;
+  for (auto m : {&DerivativeResults::witness_a_wrt_a, &DerivativeResults::witness_a_wrt_b,
+                 &DerivativeResults::witness_b_wrt_a, &DerivativeResults::witness_b_wrt_b,
+                 &DerivativeResults::normal_wrt_a, &DerivativeResults::normal_wrt_b})
+    EXPECT_TRUE(same_bits((want.*m).data, (got.*m).data)) << label;
+}
+
 }  // namespace batchcol::testing
