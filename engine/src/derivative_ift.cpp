@@ -68,10 +68,10 @@ using V = double __attribute__((vector_size(16)));
 // Runs body(l, both, put) for every register of two lanes l, l + 1 < count (both: the second lane is used), put(e,
 // v) writing entry e of the register to out[e][column[lane]]. Compiled twice, so that the common case (a full block
 // of whole registers to consecutive columns) has a fixed trip count, whole-vector stores and no per-store test.
+template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column);
 template <std::size_t kLanes, class Body>
 void run_lanes(std::size_t count, const std::size_t* column, double* const* out, const Body& body) {
-  bool columns_in_order = count == kLanes;
-  for (std::size_t l = 0; l < count; ++l) columns_in_order = columns_in_order && column[l] == l;
+  const bool columns_in_order = whole_block<kLanes>(count, column);
   const auto run = [&](auto in_order_tag) {
     constexpr bool in_order = decltype(in_order_tag)::value;
     const std::size_t lanes = in_order ? kLanes : count;
@@ -95,7 +95,8 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
   else run(std::false_type{});
 }
 
-// A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path.
+// A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path, and run_lanes()'s
+// fixed-trip-count case.
 template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
   bool in_order = count == kLanes;
   for (std::size_t l = 0; l < count; ++l) in_order = in_order && column[l] == l;
@@ -107,33 +108,40 @@ template <std::size_t kLanes> bool whole_block(std::size_t count, const std::siz
 // The lanes' bodies (derivative_lanes.inl): two lanes per SSE2 register for any block, and a whole block of eight
 // lanes in one AVX-512 register (two AVX2 registers) for the wide sets. PolytopeLanes::solve() in SSE2 was ~500
 // instructions per hull pair (callgrind, AVX2 build), a third of the analytic derivative's own cost.
-// Each set's sqrt_lanes() (the .inl's lanes' square roots: IEEE square roots are correctly rounded, so every lane
-// gets std::sqrt()'s bits; GCC emitted one scalar sqrt per lane with the lane moves for the element-wise form).
+// Each set has its own sqrt_lanes() for the .inl's square roots because GCC emitted one scalar sqrt per lane, with
+// the lane moves, for the element-wise form; IEEE square roots are correctly rounded, so every lane still gets
+// std::sqrt()'s bits. They sit in anonymous namespaces: internal linkage, like everything in the .inl.
 namespace {
 using V8 = double __attribute__((vector_size(64)));
 }  // namespace
 namespace lanes_base {
+namespace {
 inline __attribute__((always_inline)) V sqrt_lanes(const V& x) { return (V)_mm_sqrt_pd((__m128d)x); }
+}  // namespace
 #include "derivative_lanes.inl"
 }  // namespace lanes_base
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
 namespace lanes_avx512 {
+namespace {
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   // The masked form: _mm512_sqrt_pd()'s undefined source trips GCC 12's -Wuninitialized.
   return (V8)_mm512_mask_sqrt_pd((__m512d)x, 0xFF, (__m512d)x);
 }
+}  // namespace
 #include "derivative_lanes.inl"
 }  // namespace lanes_avx512
 #pragma GCC pop_options
 #pragma GCC push_options
 #pragma GCC target("avx2")
 namespace lanes_avx2 {
+namespace {
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   const __m256d lo = _mm256_sqrt_pd(__m256d{x[0], x[1], x[2], x[3]});
   const __m256d hi = _mm256_sqrt_pd(__m256d{x[4], x[5], x[6], x[7]});
   return V8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
 }
+}  // namespace
 #include "derivative_lanes.inl"
 }  // namespace lanes_avx2
 #pragma GCC pop_options
@@ -143,10 +151,8 @@ inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
 // Only the twist of a is solved, y = K F_a = [K, K Fa_w] (Fa_w = H_a [n]x - [x_a]x), and
 //   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
 //   I - sd K),   dn/dxi_a = -(I - n n^T) y;
-// the twist of b by the rigid-motion identity (as write_from_twist_a()). One loop over the lanes of a block of
-// pairs, every entry written to out[e][lane]: the compiler runs the lanes in SIMD registers and the stores are
-// whole vectors. Per pair through Eigen's fixed-size products this cost ~1150 instructions, written out in scalars
-// per pair still ~1300 with the stores (callgrind, 4096 ellipsoid pairs).
+// the twist of b by the rigid-motion identity (as write_from_twist_a()); the lanes' arithmetic is in
+// derivative_lanes.inl. Here: which set's lanes run a block (the wide ones only for a whole block on AVX2 / AVX-512).
 void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa) const {
   if (normal_b_only) {
     if (curved) solve_lanes<true, true>(out, isa);

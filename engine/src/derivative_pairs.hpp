@@ -101,8 +101,10 @@ void size_for(DerivativeResults& d, std::size_t n, bool smoothed);
 
 /// The analytic derivatives as differentiate_results() computes them, for the smoothed0 samples' first-order start:
 /// statuses and normal_wrt_b are those bits; the smooth pairs (SmoothLanes) write no other entry, the rest may.
+/// `isa` (resolved) is the query's, so that a query pinned to an instruction set runs that set's lanes here too.
 void analytic_normal_b(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                       const DerivativeOptions& analytic, int threads, DerivativeResults& derivatives);
+                       const DerivativeOptions& analytic, int threads, InstructionSet isa,
+                       DerivativeResults& derivatives);
 
 /// The 0th-order estimator (derivative_smoothed0.cpp); `results` holds the unperturbed query.
 void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOptions& query,

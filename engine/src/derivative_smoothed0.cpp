@@ -633,7 +633,7 @@ void smoothed0(const ShapeTable& shapes, const PairBatch& batch, const QueryOpti
   if (any_curved) {
     DerivativeOptions analytic = o;
     analytic.method = DerivativeMethod::analytic;
-    analytic_normal_b(shapes, batch, results, analytic, query.threads, predictor);
+    analytic_normal_b(shapes, batch, results, analytic, query.threads, resolve_instruction_set(query.isa), predictor);
   }
   QueryOptions q = query;
   q.solver = resolve_solver(query.solver, query.level);

@@ -358,8 +358,9 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
 }  // namespace
 
 void analytic_normal_b(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                       const DerivativeOptions& analytic, int threads, DerivativeResults& derivatives) {
-  differentiate_results_on(shapes, batch, results, analytic, threads, resolve_instruction_set(), derivatives, true);
+                       const DerivativeOptions& analytic, int threads, InstructionSet isa,
+                       DerivativeResults& derivatives) {
+  differentiate_results_on(shapes, batch, results, analytic, threads, isa, derivatives, true);
 }
 }  // namespace detail
 

@@ -639,9 +639,9 @@ template <class T> struct WideGjk {
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
     int newton_pair = -1;     // newton_pair_type(A.type, B.type), set by the first refill of the run; -1: not yet
     // start_candidate_pair() runs of double: each refilled lane's rim_candidate() or box_ellipsoid_candidate() (NaN:
-    // none), which start() takes as the
-    // first point where it is closer than the first support point (and side_start()'s). `rim_given`: the source
-    // wrote them at refill (WideGjkPairs, from its W-pair set-up); else start() computes them.
+    // none), which start() takes as the first point where it is closer than the first support point (and
+    // side_start()'s). `rim_given`: the source wrote them at refill (WideGjkPairs, from its W-pair set-up); else
+    // start() computes them.
     bool rim_given = false;
     V3 rim_a, rim_b;
   };
@@ -663,14 +663,9 @@ template <class T> struct WideGjk {
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     if constexpr (std::is_same_v<T, double>) {
       if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
-        if (!L.rim_given) {
-          if (box_ellipsoid_pair(L.A.type, L.B.type)) {
-            box_ellipsoid_candidate(L.A.type, L.R, L.t, L.A.s0, L.A.s1, L.A.s2, L.B.s0, L.B.s1, L.B.s2, L.rim_a,
-                                    L.rim_b);
-          } else {
-            rim_candidate(L.A.type, L.B.type, L.R, L.t, L.A.s0, L.A.s1, L.B.s0, L.B.s1, L.rim_a, L.rim_b);
-          }
-        }
+        if (!L.rim_given)
+          start_candidate(box_ellipsoid_pair(L.A.type, L.B.type), L.A.type, L.B.type, L.R, L.t,
+                          {L.A.s0, L.A.s1, L.A.s2}, {L.B.s0, L.B.s1, L.B.s2}, L.rim_a, L.rim_b);
         take_start(L, m & ~L.boolean_only, L.rim_a, L.rim_b);
       }
     }
@@ -807,6 +802,15 @@ template <class T> struct WideGjk {
   /// half-length). pa, pb: A's and B's points in A's frame, NaN where no candidate is valid.
   /// Computed where the pairs are set up, W at a time (WideGjkPairs' fill_slots()): per refilled lane its ~50
   /// divisions and square roots made cylinder-cylinder slower in wall time although 34% fewer instructions.
+  /// The closed-form start candidate of a start_candidate_pair() run (`box_ell`: box_ellipsoid_pair(ta, tb), decided
+  /// once per run by the caller), in A's frame: pa, pb (NaN where there is none). One place for the choice, which the
+  /// lanes' start() and WideGjkPairs' chunk set-up both make.
+  AI static void start_candidate(bool box_ell, ShapeType ta, ShapeType tb, const real* R, const real* t,
+                                 const real (&a)[3], const real (&b)[3], V3& pa, V3& pb) {
+    if (box_ell) box_ellipsoid_candidate(ta, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
+    else rim_candidate(ta, tb, R, t, a[0], a[1], b[0], b[1], pa, pb);
+  }
+
   __attribute__((noinline)) static void rim_candidate(ShapeType ta, ShapeType tb, const real* R, const real* t,
                                                       real a0, real a1, real b0, real b1, V3& pa, V3& pb) {
     const real zero = splat(T(0)), nan = splat(std::numeric_limits<T>::quiet_NaN());
@@ -967,8 +971,8 @@ template <class T> struct WideGjk {
   }
 
   /// reset_search() for the lanes of `bits` at once, `init` their (non-zero) initial directions: the same values,
-  /// one masked blend per field (the batch-array boolean refill, WideGjkPairs' load_lanes()). Keep the two alike.
-  /// Its only callers are boolean loops (loop()'s `batch`), which never read the Newton fields (no Newton step;
+  /// one masked blend per field (the batch-array boolean refill, WideGjkPairs' load_lanes()); the same values as
+  /// reset_search() for every field but the Newton ones. Its only callers are boolean loops (loop()'s `batch`), which never read the Newton fields (no Newton step;
   /// finish()'s newton_steps stays the zero a Lanes starts with): they are left as they are (three blends and a
   /// test per refill). (reset_search() keeps them: skipping them there by a run flag cost the witness rows the
   /// flag's test, +4-5 instructions per pair, callgrind AVX2.)

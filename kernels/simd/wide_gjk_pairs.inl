@@ -225,11 +225,7 @@ template <class T> struct WideGjkPairs {
         if constexpr (std::is_same_v<T, double>) {
           if (rim) {
             typename G::V3 qa, qb;
-            if (box_ell)
-              G::box_ellipsoid_candidate(type_a, R, t, A.size[0], A.size[1], A.size[2], B.size[0], B.size[1],
-                                        B.size[2], qa, qb);
-            else
-              G::rim_candidate(type_a, type_b, R, t, A.size[0], A.size[1], B.size[0], B.size[1], qa, qb);
+            G::start_candidate(box_ell, type_a, type_b, R, t, A.size, B.size, qa, qb);
             const tvec q[6] = {qa.x, qa.y, qa.z, qb.x, qb.y, qb.z};
             for (int c = 0; c < 6; ++c) put(chunk.rim[c] + s, q[c]);
           }
