@@ -795,13 +795,7 @@ template <class T> struct WideGjk {
       py = add(add(c, scale(vb, b)), scale(ry / rho, e));
     }
   }
-  /// The closest of the rim-lateral points of D (rim_lateral()) of W pairs of a rim_start_pair() type: A's rims
-  /// against B's lateral surface (A's frame), then B's against A's (B's frame: A's centre -R^T t, axis R^T e_z;
-  /// mapped back by R and t), a cylinder's rim at +h before -h; a later one only where strictly closer. R
-  /// (row-major), t: B's pose in A's frame; a0, a1 / b0, b1: the cores' radius and half-height (a capsule's
-  /// half-length). pa, pb: A's and B's points in A's frame, NaN where no candidate is valid.
-  /// Computed where the pairs are set up, W at a time (WideGjkPairs' fill_slots()): per refilled lane its ~50
-  /// divisions and square roots made cylinder-cylinder slower in wall time although 34% fewer instructions.
+
   /// The closed-form start candidate of a start_candidate_pair() run (`box_ell`: box_ellipsoid_pair(ta, tb), decided
   /// once per run by the caller), in A's frame: pa, pb (NaN where there is none). One place for the choice, which the
   /// lanes' start() and WideGjkPairs' chunk set-up both make.
@@ -811,6 +805,13 @@ template <class T> struct WideGjk {
     else rim_candidate(ta, tb, R, t, a[0], a[1], b[0], b[1], pa, pb);
   }
 
+  /// The closest of the rim-lateral points of D (rim_lateral()) of W pairs of a rim_start_pair() type: A's rims
+  /// against B's lateral surface (A's frame), then B's against A's (B's frame: A's centre -R^T t, axis R^T e_z;
+  /// mapped back by R and t), a cylinder's rim at +h before -h; a later one only where strictly closer. R
+  /// (row-major), t: B's pose in A's frame; a0, a1 / b0, b1: the cores' radius and half-height (a capsule's
+  /// half-length). pa, pb: A's and B's points in A's frame, NaN where no candidate is valid.
+  /// Computed where the pairs are set up, W at a time (WideGjkPairs' fill_slots()): per refilled lane its ~50
+  /// divisions and square roots made cylinder-cylinder slower in wall time although 34% fewer instructions.
   __attribute__((noinline)) static void rim_candidate(ShapeType ta, ShapeType tb, const real* R, const real* t,
                                                       real a0, real a1, real b0, real b1, V3& pa, V3& pb) {
     const real zero = splat(T(0)), nan = splat(std::numeric_limits<T>::quiet_NaN());
@@ -972,9 +973,9 @@ template <class T> struct WideGjk {
 
   /// reset_search() for the lanes of `bits` at once, `init` their (non-zero) initial directions: the same values,
   /// one masked blend per field (the batch-array boolean refill, WideGjkPairs' load_lanes()); the same values as
-  /// reset_search() for every field but the Newton ones. Its only callers are boolean loops (loop()'s `batch`), which never read the Newton fields (no Newton step;
-  /// finish()'s newton_steps stays the zero a Lanes starts with): they are left as they are (three blends and a
-  /// test per refill). (reset_search() keeps them: skipping them there by a run flag cost the witness rows the
+  /// reset_search() for every field but the Newton ones. Its only callers are boolean loops (loop()'s `batch`),
+  /// which never read the Newton fields (no Newton step; finish()'s newton_steps stays the zero a Lanes starts
+  /// with): they are left as they are (three blends and a test per refill). (reset_search() keeps them: skipping them there by a run flag cost the witness rows the
   /// flag's test, +4-5 instructions per pair, callgrind AVX2.)
   AI static void reset_search_lanes(Lanes& L, std::uint32_t bits, const V3& init) {
     const mask m = lanes_of(bits), none = splat_mask(0);
