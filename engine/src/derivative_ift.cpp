@@ -65,10 +65,17 @@ void write_from_twist_a(const double n[3], const double xa[3], const double xb[3
 // with GCC/Clang vector extensions: elementwise IEEE operations, so every lane rounds as the scalar code would.
 using V = double __attribute__((vector_size(16)));
 
+// A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path, and run_lanes()'s
+// fixed-trip-count case.
+template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
+  bool in_order = count == kLanes;
+  for (std::size_t l = 0; l < count; ++l) in_order = in_order && column[l] == l;
+  return in_order;
+}
+
 // Runs body(l, both, put) for every register of two lanes l, l + 1 < count (both: the second lane is used), put(e,
 // v) writing entry e of the register to out[e][column[lane]]. Compiled twice, so that the common case (a full block
 // of whole registers to consecutive columns) has a fixed trip count, whole-vector stores and no per-store test.
-template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column);
 template <std::size_t kLanes, class Body>
 void run_lanes(std::size_t count, const std::size_t* column, double* const* out, const Body& body) {
   const bool columns_in_order = whole_block<kLanes>(count, column);
@@ -93,14 +100,6 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
   };
   if (columns_in_order) run(std::true_type{});
   else run(std::false_type{});
-}
-
-// A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path, and run_lanes()'s
-// fixed-trip-count case.
-template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
-  bool in_order = count == kLanes;
-  for (std::size_t l = 0; l < count; ++l) in_order = in_order && column[l] == l;
-  return in_order;
 }
 
 }  // namespace
