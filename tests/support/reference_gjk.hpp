@@ -19,6 +19,7 @@
 #include "kernels/gjk.hpp"
 #include "kernels/minkowski.hpp"
 #include "support/reference_box_ellipsoid.hpp"
+#include "support/reference_box_round.hpp"
 #include "support/reference_simplex_projection.hpp"
 
 #include <algorithm>
@@ -365,6 +366,12 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (!params.boolean_only && box_ellipsoid_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
       const bool found = box_ellipsoid_candidate(D, p);
+      take_start(found, p);
+    }
+    // Box-cylinder / box-cone pairs (double): the closest face / edge / vertex / apex point of D.
+    if (!params.boolean_only && box_round_pair(D.A->type, D.B->type)) {
+      SupportPoint<T> p;
+      const bool found = box_round_candidate(D, p);
       take_start(found, p);
     }
   }
