@@ -161,9 +161,11 @@ constexpr bool rim_start_pair(ShapeType a, ShapeType b) {
 /// 20000 pairs, without rim starts 17.70: 1 step 11.15, 2 steps 8.96, 3 steps 8.22).
 constexpr int kRimNewtonSteps = 3;
 /// Pair types whose double distance / witness lanes may start from a box-ellipsoid closed-form point
-/// (kernels/simd/wide_gjk_box_ellipsoid.inl): the nearest box face, edge or vertex against the ellipsoid.
+/// (kernels/simd/wide_gjk_box_ellipsoid.inl): the nearest box face, edge or vertex against the ellipsoid; a
+/// capsule's core is a box with two zero extents (its segment), a sphere's a box with three (its centre).
 constexpr bool box_ellipsoid_pair(ShapeType a, ShapeType b) {
-  return (a == ShapeType::box && b == ShapeType::ellipsoid) || (a == ShapeType::ellipsoid && b == ShapeType::box);
+  const auto flat = [](ShapeType t) { return t == ShapeType::box || t == ShapeType::capsule || t == ShapeType::sphere; };
+  return (flat(a) && b == ShapeType::ellipsoid) || (a == ShapeType::ellipsoid && flat(b));
 }
 /// Pair types whose double distance / witness lanes may start from a box-cylinder or box-cone closed-form point
 /// (kernels/simd/wide_gjk_box_round.inl): a box face, edge or vertex against the round core's rim, side or apex.
@@ -181,6 +183,8 @@ constexpr int kEdgeRimSamples = 12;
 constexpr double kEdgeRimCos[kEdgeRimSamples / 2] = {1.0, 0.8660254037844387, 0.5, 0.0, -0.5, -0.8660254037844387};
 constexpr double kEdgeRimSin[kEdgeRimSamples / 2] = {0.0, 0.5, 0.8660254037844387, 1.0, 0.8660254037844387, 0.5};
 constexpr int kEdgeRimNewtonSteps = 3;
+/// The core box_ellipsoid_point() takes: the box, a capsule's segment, a sphere's point.
+constexpr int kBoxCore = 0, kSegmentCore = 1, kPointCore = 2;
 /// Pair types with any closed-form start candidate (start() takes the lane's rim_a / rim_b).
 constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
   return rim_start_pair(a, b) || box_ellipsoid_pair(a, b) || box_round_pair(a, b);
@@ -188,5 +192,8 @@ constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
 /// Newton steps on the edge angle and on the vertex's Lagrange multiplier (box_ellipsoid_point()).
 constexpr int kBoxEdgeNewtonSteps = 3;
 constexpr int kBoxVertexNewtonSteps = 3;
+/// A sphere's or capsule's start is the vertex alone (or nearly): more steps there, where they are the whole cost.
+constexpr int kPointVertexNewtonSteps = 6;
+constexpr int vertex_newton_steps(int core) { return core == kBoxCore ? kBoxVertexNewtonSteps : kPointVertexNewtonSteps; }
 
 }  // namespace batchcol::kernels

@@ -801,7 +801,7 @@ template <class T> struct WideGjk {
   /// lanes' start() and WideGjkPairs' chunk set-up both make.
   AI static void start_candidate(bool box_ell, ShapeType ta, ShapeType tb, const real* R, const real* t,
                                  const real (&a)[3], const real (&b)[3], V3& pa, V3& pb) {
-    if (box_ell) box_ellipsoid_candidate(ta, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
+    if (box_ell) box_ellipsoid_candidate(ta, tb, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
     else if (box_round_pair(ta, tb)) box_round_candidate(ta, tb, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
     else rim_candidate(ta, tb, R, t, a[0], a[1], b[0], b[1], pa, pb);
   }

@@ -34,6 +34,14 @@
 ///   ellipsoid whatever t is).
 /// Every candidate is a point of the box minus a point of the ellipsoid, hence of D; the closest one is kept
 /// (NaN candidates, e.g. a centre on a corner, never are). pa, pb in the box's frame.
+/// `Core`: the box itself (kBoxCore), or a box with zero extents standing for a capsule's core, the segment
+/// h = (0, 0, half length) (kSegmentCore: only the edge along z, the segment itself, and its end toward the
+/// ellipsoid; the faces and the other edges are that end again), or for a sphere's core, the point h = 0
+/// (kPointCore: only the vertex, the nearest ellipsoid point, exact up to the Newton steps). Why: sphere- and
+/// capsule-ellipsoid pairs run GJK on the cores to convergence at the witness level, overlapping spheres and
+/// capsules included (their cores are apart); the demo measured 4.3-4.7 mean iterations on them, 14% of its
+/// instructions (bench/results/history/narrowphase-sessions.md, helper `demo`, 2026-11-27).
+template <int Core>
 AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, const real* h, V3& pa, V3& pb) {
   const real zero = splat(T(0)), one = splat(T(1)), nan = splat(std::numeric_limits<T>::quiet_NaN());
   const real rr[3] = {r[0] * r[0], r[1] * r[1], r[2] * r[2]};
@@ -55,8 +63,8 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
     best = select(take, n2, best);
   };
   // Faces.
-  real gap[3];
-  for (int k = 0; k < 3; ++k) {
+  real gap[3] = {zero, zero, zero};
+  for (int k = 0; k < 3 && Core == kBoxCore; ++k) {
     const real rk = wsqrt<T>(Q[4 * k]);
     gap[k] = (s[k] * cc[k] - rk) - h[k];
     const real f = s[k] / rk;
@@ -68,15 +76,16 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
     keep(qa, qb);
   }
   // The edge along the axis of the smallest gap (k0, k1, k2: that axis is x, y, z); (i, j) = (k + 1, k + 2) mod 3.
-  const mask k0 = (gap[0] <= gap[1]) & (gap[0] <= gap[2]);
-  const mask k1 = ~k0 & (gap[1] <= gap[2]);
+  // A segment's edge is z (kSegmentCore).
+  const mask k0 = Core == kBoxCore ? (gap[0] <= gap[1]) & (gap[0] <= gap[2]) : splat_mask(0);
+  const mask k1 = Core == kBoxCore ? ~k0 & (gap[1] <= gap[2]) : splat_mask(0);
   const mask k2 = ~(k0 | k1);
   const auto by_axis = [&](const real& v0, const real& v1, const real& v2) { return select(k0, v0, select(k1, v1, v2)); };
   const real pp[3] = {s[0] * cc[0] - h[0], s[1] * cc[1] - h[1], s[2] * cc[2] - h[2]};
   const real a = by_axis(Q[4], Q[8], Q[0]), d = by_axis(Q[8], Q[0], Q[4]);
   const real b = by_axis((s[1] * s[2]) * Q[5], (s[2] * s[0]) * Q[2], (s[0] * s[1]) * Q[1]);
   const real p0 = by_axis(pp[1], pp[2], pp[0]), p1 = by_axis(pp[2], pp[0], pp[1]);
-  {
+  if (Core != kPointCore) {
     const real m0 = d * p0 - b * p1, m1 = a * p1 - b * p0;
     const real inv0 = one / wsqrt<T>(m0 * m0 + m1 * m1);
     real C = m0 * inv0, S = m1 * inv0;
@@ -115,7 +124,7 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
       w[k] = rr[k] * (p[k] * p[k]);
     }
     real t = zero;
-    for (int it = 0; it < kBoxVertexNewtonSteps; ++it) {
+    for (int it = 0; it < vertex_newton_steps(Core); ++it) {
       const real e0 = one / (rr[0] + t), e1 = one / (rr[1] + t), e2 = one / (rr[2] + t);
       const real a0 = (w[0] * e0) * e0, a1 = (w[1] * e1) * e1, a2 = (w[2] * e2) * e2;
       const real S = (a0 + a1) + a2;
@@ -146,28 +155,41 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
 }
 
 /// box_ellipsoid_point() for W pairs of a box_ellipsoid_pair() type, A's frame: R (row-major), t: B's pose in A's
-/// frame; sa, sb: the cores' sizes (a box's half extents, an ellipsoid's radii). With the box as B the ellipsoid's
-/// pose in B's frame is (R^T, -R^T t), and the points are mapped back by R and t. Computed where the pairs are set
-/// up, W at a time (WideGjkPairs' fill_slots()), as rim_candidate(). The sizes by value: passing fill_slots()'s
-/// size arrays by address made it keep its sides' values in memory in every run, boolean runs included (+6
+/// frame; sa, sb: the cores' sizes (a box's half extents, an ellipsoid's radii, a capsule's half length as the
+/// second, kernels/shape_core.hpp; a sphere's core has none). With the ellipsoid as A, the other core's pose in
+/// B's frame is (R^T, -R^T t), and the points are mapped back by R and t. Computed where the pairs are set up, W
+/// at a time (WideGjkPairs' fill_slots()), as rim_candidate(). The sizes by value: passing fill_slots()'s size
+/// arrays by address made it keep its sides' values in memory in every run, boolean runs included (+6
 /// instructions per pair in run_certified(), boolean box-ellipsoid and box-cylinder double, callgrind AVX2).
-__attribute__((noinline)) static void box_ellipsoid_candidate(ShapeType ta, const real* R, const real* t, real a0,
-                                                              real a1, real a2, real b0, real b1, real b2, V3& pa,
-                                                              V3& pb) {
-  const real sa[3] = {a0, a1, a2}, sb[3] = {b0, b1, b2};
-  if (ta == ShapeType::box) {
-    box_ellipsoid_point(R, V3{t[0], t[1], t[2]}, sb, sa, pa, pb);
+__attribute__((noinline)) static void box_ellipsoid_candidate(ShapeType ta, ShapeType tb, const real* R, const real* t,
+                                                              real a0, real a1, real a2, real b0, real b1, real b2,
+                                                              V3& pa, V3& pb) {
+  const real zero = splat(T(0));
+  const bool a_flat = ta != ShapeType::ellipsoid;
+  const ShapeType flat = a_flat ? ta : tb;
+  // The flat core's half extents: a box's own, a capsule's segment along z, a sphere's point.
+  const real f1 = a_flat ? a1 : b1;
+  const real h[3] = {flat == ShapeType::box ? (a_flat ? a0 : b0) : zero, flat == ShapeType::box ? f1 : zero,
+                     flat == ShapeType::box ? (a_flat ? a2 : b2) : (flat == ShapeType::capsule ? f1 : zero)};
+  const real r[3] = {a_flat ? b0 : a0, a_flat ? b1 : a1, a_flat ? b2 : a2};
+  const auto point = [&](const real* E, const V3& c, V3& qf, V3& qe) {
+    if (flat == ShapeType::box) box_ellipsoid_point<kBoxCore>(E, c, r, h, qf, qe);
+    else if (flat == ShapeType::capsule) box_ellipsoid_point<kSegmentCore>(E, c, r, h, qf, qe);
+    else box_ellipsoid_point<kPointCore>(E, c, r, h, qf, qe);
+  };
+  if (a_flat) {
+    point(R, V3{t[0], t[1], t[2]}, pa, pb);
     return;
   }
   const real Rt[9] = {R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]};
   const V3 c = {-((R[0] * t[0] + R[3] * t[1]) + R[6] * t[2]), -((R[1] * t[0] + R[4] * t[1]) + R[7] * t[2]),
                 -((R[2] * t[0] + R[5] * t[1]) + R[8] * t[2])};
-  V3 qbox, qell;
-  box_ellipsoid_point(Rt, c, sa, sb, qbox, qell);
+  V3 qflat, qell;
+  point(Rt, c, qflat, qell);
   const auto back = [&](const V3& q) {
     return V3{((R[0] * q.x + R[1] * q.y) + R[2] * q.z) + t[0], ((R[3] * q.x + R[4] * q.y) + R[5] * q.z) + t[1],
               ((R[6] * q.x + R[7] * q.y) + R[8] * q.z) + t[2]};
   };
   pa = back(qell);
-  pb = back(qbox);
+  pb = back(qflat);
 }

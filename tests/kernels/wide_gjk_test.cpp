@@ -331,6 +331,56 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
   EXPECT_GE(one_or_two, trials * 3 / 4) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
 }
 
+/// Sphere and capsule against an ellipsoid at a known gap (the ellipsoid touching the plane through pb = pa + (gap +
+/// radius) m from beyond, pa the sphere's centre, or a point of the capsule's segment with m orthogonal to it, or
+/// its end with m in the end's normal cone): the cores are a box with zero extents (a point, a segment), whose
+/// box_ellipsoid_point() start (kPointCore, kSegmentCore) GJK's first plain step certifies. Measured before it,
+/// close witness double (20000 pairs): sphere-ellipsoid 4.91, capsule-ellipsoid 6.77 mean iterations.
+TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
+  Rng rng(2028);
+  QueryOptions opt;
+  opt.level = QueryLevel::witness;
+  opt.tolerance = 1e-9;
+  int trials = 0, one_or_two = 0;
+  for (const bool swap : {false, true}) {
+    for (const int kind : {0, 1, 2}) {  // sphere, capsule side, capsule end
+      for (int trial = 0; trial < 50; ++trial) {
+        const double radius = testing::uniform(rng, 0.01, 0.2), half = testing::uniform(rng, 0.02, 0.3);
+        const Eigen::Vector3d r(testing::uniform(rng, 0.03, 0.3), testing::uniform(rng, 0.03, 0.3),
+                                testing::uniform(rng, 0.03, 0.3));
+        Eigen::Vector3d m = testing::random_unit_vector(rng), pa = Eigen::Vector3d::Zero();
+        if (kind == 1) {
+          m.z() = 0;
+          pa.z() = testing::uniform(rng, -0.9, 0.9) * half;
+        } else if (kind == 2) {
+          m.z() = std::abs(m.z()) + 0.1;
+          pa.z() = half;
+        }
+        m.normalize();
+        const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
+        const Eigen::Vector3d pb = pa + (gap + radius) * m;
+        const Eigen::Quaterniond qe = testing::random_rotation(rng);
+        const Eigen::Matrix3d E = qe.toRotationMatrix();
+        const Eigen::Matrix3d Qm = E * r.cwiseProduct(r).asDiagonal() * E.transpose();
+        const Eigen::Vector3d ce = pb + Qm * m / std::sqrt(m.dot(Qm * m));
+        const Eigen::Quaterniond Q = testing::random_rotation(rng);
+        const Eigen::Vector3d T = testing::random_vector(rng);
+        const Pose pose_a{T, Q}, pose_ell{T + Q * ce, Q * qe};
+        const Shape a = kind == 0 ? Shape::sphere(radius) : Shape::capsule(radius, half);
+        const Shape ell = Shape::ellipsoid(r.x(), r.y(), r.z());
+        const auto res = swap ? testing::run_pair(ell, pose_ell, a, pose_a, opt) : testing::run_pair(a, pose_a, ell, pose_ell, opt);
+        SCOPED_TRACE("swap " + std::to_string(swap) + " kind " + std::to_string(kind) + " trial " +
+                     std::to_string(trial) + " gap " + std::to_string(gap));
+        EXPECT_EQ(res.status, Status::converged);
+        EXPECT_NEAR(res.distance, gap, 1e-9);  // GJK's certified gap: opt.tolerance
+        ++trials;
+        one_or_two += res.iterations <= 2 ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GE(one_or_two, trials * 9 / 10) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
+}
+
 TEST(WideGjk, StartCellsOfTheLanesAreTheScalarStartCell) {
   // The large-hull supports look up the direction table with the cells start_cells() computes W lanes at a time;
   // the reference computes start_cell() per call. They must name the same cell (or none) for every direction:

@@ -15,8 +15,9 @@ using namespace batchcol::kernels;
 
 /// wide_gjk_box_ellipsoid.inl's box_ellipsoid_point(): E row-major (the ellipsoid's axes as columns), c, r the
 /// ellipsoid's centre and radii, h the box's half extents, all in the box's frame; pa on the box, pb on the
-/// ellipsoid (NaN where no candidate is finite).
-template <class T>
+/// ellipsoid (NaN where no candidate is finite). `Core`: kBoxCore, kSegmentCore (h = (0, 0, half length): the
+/// edge along z and the vertex only) or kPointCore (h = 0: the vertex only).
+template <class T, int Core>
 void box_ellipsoid_point(const T* E, const T* c, const T* r, const T* h, T* pa, T* pb) {
   const T nan = std::numeric_limits<T>::quiet_NaN();
   const T rr[3] = {r[0] * r[0], r[1] * r[1], r[2] * r[2]};
@@ -37,8 +38,8 @@ void box_ellipsoid_point(const T* E, const T* c, const T* r, const T* h, T* pa, 
       best = n2;
     }
   };
-  T gap[3];
-  for (int k = 0; k < 3; ++k) {
+  T gap[3] = {T(0), T(0), T(0)};
+  for (int k = 0; k < 3 && Core == kBoxCore; ++k) {
     const T rk = std::sqrt(Q[4 * k]);
     gap[k] = (s[k] * c[k] - rk) - h[k];
     const T f = s[k] / rk;
@@ -47,11 +48,11 @@ void box_ellipsoid_point(const T* E, const T* c, const T* r, const T* h, T* pa, 
     qa[k] = s[k] * h[k];
     keep(qa, qb);
   }
-  const int k = gap[0] <= gap[1] && gap[0] <= gap[2] ? 0 : (gap[1] <= gap[2] ? 1 : 2);
+  const int k = Core != kBoxCore ? 2 : (gap[0] <= gap[1] && gap[0] <= gap[2] ? 0 : (gap[1] <= gap[2] ? 1 : 2));
   const int i = (k + 1) % 3, j = (k + 2) % 3;
   const T a = Q[4 * i], d = Q[4 * j], b = (s[i] * s[j]) * Q[3 * i + j];
   const T p0 = s[i] * c[i] - h[i], p1 = s[j] * c[j] - h[j];
-  {
+  if (Core != kPointCore) {
     const T m0 = d * p0 - b * p1, m1 = a * p1 - b * p0;
     const T inv0 = T(1) / std::sqrt(m0 * m0 + m1 * m1);
     T C = m0 * inv0, S = m1 * inv0;
@@ -94,7 +95,7 @@ void box_ellipsoid_point(const T* E, const T* c, const T* r, const T* h, T* pa, 
       w[n] = rr[n] * (p[n] * p[n]);
     }
     T t = T(0);
-    for (int it = 0; it < kBoxVertexNewtonSteps; ++it) {
+    for (int it = 0; it < vertex_newton_steps(Core); ++it) {
       const T e0 = T(1) / (rr[0] + t), e1 = T(1) / (rr[1] + t), e2 = T(1) / (rr[2] + t);
       const T a0 = (w[0] * e0) * e0, a1 = (w[1] * e1) * e1, a2 = (w[2] * e2) * e2;
       const T S = (a0 + a1) + a2;
@@ -123,25 +124,34 @@ void box_ellipsoid_point(const T* E, const T* c, const T* r, const T* h, T* pa, 
 template <class T> bool box_ellipsoid_candidate(const MinkowskiDifference<T>& D, SupportPoint<T>& sp) {
   const auto& R = D.b_in_a.R;
   const Vec3<T>& t = D.b_in_a.t;
-  const T sa[3] = {D.A->size.x(), D.A->size.y(), D.A->size.z()};
-  const T sb[3] = {D.B->size.x(), D.B->size.y(), D.B->size.z()};
+  const bool a_flat = D.A->type != ShapeType::ellipsoid;
+  const ShapeCore<T>& F = a_flat ? *D.A : *D.B;
+  const ShapeCore<T>& L = a_flat ? *D.B : *D.A;
+  const T h[3] = {F.type == ShapeType::box ? F.size.x() : T(0), F.type == ShapeType::box ? F.size.y() : T(0),
+                  F.type == ShapeType::box ? F.size.z() : (F.type == ShapeType::capsule ? F.size.y() : T(0))};
+  const T r[3] = {L.size.x(), L.size.y(), L.size.z()};
+  const auto point = [&](const T* E, const T* c, T* qf, T* qe) {
+    if (F.type == ShapeType::box) box_ellipsoid_point<T, kBoxCore>(E, c, r, h, qf, qe);
+    else if (F.type == ShapeType::capsule) box_ellipsoid_point<T, kSegmentCore>(E, c, r, h, qf, qe);
+    else box_ellipsoid_point<T, kPointCore>(E, c, r, h, qf, qe);
+  };
   T pa[3], pb[3];
-  if (D.A->type == ShapeType::box) {
+  if (a_flat) {
     const T E[9] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)};
     const T c[3] = {t.x(), t.y(), t.z()};
-    box_ellipsoid_point(E, c, sb, sa, pa, pb);
+    point(E, c, pa, pb);
   } else {
     const T E[9] = {R(0, 0), R(1, 0), R(2, 0), R(0, 1), R(1, 1), R(2, 1), R(0, 2), R(1, 2), R(2, 2)};
     const T c[3] = {-((R(0, 0) * t.x() + R(1, 0) * t.y()) + R(2, 0) * t.z()),
                     -((R(0, 1) * t.x() + R(1, 1) * t.y()) + R(2, 1) * t.z()),
                     -((R(0, 2) * t.x() + R(1, 2) * t.y()) + R(2, 2) * t.z())};
-    T qbox[3], qell[3];
-    box_ellipsoid_point(E, c, sa, sb, qbox, qell);
+    T qflat[3], qell[3];
+    point(E, c, qflat, qell);
     const auto back = [&](const T* q, T* o) {
       for (int i = 0; i < 3; ++i) o[i] = ((R(i, 0) * q[0] + R(i, 1) * q[1]) + R(i, 2) * q[2]) + t[i];
     };
     back(qell, pa);
-    back(qbox, pb);
+    back(qflat, pb);
   }
   sp.a = Vec3<T>(pa[0], pa[1], pa[2]);
   sp.b = Vec3<T>(pb[0], pb[1], pb[2]);
