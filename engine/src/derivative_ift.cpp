@@ -109,13 +109,20 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
 // instructions per hull pair (callgrind, AVX2 build), a third of the analytic derivative's own cost.
 // Each set has its own sqrt_lanes() for the .inl's square roots because GCC emitted one scalar sqrt per lane, with
 // the lane moves, for the element-wise form; IEEE square roots are correctly rounded, so every lane still gets
-// std::sqrt()'s bits. They sit in anonymous namespaces: internal linkage, like everything in the .inl.
+// std::sqrt()'s bits. Likewise select_positive(z, a, b), z > 0 ? a : b lane by lane (ordered: b where z is NaN):
+// GCC compiled the vector extension's `?:` on eight lanes as a scalar compare and mask per lane (+~100
+// instructions per ellipsoid pair in AVX2 for the curvature's and the rotations' five selects, callgrind). They sit
+// in anonymous namespaces: internal linkage, like everything in the .inl.
 namespace {
 using V8 = double __attribute__((vector_size(64)));
 }  // namespace
 namespace lanes_base {
 namespace {
 inline __attribute__((always_inline)) V sqrt_lanes(const V& x) { return (V)_mm_sqrt_pd((__m128d)x); }
+inline __attribute__((always_inline)) V select_positive(const V& z, const V& a, const V& b) {
+  const __m128d gt = _mm_cmpgt_pd((__m128d)z, _mm_setzero_pd());
+  return (V)_mm_or_pd(_mm_and_pd(gt, (__m128d)a), _mm_andnot_pd(gt, (__m128d)b));
+}
 }  // namespace
 #include "derivative_lanes.inl"
 }  // namespace lanes_base
@@ -126,6 +133,10 @@ namespace {
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   // The masked form: _mm512_sqrt_pd()'s undefined source trips GCC 12's -Wuninitialized.
   return (V8)_mm512_mask_sqrt_pd((__m512d)x, 0xFF, (__m512d)x);
+}
+inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& a, const V8& b) {
+  const __mmask8 gt = _mm512_cmp_pd_mask((__m512d)z, _mm512_setzero_pd(), _CMP_GT_OQ);
+  return (V8)_mm512_mask_blend_pd(gt, (__m512d)b, (__m512d)a);
 }
 }  // namespace
 #include "derivative_lanes.inl"
@@ -138,6 +149,13 @@ namespace {
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   const __m256d lo = _mm256_sqrt_pd(__m256d{x[0], x[1], x[2], x[3]});
   const __m256d hi = _mm256_sqrt_pd(__m256d{x[4], x[5], x[6], x[7]});
+  return V8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
+}
+inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& a, const V8& b) {
+  const auto half = [](const V8& v, int h) { return __m256d{v[4 * h], v[4 * h + 1], v[4 * h + 2], v[4 * h + 3]}; };
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d lo = _mm256_blendv_pd(half(b, 0), half(a, 0), _mm256_cmp_pd(half(z, 0), zero, _CMP_GT_OQ));
+  const __m256d hi = _mm256_blendv_pd(half(b, 1), half(a, 1), _mm256_cmp_pd(half(z, 1), zero, _CMP_GT_OQ));
   return V8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
 }
 }  // namespace
@@ -154,21 +172,24 @@ inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
 // derivative_lanes.inl. Here: which set's lanes run a block (the wide ones only for a whole block on AVX2 / AVX-512).
 void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa) const {
   if (normal_b_only) {
-    if (curved) solve_lanes<true, true>(out, isa);
-    else solve_lanes<true, false>(out, isa);
+    if (!curved) solve_lanes<true, false, true>(out, isa);
+    else if (given) solve_lanes<true, true, true>(out, isa);
+    else solve_lanes<true, true, false>(out, isa);
   } else {
-    if (curved) solve_lanes<false, true>(out, isa);
-    else solve_lanes<false, false>(out, isa);
+    if (!curved) solve_lanes<false, false, true>(out, isa);
+    else if (given) solve_lanes<false, true, true>(out, isa);
+    else solve_lanes<false, true, false>(out, isa);
   }
 }
 
-template <bool kNormalB, bool kCurved> void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa) const {
+template <bool kNormalB, bool kCurved, bool kGiven>
+void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa) const {
   if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
-    return lanes_avx512::smooth_block<V8, kNormalB, kCurved>(*this, out);
+    return lanes_avx512::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out);
   if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
-    return lanes_avx2::smooth_block<V8, kNormalB, kCurved>(*this, out);
+    return lanes_avx2::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out);
   run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
-    lanes_base::smooth_lanes<kNormalB, kCurved, V>(*this, l, put);
+    lanes_base::smooth_lanes<kNormalB, kCurved, kGiven, V>(*this, l, put);
   });
 }
 
@@ -181,19 +202,18 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
   const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
   const Eigen::Vector3d& nv = g.normal;
   const std::size_t l = count;
-  const auto set = [&](double (*m)[kLanes], int i, int j, double v) { m[3 * i + j][l] = v; };
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) set(P, i, j, 0.0), set(G, i, j, 0.0), set(W, i, j, 0.0);
+  // The case's P, G, W built in locals and each lane entry stored once (zeroing the lane's 27 entries first and
+  // storing the case's over them cost ~170 instructions per hull pair, callgrind).
+  double p[9] = {}, gm[9] = {}, w[9] = {};
   if (k == 1) {  // one edge (flats are unit and orthogonal to n): P = c c^T; G = P [n]x = c (c x n)^T for a's edge
     const Eigen::Vector3d c = ka > 0 ? g.flat_a.col(0) : g.flat_b.col(0);
     const Eigen::Vector3d cn = c.cross(nv);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
-        set(P, i, j, c(i) * c(j));
-        if (ka > 0) set(G, i, j, c(i) * cn(j));
+        p[3 * i + j] = c(i) * c(j);
+        if (ka > 0) gm[3 * i + j] = c(i) * cn(j);
       }
-    if (kb > 0)
-      for (int i = 0; i < 3; ++i) set(W, i, i, 1.0);
+    if (kb > 0) w[0] = w[4] = w[8] = 1.0;
   } else if (k == 2) {  // two independent flats orthogonal to n span its tangent plane: P = I - n n^T
     if (ka == 1) {  // edge A against edge B; independent when A . (n x B) = +-|A x B| is not ~0 (polytope_jacobians'
                     // test: what is left of one unit flat after removing the other)
@@ -203,16 +223,16 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
       if (!(std::abs(s) > 1e-6)) return false;
       const double t = B.dot(A_perp);
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) set(G, i, j, B_perp(i) * (An(j) / s)), set(W, i, j, B(i) * (A_perp(j) / t));
+        for (int j = 0; j < 3; ++j) gm[3 * i + j] = B_perp(i) * (An(j) / s), w[3 * i + j] = B(i) * (A_perp(j) / t);
     } else if (ka == 2) {  // a's face against b's vertex: G = P [n]x = [n]x (n^T [n]x = 0)
-      set(G, 0, 1, -nv.z()), set(G, 0, 2, nv.y()), set(G, 1, 0, nv.z());
-      set(G, 1, 2, -nv.x()), set(G, 2, 0, -nv.y()), set(G, 2, 1, nv.x());
+      gm[1] = -nv.z(), gm[2] = nv.y(), gm[3] = nv.z(), gm[5] = -nv.x(), gm[6] = -nv.y(), gm[7] = nv.x();
     } else {  // a's vertex against b's face
-      for (int i = 0; i < 3; ++i) set(W, i, i, 1.0);
+      w[0] = w[4] = w[8] = 1.0;
     }
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) set(P, i, j, (i == j ? 1.0 : 0.0) - nv(i) * nv(j));
+      for (int j = 0; j < 3; ++j) p[3 * i + j] = (i == j ? 1.0 : 0.0) - nv(i) * nv(j);
   }
+  for (int e = 0; e < 9; ++e) P[e][l] = p[e], G[e][l] = gm[e], W[e][l] = w[e];
   ++count;
   column[l] = col;
   sd[l] = g.distance;
@@ -237,15 +257,27 @@ void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* 
   sd[l] = g.distance;
   for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
   const auto side = [&](Side& s, const CurvedSide* c, const Eigen::Matrix3d& H) {
-    for (int i = 0; i < 3; ++i) {
-      s.radii2[i][l] = c ? c->radii2(i) : 0.0;
-      for (int j = 0; j < 3; ++j) {
-        s.H0[3 * i + j][l] = c ? 0.0 : H(i, j);
-        s.R[3 * i + j][l] = c ? (*c->R)(i, j) : 0.0;
-      }
+    if (c) {
+      if (given)
+        for (int e = 0; e < 9; ++e) s.H0[e][l] = 0.0;
+      for (int k = 0; k < 4; ++k) s.q[k][l] = c->q[k];
+      for (int i = 0; i < 3; ++i) s.radii2[i][l] = c->radii2(i);
+      s.round[l] = c->round;
+      curved = true;
+      return;
     }
-    s.round[l] = c ? c->round : 0.0;
-    curved = curved || c;
+    if (!given) {  // the lanes so far (this lane's other side included) have curved sides without H0
+      // Every lane (those after l are written when added): fixed-size vector stores, where zeroing lanes 0..l
+      // became 18 memset calls (~27 instructions per smoothed1 pair, callgrind).
+      for (int e = 0; e < 9; ++e)
+        for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
+      given = true;
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) s.H0[3 * i + j][l] = H(i, j);
+    for (int k = 0; k < 4; ++k) s.q[k][l] = 0.0;
+    for (int i = 0; i < 3; ++i) s.radii2[i][l] = 0.0;
+    s.round[l] = 0.0;
   };
   side(a, curved_a, g.H_a);
   side(b, curved_b, g.H_b);

@@ -91,10 +91,12 @@ static_assert(store_at::distance_a == 0 && store_at::distance_b == 6 && store_at
               store_at::normal_b == store_at::normal_a + 18);
 
 /// A sphere's or an ellipsoid's support-map Jacobian left to SmoothLanes to compute (world_support_jacobian()'s
-/// formula): the shape's rotation, its squared radii (zero for a sphere) and its round radius (sphere radius plus
-/// inflation, or the ellipsoid's inflation).
+/// formula): the shape's rotation as the pose's quaternion (x, y, z, w, not normalised: the lanes normalise it and
+/// build the matrix as Eigen's normalized().toRotationMatrix() does, eight poses per register instead of one), its
+/// squared radii (zero for a sphere) and its round radius (sphere radius plus inflation, or the ellipsoid's
+/// inflation).
 struct CurvedSide {
-  const Eigen::Matrix3d* R = nullptr;
+  double q[4] = {0.0, 0.0, 0.0, 1.0};
   Eigen::Vector3d radii2 = Eigen::Vector3d::Zero();
   double round = 0.0;
 };
@@ -105,10 +107,11 @@ struct CurvedSide {
 /// register half past `count` is computed on whatever it holds and not written.
 struct SmoothLanes {
   static constexpr std::size_t kLanes = 8;
-  // Per side (a, b): H = H0 + B / m - (B n)(B n)^T / m^3 + round (I - n n^T) with B = R diag(radii2) R^T and
-  // m = sqrt(n^T B n) (0 / 0 taken as 0): a sphere or ellipsoid, or the given H0 (radii2 = round = 0).
+  // Per side (a, b): H = H0 + B / m - (B n)(B n)^T / m^3 + round (I - n n^T) with B = R diag(radii2) R^T, R the
+  // rotation of the quaternion q (x, y, z, w) and m = sqrt(n^T B n) (0 / 0 taken as 0): a sphere or ellipsoid
+  // (H0 = 0), or the given H0 (q = radii2 = round = 0: R = I, B = +0).
   struct Side {
-    alignas(64) double H0[9][kLanes], R[9][kLanes], radii2[3][kLanes], round[kLanes];
+    alignas(64) double H0[9][kLanes], q[4][kLanes], radii2[3][kLanes], round[kLanes];
   };
   alignas(64) double n[3][kLanes], xa[3][kLanes], xb[3][kLanes], sd[kLanes];
   Side a, b;
@@ -118,7 +121,11 @@ struct SmoothLanes {
   /// smoothed1 pairs, analytic pairs with features): solve() then takes H = H0 + 0.0, the same bits as the full
   /// formula with R = radii2 = round = 0 (each of its terms is +0 or -0, and x + 0 - 0 + (-0) is x, +0 for -0).
   bool curved = false;
-  void clear() { count = 0, curved = false; }
+  /// Some lane has a side with a given H0 (not a sphere or ellipsoid). Until one does, add() writes no H0 and the
+  /// lanes take H0 = +0, what it held for curved sides (no H0 stores and loads for ellipsoid pairs); the first
+  /// given side zeroes the H0 of the lanes before it.
+  bool given = false;
+  void clear() { count = 0, curved = false, given = false; }
   /// The next lane takes pair g, for output column `column`; a null side uses g.H_a / g.H_b.
   void add(std::size_t column, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
            const CurvedSide* curved_b = nullptr);
@@ -131,7 +138,7 @@ struct SmoothLanes {
   void solve(double* const* out, bool normal_b_only = false, InstructionSet isa = InstructionSet::scalar) const;
 
  private:
-  template <bool kNormalB, bool kCurved> void solve_lanes(double* const* out, InstructionSet isa) const;
+  template <bool kNormalB, bool kCurved, bool kGiven> void solve_lanes(double* const* out, InstructionSet isa) const;
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two

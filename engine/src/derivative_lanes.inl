@@ -6,7 +6,8 @@
 // writes the same bits. Everything here has internal linkage and is inlined: no AVX code can be shared with
 // baseline code through a weak symbol.
 //
-// The includer declares sqrt_lanes(V) (its set's vector square root) before the include.
+// The includer declares sqrt_lanes(V) (its set's vector square root) and select_positive(z, a, b) (z > 0 ? a : b
+// lane by lane) before the include.
 //
 // No include guard.
 
@@ -80,7 +81,8 @@ inline __attribute__((always_inline)) void put_outputs(const Put& put, const V (
 //   dx_b/dxi_a = H_b y,   dx_a/dxi_a = dx_b/dxi_a + sd y   (dz = -sd y; equal to F_a - H_a y since H_a K + H_b K =
 //   I - sd K),   dn/dxi_a = -(I - n n^T) y;
 // the twist of b by the rigid-motion identity (put_outputs()). Lanes l .. l + |V| of `s`, written through put.
-template <bool kNormalB, bool kCurved, class V, class Put>
+// kGiven: some lane has a given H0 (SmoothLanes::given); otherwise every H0 is +0 and is not read.
+template <bool kNormalB, bool kCurved, bool kGiven, class V, class Put>
 inline __attribute__((always_inline)) void smooth_lanes(const SmoothLanes& s, std::size_t l, const Put& put) {
   {
     const V d = load<V>(&s.sd[l]);
@@ -93,9 +95,26 @@ inline __attribute__((always_inline)) void smooth_lanes(const SmoothLanes& s, st
           for (int j = 0; j < 3; ++j) H[i][j] = load<V>(&side.H0[3 * i + j][l]) + 0.0;
         return;
       }
+      // R = Eigen's q.normalized().toRotationMatrix() with its operations in its order (|q|^2 summed as
+      // (x^2 + z^2) + (y^2 + w^2), its SSE2 reduction; each coefficient divided by |q|, q kept where |q|^2 is not
+      // > 0): the same bits, checked against Eigen on random quaternions by
+      // DerivativesLanes.LaneRotationsGiveEigensBits. A side without a curved shape (q = 0) gets the identity,
+      // whose B with radii2 = 0 is +0 everywhere, as the zero matrix's was.
       V R[3][3], B[3][3], Bn[3];
-      for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) R[i][k] = load<V>(&side.R[3 * i + k][l]);
+      {
+        V c[4];
+        for (int k = 0; k < 4; ++k) c[k] = load<V>(&side.q[k][l]);
+        const V z = (c[0] * c[0] + c[2] * c[2]) + (c[1] * c[1] + c[3] * c[3]);
+        const V root = sqrt_lanes(z);
+        const V x = select_positive(z, c[0] / root, c[0]), y = select_positive(z, c[1] / root, c[1]);
+        const V zq = select_positive(z, c[2] / root, c[2]), w = select_positive(z, c[3] / root, c[3]);
+        const V tx = 2.0 * x, ty = 2.0 * y, tz = 2.0 * zq;
+        const V twx = tx * w, twy = ty * w, twz = tz * w, txx = tx * x, txy = ty * x, txz = tz * x;
+        const V tyy = ty * y, tyz = tz * y, tzz = tz * zq;
+        R[0][0] = 1.0 - (tyy + tzz), R[0][1] = txy - twz, R[0][2] = txz + twy;
+        R[1][0] = txy + twz, R[1][1] = 1.0 - (txx + tzz), R[1][2] = tyz - twx;
+        R[2][0] = txz - twy, R[2][1] = tyz + twx, R[2][2] = 1.0 - (txx + tyy);
+      }
       const V D[3] = {load<V>(&side.radii2[0][l]), load<V>(&side.radii2[1][l]), load<V>(&side.radii2[2][l])};
       for (int i = 0; i < 3; ++i)
         for (int j = i; j < 3; ++j)
@@ -104,12 +123,12 @@ inline __attribute__((always_inline)) void smooth_lanes(const SmoothLanes& s, st
       const V m2 = n[0] * Bn[0] + n[1] * Bn[1] + n[2] * Bn[2];
       const V m = sqrt_lanes(m2);
       const V zero = {};
-      const V inv_m = m2 > 0.0 ? 1.0 / m : zero, inv_m3 = inv_m * inv_m * inv_m;
+      const V inv_m = select_positive(m2, 1.0 / m, zero), inv_m3 = inv_m * inv_m * inv_m;
       const V r = load<V>(&side.round[l]);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-          H[i][j] = load<V>(&side.H0[3 * i + j][l]) + B[i][j] * inv_m - Bn[i] * Bn[j] * inv_m3 +
-                    r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
+          H[i][j] = (kGiven ? load<V>(&side.H0[3 * i + j][l]) : zero) + B[i][j] * inv_m -
+                    Bn[i] * Bn[j] * inv_m3 + r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
     };
     V Ha[3][3], Hb[3][3];
     curvature(s.a, Ha);
@@ -187,9 +206,11 @@ inline __attribute__((always_inline)) void polytope_lanes(const PolytopeLanes& l
 }
 
 // A whole block of kLanes pairs to output columns 0 .. kLanes - 1, one register of V: every entry one store.
-template <class V, bool kNormalB, bool kCurved> void smooth_block(const SmoothLanes& s, double* const* out) {
+template <class V, bool kNormalB, bool kCurved, bool kGiven>
+void smooth_block(const SmoothLanes& s, double* const* out) {
   static_assert(sizeof(V) == SmoothLanes::kLanes * sizeof(double));
-  smooth_lanes<kNormalB, kCurved, V>(s, 0, [out](int e, const V& v) { __builtin_memcpy(out[e], &v, sizeof v); });
+  smooth_lanes<kNormalB, kCurved, kGiven, V>(s, 0,
+                                             [out](int e, const V& v) { __builtin_memcpy(out[e], &v, sizeof v); });
 }
 
 template <class V> void polytope_block(const PolytopeLanes& lanes, double* const* out) {

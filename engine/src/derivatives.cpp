@@ -36,13 +36,25 @@ bool witness_geometry(const ShapeTable& shapes, const PairBatch& batch, const Pa
 
 }  // namespace
 
-bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
-                      PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b) {
+namespace {
+
+// witness_geometry() and the problem's length scale: nominal_geometry() without the rotations (the analytic path
+// builds only those of shapes that are not spheres or ellipsoids; SmoothLanes builds theirs eight at a time).
+bool scaled_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+                     PairGeometry& g) {
   if (!witness_geometry(shapes, batch, results, i, g)) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
+  g.scale = ShapeTableAccess::bounding_radii(shapes)[a] + ShapeTableAccess::bounding_radii(shapes)[b];
+  return true;
+}
+
+}  // namespace
+
+bool nominal_geometry(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
+                      PairGeometry& g, Eigen::Matrix3d& R_a, Eigen::Matrix3d& R_b) {
+  if (!scaled_geometry(shapes, batch, results, i, g)) return false;
   R_a = batch.rotation_a[i].normalized().toRotationMatrix();
   R_b = batch.rotation_b[i].normalized().toRotationMatrix();
-  g.scale = ShapeTableAccess::bounding_radii(shapes)[a] + ShapeTableAccess::bounding_radii(shapes)[b];
   return true;
 }
 
@@ -168,7 +180,9 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
   double* slot = nullptr;
-  if (polytope_pair(g)) {
+  // polytope_pair(g) without its tests of what this function has already established (separated beyond the
+  // threshold, H_a = H_b = 0): its two isZero() scans of the zeros just stored cost ~75 instructions per hull pair.
+  if (g.flats_a + g.flats_b <= 2) {
     slot = out.add_polytope(i, g);
     if (!slot) {
       d.status[i] = status;
@@ -195,18 +209,20 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
   if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out)) return;
   DerivativeResults& d = out.d;
   PairGeometry g;
-  Eigen::Matrix3d R_a, R_b;
-  if (!nominal_geometry(shapes, batch, results, i, g, R_a, R_b)) {
+  Eigen::Matrix3d R_a, R_b;  // the analytic path sets them only where it uses them (see side())
+  const bool analytic = o.method == DerivativeMethod::analytic;
+  if (!(analytic ? scaled_geometry(shapes, batch, results, i, g)
+                 : nominal_geometry(shapes, batch, results, i, g, R_a, R_b))) {
     store_nothing(out, i);
     return;
   }
   const Shape& a = shapes[batch.shape_a[i]];
   const Shape& b = shapes[batch.shape_b[i]];
   DerivativeStatus status = DerivativeStatus::smooth;
-  if (o.method == DerivativeMethod::analytic) {
+  if (analytic) {
     // Spheres and ellipsoids (no features, no flats): their support-map Jacobian is left to the lanes of
-    // SmoothLanes (or computed below when the other side has flats); the others go through their local frame,
-    // where the features are tested.
+    // SmoothLanes (or computed below when the other side has flats), which also build their rotations; the others
+    // go through their local frame, where the features are tested.
     const auto plain_polytope = [](const Shape& s) {
       return s.inflation == 0.0 &&
              (s.type == ShapeType::convex || s.type == ShapeType::box || s.type == ShapeType::triangle);
@@ -214,15 +230,16 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     // Separated pairs only: GJK ends on the exact features. (EPA's normals were exact on the saved overlapping hull
     // batches too, but EPA stops at a tolerance, and those pairs take the general solve anyway.)
     const bool exact_normal = g.distance > 0.0 && plain_polytope(a) && plain_polytope(b);
-    const auto side = [&](const Shape& s, const Eigen::Matrix3d& R, const Eigen::Vector3d& witness,
-                          const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H, int& flats,
-                          Eigen::Matrix<double, 3, 2>& flat, bool& zero, CurvedSide& curved) {
-      if (s.type == ShapeType::sphere || s.type == ShapeType::ellipsoid) {
-        curved.R = &R;
-        if (s.type == ShapeType::ellipsoid) curved.radii2 = s.size.cwiseProduct(s.size);
-        curved.round = s.inflation + (s.type == ShapeType::sphere ? s.size.x() : 0.0);
-        return;
-      }
+    const auto is_round = [](const Shape& s) { return s.type == ShapeType::sphere || s.type == ShapeType::ellipsoid; };
+    const auto round_side = [](const Shape& s, const Eigen::Quaterniond& rotation, CurvedSide& curved) {
+      for (int k = 0; k < 4; ++k) curved.q[k] = rotation.coeffs()[k];
+      if (s.type == ShapeType::ellipsoid) curved.radii2 = s.size.cwiseProduct(s.size);
+      curved.round = s.inflation + (s.type == ShapeType::sphere ? s.size.x() : 0.0);
+    };
+    const auto side = [&](const Shape& s, const Eigen::Quaterniond& rotation, Eigen::Matrix3d& R,
+                          const Eigen::Vector3d& witness, const Eigen::Vector3d& t, double sign, Eigen::Matrix3d& H,
+                          int& flats, Eigen::Matrix<double, 3, 2>& flat, bool& zero) {
+      R = rotation.normalized().toRotationMatrix();
       const Eigen::Vector3d u = sign * (R.transpose() * g.normal);
       // Against a polytope, a hull's feature is the one n exposes (exposed_support_jacobian()); otherwise the
       // witness's position decides (GJK's normal is not exact against curved shapes).
@@ -238,17 +255,22 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     };
     bool zero_a = false, zero_b = false;
     CurvedSide curved_a, curved_b;
-    side(a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a, curved_a);
-    side(b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b, curved_b);
+    const Eigen::Quaterniond q_a = batch.rotation_a[i], q_b = batch.rotation_b[i];
+    // Sphere and ellipsoid sides without side()'s call (~100 instructions per ellipsoid pair with its arguments).
+    const bool round_a = is_round(a), round_b = is_round(b);
+    if (round_a) round_side(a, q_a, curved_a);
+    else side(a, q_a, R_a, g.witness_a, batch.translation_a[i], 1.0, g.H_a, g.flats_a, g.flat_a, zero_a);
+    if (round_b) round_side(b, q_b, curved_b);
+    else side(b, q_b, R_b, g.witness_b, batch.translation_b[i], -1.0, g.H_b, g.flats_b, g.flat_b, zero_b);
     if (zero_a || zero_b) status = DerivativeStatus::zero_curvature;
     // Polytopes without inflation (no curvature) go to PolytopeLanes below.
-    if (smooth_pair(g) && (curved_a.R || curved_b.R || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
-      out.add_smooth(i, g, curved_a.R ? &curved_a : nullptr, curved_b.R ? &curved_b : nullptr);
+    if (smooth_pair(g) && (round_a || round_b || !g.H_a.isZero(0.0) || !g.H_b.isZero(0.0))) {
+      out.add_smooth(i, g, round_a ? &curved_a : nullptr, round_b ? &curved_b : nullptr);
       d.status[i] = status;
       return;
     }
-    if (curved_a.R) world_support_jacobian(a, R_a, g.normal, g.H_a);
-    if (curved_b.R) world_support_jacobian(b, R_b, g.normal, g.H_b);
+    if (round_a) world_support_jacobian(a, q_a.normalized().toRotationMatrix(), g.normal, g.H_a);
+    if (round_b) world_support_jacobian(b, q_b.normalized().toRotationMatrix(), g.normal, g.H_b);
   } else {
     const Eigen::Vector3d u_a = R_a.transpose() * g.normal, u_b = -(R_b.transpose() * g.normal);
     const auto direction_noise = [&](const Shape& s) {

@@ -1,0 +1,104 @@
+// SmoothLanes builds the rotations of sphere and ellipsoid sides itself, eight poses per register, from the pose's
+// quaternion (derivative_lanes.inl). The analytic derivatives must keep the bits they had when each pair converted
+// its quaternions with Eigen's q.normalized().toRotationMatrix(): a lane given the quaternion must write what a lane
+// given that Eigen rotation's curvature matrix writes.
+#include "derivative_ift.hpp"  // engine/src
+#include "support/same_results.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace batchcol::testing {
+namespace {
+
+// world_support_jacobian()'s formula in the lanes' order of operations (derivative_lanes.inl, curvature()), with
+// the rotation from Eigen: H = 0 + B / m - (B n)(B n)^T / m^3 + r (I - n n^T), B = R diag(radii2) R^T. Never -0
+// (0 + x is +0 for x = -0, and the later terms cannot make a -0 of a +0 or a non-zero), so a lane given it as H0
+// (H0 + 0, SmoothLanes' path without curvature) computes with exactly these bits.
+Eigen::Matrix3d eigen_curvature(const Eigen::Quaterniond& q, const Eigen::Vector3d& radii2, double r,
+                                const Eigen::Vector3d& n) {
+  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  double B[3][3], Bn[3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j)  // the upper triangle, mirrored
+      B[i][j] = B[j][i] = R(i, 0) * radii2[0] * R(j, 0) + R(i, 1) * radii2[1] * R(j, 1) + R(i, 2) * radii2[2] * R(j, 2);
+  for (int i = 0; i < 3; ++i) Bn[i] = B[i][0] * n[0] + B[i][1] * n[1] + B[i][2] * n[2];
+  const double m2 = n[0] * Bn[0] + n[1] * Bn[1] + n[2] * Bn[2];
+  const double inv_m = m2 > 0.0 ? 1.0 / std::sqrt(m2) : 0.0, inv_m3 = inv_m * inv_m * inv_m;
+  Eigen::Matrix3d H;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      H(i, j) = 0.0 + B[i][j] * inv_m - Bn[i] * Bn[j] * inv_m3 + r * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
+  return H;
+}
+
+// Random separated geometry with sphere / ellipsoid sides on unnormalised quaternions of magnitudes 1e-3 .. 1e3
+// (and some exactly unit, some with zero coefficients): every lane of a whole block of curved sides against the
+// same block given Eigen's curvature matrices, on the baseline lanes (a partial block) and on every wide set here.
+TEST(DerivativesLanes, LaneRotationsGiveEigensBits) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), positive(0.05, 2.0);
+  constexpr std::size_t L = detail::SmoothLanes::kLanes;
+  std::vector<InstructionSet> sets = {InstructionSet::scalar};
+  for (const auto isa : vector_isas_here()) sets.push_back(isa);
+  int compared = 0, nonzero = 0;
+  for (int block = 0; block < 400; ++block) {
+    detail::SmoothLanes curved{}, given{};
+    for (std::size_t l = 0; l < L; ++l) {
+      detail::PairGeometry g;
+      g.normal = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+      g.witness_a = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      g.distance = positive(rng);
+      g.witness_b = g.witness_a + g.distance * g.normal;
+      detail::CurvedSide side[2];
+      for (auto& s : side) {
+        Eigen::Vector4d c(unit(rng), unit(rng), unit(rng), unit(rng));
+        if (l % 4 == 1) c[rng() % 4] = 0.0;
+        if (l % 4 == 2) c.normalize();
+        else c *= std::pow(10.0, 3.0 * unit(rng));
+        for (int k = 0; k < 4; ++k) s.q[k] = c[k];
+        const bool sphere = l % 5 == 4;
+        if (!sphere) s.radii2 = Eigen::Vector3d(positive(rng), positive(rng), positive(rng)).cwiseAbs2();
+        s.round = sphere || l % 3 == 0 ? positive(rng) : 0.0;
+      }
+      curved.add(l, g, &side[0], &side[1]);
+      const auto quaternion = [](const detail::CurvedSide& s) {
+        return Eigen::Quaterniond(s.q[3], s.q[0], s.q[1], s.q[2]);
+      };
+      g.H_a = eigen_curvature(quaternion(side[0]), side[0].radii2, side[0].round, g.normal);
+      g.H_b = eigen_curvature(quaternion(side[1]), side[1].radii2, side[1].round, g.normal);
+      given.add(l, g);
+    }
+    for (const auto isa : sets)
+      for (const bool whole : {true, false}) {
+        // A partial block (the last lane left out) takes the baseline lanes on every set.
+        if (!whole) curved.count = given.count = L - 1;
+        double a[detail::StoreEntries][L] = {}, b[detail::StoreEntries][L] = {};
+        double *ra[detail::StoreEntries], *rb[detail::StoreEntries];
+        for (int e = 0; e < detail::StoreEntries; ++e) ra[e] = a[e], rb[e] = b[e];
+        curved.solve(ra, false, isa);
+        given.solve(rb, false, isa);
+        for (int e = 0; e < detail::StoreEntries; ++e)
+          for (std::size_t l = 0; l < curved.count; ++l) {
+            ASSERT_EQ(std::memcmp(&a[e][l], &b[e][l], sizeof(double)), 0)
+                << "block " << block << " lane " << l << " entry " << e << " " << to_string(isa) << ": "
+                << a[e][l] << " vs " << b[e][l];
+            nonzero += a[e][l] != 0.0;
+          }
+        ++compared;
+        curved.count = given.count = L;
+      }
+  }
+  EXPECT_GT(nonzero, compared * int(L - 1) * 60);  // the outputs are not trivially zero
+  std::printf("%d blocks compared\n", compared);
+}
+
+}  // namespace
+}  // namespace batchcol::testing
