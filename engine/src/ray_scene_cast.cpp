@@ -73,8 +73,8 @@ double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
 
 class Caster {
  public:
-  Caster(const RaySceneIndex::State& s, const RayOptions& o)
-      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse()) {}
+  Caster(const RaySceneIndex::State& s, const RayOptions& o, int isa)
+      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse(isa)) {}
 
   // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
   // call, and on trees larger than the L2 pushed nodes are prefetched.
@@ -365,7 +365,8 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   if (!state_->ready) throw InputError("RaySceneIndex::cast: call update(scene) first");
   const std::size_t n = rays.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
   detail::size_ray_results(out, n, true);
-  const Caster caster(*state_, options);
+  const int isa = detail::ray_isa_index(options.isa);  // InputError when this CPU lacks the requested set
+  const Caster caster(*state_, options, isa);
   const bool all = options.query == RayQuery::all;
   std::vector<std::vector<Hit>> chunk_hits(all ? chunks : 0);
   std::vector<std::vector<std::uint32_t>> chunk_counts(all ? chunks : 0);
@@ -377,7 +378,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
       RayOrder order(rays, state_->wide.nodes()[0]);
       CastBuffer<CastResult> results(n);
       const bool any = options.query == RayQuery::any;
-      const WideRaySetup setup = select_wide_ray_setup();
+      const WideRaySetup setup = select_wide_ray_setup(isa);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
         double rows[7][kWideRaySetupLanes];  // 8 records in cast order as structure of arrays
         const WideRayInput group{{rows[0], rows[1], rows[2]}, {rows[3], rows[4], rows[5]}, rows[6]};
@@ -421,7 +422,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   }
   // Input order: the rays' validity and wide setup are computed 8 at a time in SIMD lanes (WideRaySetup: the same
   // bits as ray_is_valid() and make_wide_ray(), without their data-dependent branches).
-  const WideRaySetup setup = select_wide_ray_setup();
+  const WideRaySetup setup = select_wide_ray_setup(isa);
   const WideRayInput input{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
                            {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
                            rays.t_max.data()};

@@ -135,15 +135,20 @@ WideRaySetup wide_ray_setup_for(int isa) {
   }
 }
 
-WideRaySetup select_wide_ray_setup() {
-  if (WideRaySetup f = wide_ray_setup_for(1)) return f;
+WideRaySetup select_wide_ray_setup(int isa) {
+  for (isa = std::min(isa, 1); isa > 0; --isa)
+    if (WideRaySetup f = wide_ray_setup_for(isa)) return f;
   return wide_ray_setup_for(0);
 }
 
-WideTraverse select_wide_traverse() {
-  for (int isa = 2; isa > 0; --isa)
+WideRaySetup select_wide_ray_setup() { return select_wide_ray_setup(2); }
+
+WideTraverse select_wide_traverse(int isa) {
+  for (; isa > 0; --isa)
     if (WideTraverse f = wide_traverse_for(isa)) return f;
   return wide_traverse_for(0);
 }
+
+WideTraverse select_wide_traverse() { return select_wide_traverse(2); }
 
 }  // namespace batchcol

@@ -76,6 +76,7 @@ constexpr std::size_t kWideRaySetupLanes = 8;
 /// The setup for this processor, and per instruction set for the tests (0 baseline, 1 AVX2 (also on AVX-512
 /// processors); nullptr for others and when the processor lacks it).
 WideRaySetup select_wide_ray_setup();
+WideRaySetup select_wide_ray_setup(int isa);  // at most `isa` (AVX-512 processors run the AVX2 setup)
 WideRaySetup wide_ray_setup_for(int isa);
 
 /// The float limit the traversal compares with for a double limit t: t (1 + 2^-20) rounded up to float.
@@ -101,8 +102,10 @@ inline float wide_limit(double t) {
 using WideLeafVisit = bool (*)(void* context, std::uint32_t leaf, float& limit);
 using WideTraverse = void (*)(const WideNode* nodes, const WideRay& ray, float limit, WideLeafVisit visit,
                               void* context);
-/// The traversal for this processor (reads the CPU's features; no state is kept).
+/// The traversal for this processor (reads the CPU's features; no state is kept), and the one of instruction set
+/// `isa` (0 baseline, 1 AVX2, 2 AVX-512) or the next lower one this processor runs.
 WideTraverse select_wide_traverse();
+WideTraverse select_wide_traverse(int isa);
 /// The traversal of one instruction set, for the tests: 0 baseline, 1 AVX2, 2 AVX-512; nullptr when the processor
 /// lacks it.
 WideTraverse wide_traverse_for(int isa);

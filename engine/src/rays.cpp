@@ -72,6 +72,14 @@ void check_ray_batch(const RayBatch& rays) {
   }
 }
 
+int ray_isa_index(InstructionSet requested) {
+  switch (resolve_instruction_set(requested)) {
+    case InstructionSet::avx512: return 2;
+    case InstructionSet::avx2: return 1;
+    default: return 0;
+  }
+}
+
 bool ray_is_valid(const RayBatch& rays, std::size_t i) {
   const double ox = rays.origin.x[i], oy = rays.origin.y[i], oz = rays.origin.z[i];
   const double dx = rays.direction.x[i], dy = rays.direction.y[i], dz = rays.direction.z[i];

@@ -20,6 +20,10 @@ bool ray_is_valid(const RayBatch& rays, std::size_t i);
 /// n rays of defaults: invalid_input, no hit, NaN values; `object` sized only for scene queries; all-hit rows empty.
 void size_ray_results(RayResults& r, std::size_t n, bool with_objects);
 
+/// The ray kernels' index of an instruction set (0 scalar, 1 AVX2, 2 AVX-512: wide_traverse_for(), lane_casts_for())
+/// after resolve_instruction_set(), which throws InputError when this CPU lacks the requested one.
+int ray_isa_index(InstructionSet requested);
+
 /// Runs f() in an arena of `threads` threads (0 = the caller's arena).
 template <class F> void run_with_threads(int threads, const F& f) {
   if (threads <= 0 || threads == tbb::this_task_arena::max_concurrency()) {

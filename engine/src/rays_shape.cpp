@@ -93,10 +93,18 @@ void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const
   }
 }
 
+// The lane kernels of instruction set `isa` (ray_isa_index()), or of the next lower one this build's checks accept
+// (resolve_instruction_set() and the kernels' own feature tests agree on this CPU; the fallback only guards a mismatch).
+kr::LaneCasts lane_casts_at_most(int isa) {
+  for (; isa > 0; --isa)
+    if (const kr::LaneCasts c = kr::lane_casts_for(isa); c.width > 0) return c;
+  return kr::lane_casts_for(0);
+}
+
 template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& b, const RayOptions& o, RayResults& r) {
   const PreparedShapes<T> prepared(shapes);
   const kernels::rays::RayGjkSettings gjk{o.tolerance, o.max_iterations};
-  const kr::LaneCasts wide = kr::select_lane_casts(), single = kr::lane_casts_for(0);
+  const kr::LaneCasts wide = lane_casts_at_most(detail::ray_isa_index(o.isa)), single = kr::lane_casts_for(0);
   const bool dbl = std::is_same_v<T, double>;
   const LaneContext lanes{lane_shapes(shapes, prepared),
                           {b.rays.origin.x.data(), b.rays.origin.y.data(), b.rays.origin.z.data(),

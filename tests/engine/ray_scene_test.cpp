@@ -374,6 +374,70 @@ TEST(RayScene, CastOrderOfLargeBatchesGivesTheSameBits) {
   }
 }
 
+// RayOptions::isa picks the scene traversal's and the shape form's lane kernels' instruction set: every set this CPU
+// runs gives the same bits as the scalar one (closest and any on a tree large enough for the Morton-ordered cast, all
+// in input order; the shape form in double and float, where the lanes are 1, 4 or 8 rays wide).
+TEST(RayScene, EveryInstructionSetGivesTheSameBits) {
+  Rng rng(18);
+  World w = make_world(rng, 30000, true);
+  const RayBatch rays = random_rays(rng, 6000);
+  RaySceneIndex index;
+  index.update(w.scene, 2);
+  ShapeRayBatch shape_rays;
+  for (std::size_t i = 0; i < 3000; ++i) {
+    const std::uint32_t shape = static_cast<std::uint32_t>(i % w.table->size());
+    const Eigen::Vector3d t(uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2));
+    const Eigen::Vector3d o = t + Eigen::Vector3d(uniform(rng, -3, 3), uniform(rng, -3, 3), 3.0);
+    const Eigen::Vector3d target = t + Eigen::Vector3d(uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4), 0.0);
+    shape_rays.add(shape, {t, testing::random_rotation(rng)}, o, target - o, rays.t_max[i]);
+  }
+  const InstructionSet sets[] = {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512};
+  const bool has[] = {true, __builtin_cpu_supports("avx2") != 0,
+                      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")};
+  const auto same = [](const RayResults& a, const RayResults& b) {
+    return same_bits(a.status, b.status) && same_bits(a.hit, b.hit) && same_bits(a.t, b.t) &&
+           same_bits(a.normal.x, b.normal.x) && same_bits(a.normal.y, b.normal.y) &&
+           same_bits(a.normal.z, b.normal.z) && same_bits(a.object, b.object) && same_bits(a.hit_begin, b.hit_begin) &&
+           same_bits(a.all_t, b.all_t) && same_bits(a.all_object, b.all_object);
+  };
+  for (RayQuery q : {RayQuery::closest, RayQuery::any, RayQuery::all}) {
+    RayResults reference;
+    for (int k = 0; k < 3; ++k) {
+      if (!has[k]) continue;
+      RayOptions o;
+      o.query = q;
+      o.threads = 2;
+      o.isa = sets[k];
+      RayResults r;
+      index.cast(rays, o, r);
+      if (k == 0) {
+        reference = r;
+      } else {
+        EXPECT_TRUE(same(r, reference)) << to_string(q) << " " << to_string(sets[k]);
+      }
+    }
+    EXPECT_GT(std::count(reference.hit.begin(), reference.hit.end(), 1), 1000) << to_string(q);
+  }
+  for (Precision p : {Precision::float64, Precision::float32}) {
+    RayResults reference;
+    for (int k = 0; k < 3; ++k) {
+      if (!has[k]) continue;
+      RayOptions o;
+      o.precision = p;
+      o.isa = sets[k];
+      RayResults r;
+      cast_rays(*w.table, shape_rays, o, r);
+      if (k == 0) {
+        reference = r;
+      } else {
+        EXPECT_TRUE(same(r, reference)) << to_string(p) << " " << to_string(sets[k]);
+      }
+    }
+    EXPECT_GT(std::count(reference.hit.begin(), reference.hit.end(), 1), 100) << to_string(p);
+  }
+}
+
 // The wide traversal rejects leaves with a float ball test before the exact double one (ray_wide_traverse.hpp); its
 // margins cover the rounding of origins and centres to float, which at 10^6 m is 1/16 m, far more than the gap left
 // here (the test fails when the margins are left out). Spheres of radius 0.5 m around centres up to 10^6 m from the

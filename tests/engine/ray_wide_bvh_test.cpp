@@ -334,6 +334,26 @@ TEST(RayWideBvh, FloatTestIsTightAndTheSameOnEveryInstructionSet) {
   }
 }
 
+TEST(RayWideBvh, InstructionSetOptionPicksThatTraversal) {
+  // RayOptions::isa reaches the traversal through ray_isa_index() and select_wide_traverse(isa): each set's own loop
+  // (the same code would hide a wrong mapping behind equal answers), and the AVX2 ray setup for both vector sets.
+  EXPECT_EQ(detail::ray_isa_index(InstructionSet::scalar), 0);
+  EXPECT_EQ(select_wide_traverse(0), wide_traverse_for(0));
+  EXPECT_EQ(select_wide_ray_setup(0), wide_ray_setup_for(0));
+  if (wide_traverse_for(1) != nullptr) {
+    EXPECT_EQ(detail::ray_isa_index(InstructionSet::avx2), 1);
+    EXPECT_EQ(select_wide_traverse(1), wide_traverse_for(1));
+    EXPECT_EQ(select_wide_ray_setup(1), wide_ray_setup_for(1));
+    EXPECT_NE(select_wide_traverse(1), select_wide_traverse(0));
+  }
+  if (wide_traverse_for(2) != nullptr) {
+    EXPECT_EQ(detail::ray_isa_index(InstructionSet::avx512), 2);
+    EXPECT_EQ(select_wide_traverse(2), wide_traverse_for(2));
+    EXPECT_EQ(select_wide_ray_setup(2), wide_ray_setup_for(1));
+    EXPECT_EQ(select_wide_traverse(), wide_traverse_for(2));
+  }
+}
+
 TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {
   const double o[3] = {0, 0, 0}, d_ok[3] = {1, 0, -0.0}, d_tiny[3] = {1, 1e-30, 0}, far_o[3] = {1e30, 0, 0};
   EXPECT_TRUE(wide_ray_supported(o, d_ok));

@@ -54,6 +54,39 @@ TEST_F(RaysCli, OutWritesOneRowPerRayAndTheSameForAnyThreadCount) {
   EXPECT_NE(text.find("\n0,ok,"), std::string::npos);
 }
 
+// --isa picks the traversal's and lane kernels' instruction set, reported as "isa"; every set this CPU runs writes
+// the same hits, for closest (the Morton-ordered cast on this scene) and all (input order).
+TEST_F(RaysCli, EveryInstructionSetWritesTheSameHits) {
+  const bool has[3] = {true, __builtin_cpu_supports("avx2") != 0,
+                       __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")};
+  const char* names[3] = {"scalar", "avx2", "avx512"};
+  for (const char* query : {"closest", "all"}) {
+    std::string reference;
+    for (int isa = 0; isa < 3; ++isa) {
+      if (!has[isa]) continue;
+      SCOPED_TRACE(std::string(query) + " " + names[isa]);
+      const std::string path = (dir_ / (std::string(names[isa]) + ".csv")).string();
+      const json j = run_json("--objects 4000 --hull-vertices 40 --rays 6000 --runs 1 --frames 1 --seed 5 --query " +
+                              std::string(query) + " --isa " + names[isa] + " --out '" + path + "'");
+      EXPECT_EQ(j["isa"], names[isa]);
+      const std::string text = read_text(path);
+      if (isa == 0) {
+        reference = text;
+      } else {
+        EXPECT_TRUE(text == reference);  // not EXPECT_EQ: a 6000-row diff would flood the log
+      }
+    }
+    // Rays do hit: closest writes a row per ray, all a row per hit (~0.7 of 6000 rays hit something).
+    EXPECT_GT(std::count(reference.begin(), reference.end(), '\n'), 3000);
+    if (query == std::string("closest")) {
+      EXPECT_NE(reference.find(",ok,1,"), std::string::npos);
+    }
+  }
+  const json shape = run_json("--mode shape --rays 2000 --runs 1 --isa scalar");
+  EXPECT_EQ(shape["isa"], "scalar");
+}
+
 TEST_F(RaysCli, AllQueryWritesOneRowPerHit) {
   const std::string path = (dir_ / "all.csv").string();
   const json j = run_json(std::string(kSmall) + " --query all --out '" + path + "'");
@@ -107,6 +140,7 @@ TEST_F(RaysCli, BadFlagsExitWithCode2AndAClearMessage) {
       {"--hull-vertices 3", "--hull-vertices must be >= 4"},
       {"--rays ten", "--rays"},
       {"--mode shape --rays 10 --out x.csv", "--out is only available with --mode scene"},
+      {"--isa sse9", "--isa sse9: unknown instruction set (valid: auto, scalar, avx2, avx512)"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args);

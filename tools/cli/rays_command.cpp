@@ -37,7 +37,7 @@ using testkit::RaysSceneSpec;
 
 struct RaysSettings {
   RaysSceneSpec scene;
-  std::string mode = "scene", query = "closest", out, batch, scene_file;
+  std::string mode = "scene", query = "closest", out, batch, scene_file, isa = "auto";
   std::int64_t rays = 1000000;
   int threads = 0, runs = 3, frames = 5, segments = 64;
   bool json = false, peers = false;
@@ -63,7 +63,14 @@ void validate(const RaysSettings& s) {
   check(s.scene_file.empty() || s.mode == "scene", "--scene casts against a scene: it cannot be used with --mode shape");
   check(s.query == "closest" || s.query == "any" || s.query == "all",
         "--query " + s.query + ": unknown (valid: closest, any, all)");
+  check(s.isa == "auto" || s.isa == "scalar" || s.isa == "avx2" || s.isa == "avx512",
+        "--isa " + s.isa + ": unknown instruction set (valid: auto, scalar, avx2, avx512)");
   check(!s.peers || peers::have_embree(), "--peers needs Embree 3 (install libembree-dev and rebuild)");
+}
+
+// The instruction set the casts run (resolved: InputError when this CPU cannot run the one asked for).
+InstructionSet ray_isa(const RaysSettings& s) {
+  return resolve_instruction_set(s.isa == "auto" ? InstructionSet::automatic : parse_instruction_set(s.isa));
 }
 
 double time_ms(const std::function<void()>& f) {
@@ -151,6 +158,7 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
   RayOptions options;
   options.query = query;
   options.threads = s.threads;
+  options.isa = ray_isa(s);
 #ifdef BATCHCOL_HAVE_EMBREE
   // Embree's scene is built before the timed casts, whose runs then alternate between the two libraries so that
   // both see the same machine load (the ratio is what the report is for; the machine may be shared).
@@ -184,6 +192,7 @@ nlohmann::json run_scene_mode(const RaysSettings& s, RayResults& results) {
                       {"rays", n_rays},
                       {"query", s.query},
                       {"threads", s.threads},
+                      {"isa", to_string(ray_isa(s))},
                       {"hit_fraction", double(hits) / double(n_rays)},
                       {"batchcol",
                        {{"build_ms", median(build)},
@@ -246,7 +255,7 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
   const std::uint32_t ids[4] = {table.add(Shape::sphere(0.5)), table.add(Shape::box(0.4, 0.3, 0.2)),
                                 table.add(Shape::capsule(0.25, 0.25)), table.add(Shape::convex(points))};
   const char* names[4] = {"sphere", "box", "capsule", "hull"};
-  nlohmann::json j = {{"mode", "shape"}, {"rays", s.rays}, {"threads", s.threads}, {"hull_vertices", s.scene.hull_vertices}};
+  nlohmann::json j = {{"mode", "shape"}, {"rays", s.rays}, {"threads", s.threads}, {"isa", to_string(ray_isa(s))}, {"hull_vertices", s.scene.hull_vertices}};
   for (int k = 0; k < 4; ++k) {
     ShapeRayBatch batch;
     for (std::int64_t i = 0; i < s.rays; ++i) {
@@ -258,6 +267,7 @@ nlohmann::json run_shape_mode(const RaysSettings& s) {
     for (Precision p : {Precision::float64, Precision::float32}) {
       RayOptions o;
       o.threads = s.threads;
+      o.isa = ray_isa(s);
       o.precision = p;
       RayResults r;
       std::vector<double> ms;
@@ -279,6 +289,7 @@ nlohmann::json run_batch_mode(const RaysSettings& s, RayResults& results) {
   check(file.rays.size() > 0, s.batch + ": the file has no \"rays\"");
   RayOptions options;
   options.threads = s.threads;
+  options.isa = ray_isa(s);
   if (file.precision) options.precision = *file.precision;
   const double ms = time_ms([&] { cast_rays(file.shapes, file.rays, options, results); });
   std::size_t hits = 0;
@@ -351,6 +362,7 @@ Command add_rays_command(CLI::App& parent) {
   app->add_option("--fill", s->scene.fill, "Objects a ray crosses on average (sets the scene size)")->capture_default_str();
   app->add_option("--query", s->query, "closest, any or all")->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")->capture_default_str();
+  app->add_option("--isa", s->isa, "auto, scalar, avx2 or avx512: the traversal's and lane kernels' instruction set (auto: the best this CPU runs; same hits on every set)")->capture_default_str();
   app->add_option("--runs", s->runs, "Timed runs (the median is reported)")->capture_default_str();
   app->add_option("--frames", s->frames, "Refit frames (every object moves 1 cm)")->capture_default_str();
   app->add_option("--segments", s->segments, "Embree tessellation of cylinders (segments around)")->capture_default_str();

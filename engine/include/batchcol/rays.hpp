@@ -77,6 +77,10 @@ struct RayOptions {
   double tolerance = 1e-9;  // GJK ray cast: distance (metres) of the reported hit point to the surface, at most
   int max_iterations = 64;  // GJK ray cast iterations per ray and shape
   int threads = 0;          // 0 = all cores
+  // Instruction set of the scene traversal (and its ray setup) and of the shape form's lane kernels (automatic: the
+  // best this CPU runs, capped by BATCHCOL_ISA as for collide()); every set gives bitwise the same results. A set
+  // this CPU lacks throws InputError. The hulls' plane clipping inside the exact kernels keeps the CPU's best.
+  InstructionSet isa = InstructionSet::automatic;
 };
 /// Throws InputError naming the option (tolerance not finite or <= 0, max_iterations < 1, threads < 0).
 BATCHCOL_API void validate(const RayOptions& options);
