@@ -201,6 +201,35 @@ template <class T> void expect_start_cells_match(const std::vector<Eigen::Matrix
   }
 }
 
+namespace {
+
+/// The closed-form start tests below: every pair's certified distance is the gap it was built with, and the share
+/// of pairs done in <= 2 iterations (the start certified by the first plain step) is counted.
+struct StartTally {
+  int trials = 0, one_or_two = 0;
+  void add(const testing::SingleResult& res, double gap) {
+    EXPECT_EQ(res.status, Status::converged);
+    EXPECT_NEAR(res.distance, gap, 1e-9);  // GJK's certified gap: the tests' opt.tolerance
+    ++trials;
+    one_or_two += res.iterations <= 2 ? 1 : 0;
+  }
+  void expect_at_least(int num, int den) const {
+    EXPECT_GE(one_or_two, trials * num / den) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
+  }
+};
+
+/// An ellipsoid of radii r in a random orientation (drawn from rng) touching, from beyond, the plane through pb
+/// orthogonal to the unit m: its centre pb + Q m / sqrt(m^T Q m) (Q = E diag(r^2) E^T) and its rotation.
+std::pair<Eigen::Vector3d, Eigen::Quaterniond> ellipsoid_touching(Rng& rng, const Eigen::Vector3d& r,
+                                                                 const Eigen::Vector3d& pb, const Eigen::Vector3d& m) {
+  const Eigen::Quaterniond qe = testing::random_rotation(rng);
+  const Eigen::Matrix3d E = qe.toRotationMatrix();
+  const Eigen::Matrix3d Qm = E * r.cwiseProduct(r).asDiagonal() * E.transpose();
+  return {pb + Qm * m / std::sqrt(m.dot(Qm * m)), qe};
+}
+
+}  // namespace
+
 /// Box edge and vertex contacts with an ellipsoid, built with a known gap: the ellipsoid touches the plane through
 /// pb = pa + gap m (m in the feature's normal cone, pa on the edge or the vertex) from beyond, its centre at pb +
 /// Q m / sqrt(m^T Q m) (Q = E diag(r^2) E^T). GJK converged in 18.7 mean iterations on such close pairs (21.0 on
@@ -211,7 +240,7 @@ TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
   QueryOptions opt;
   opt.level = QueryLevel::witness;
   opt.tolerance = 1e-9;
-  int trials = 0, one_or_two = 0;
+  StartTally tally;
   for (const bool swap : {false, true}) {
     for (const bool vertex : {false, true}) {
       for (int trial = 0; trial < 50; ++trial) {
@@ -231,10 +260,7 @@ TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
         m.normalize();
         const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
         const Eigen::Vector3d pb = pa + gap * m;
-        const Eigen::Quaterniond qe = testing::random_rotation(rng);
-        const Eigen::Matrix3d E = qe.toRotationMatrix();
-        const Eigen::Matrix3d Qm = E * r.cwiseProduct(r).asDiagonal() * E.transpose();
-        const Eigen::Vector3d ce = pb + Qm * m / std::sqrt(m.dot(Qm * m));
+        const auto [ce, qe] = ellipsoid_touching(rng, r, pb, m);
         const Eigen::Quaterniond Q = testing::random_rotation(rng);
         const Eigen::Vector3d T = testing::random_vector(rng);
         const Pose pose_box{T, Q}, pose_ell{T + Q * ce, Q * qe};
@@ -243,14 +269,11 @@ TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
                               : testing::run_pair(box, pose_box, ell, pose_ell, opt);
         SCOPED_TRACE("swap " + std::to_string(swap) + " vertex " + std::to_string(vertex) + " trial " +
                      std::to_string(trial) + " gap " + std::to_string(gap));
-        EXPECT_EQ(res.status, Status::converged);
-        EXPECT_NEAR(res.distance, gap, 1e-9);  // GJK's certified gap: opt.tolerance
-        ++trials;
-        one_or_two += res.iterations <= 2 ? 1 : 0;
+        tally.add(res, gap);
       }
     }
   }
-  EXPECT_GE(one_or_two, trials * 9 / 10) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
+  tally.expect_at_least(9, 10);
 }
 
 /// Box edges against a cylinder's or a cone's rim and box vertices against the side (slant), built with a known
@@ -266,7 +289,7 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
   QueryOptions opt;
   opt.level = QueryLevel::witness;
   opt.tolerance = 1e-9;
-  int trials = 0, one_or_two = 0;
+  StartTally tally;
   for (const bool cone : {false, true}) {
     for (const bool swap : {false, true}) {
       for (const bool vertex : {false, true}) {
@@ -318,17 +341,14 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
                                 : testing::run_pair(box, pose_box, round, pose_round, opt);
           SCOPED_TRACE("cone " + std::to_string(cone) + " swap " + std::to_string(swap) + " vertex " +
                        std::to_string(vertex) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));
-          EXPECT_EQ(res.status, Status::converged);
-          EXPECT_NEAR(res.distance, gap, 1e-9);  // GJK's certified gap: opt.tolerance
-          ++trials;
-          one_or_two += res.iterations <= 2 ? 1 : 0;
+          tally.add(res, gap);
         }
       }
     }
   }
   // Measured 330 of 400 (edge-rim contacts whose rim angle the samples and Newton steps leave a little off take a
   // few more iterations); without the start almost none of these pairs converges in 2.
-  EXPECT_GE(one_or_two, trials * 3 / 4) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
+  tally.expect_at_least(3, 4);
 }
 
 /// Sphere and capsule against an ellipsoid at a known gap (the ellipsoid touching the plane through pb = pa + (gap +
@@ -341,7 +361,7 @@ TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
   QueryOptions opt;
   opt.level = QueryLevel::witness;
   opt.tolerance = 1e-9;
-  int trials = 0, one_or_two = 0;
+  StartTally tally;
   for (const bool swap : {false, true}) {
     for (const int kind : {0, 1, 2}) {  // sphere, capsule side, capsule end
       for (int trial = 0; trial < 50; ++trial) {
@@ -359,10 +379,7 @@ TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
         m.normalize();
         const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
         const Eigen::Vector3d pb = pa + (gap + radius) * m;
-        const Eigen::Quaterniond qe = testing::random_rotation(rng);
-        const Eigen::Matrix3d E = qe.toRotationMatrix();
-        const Eigen::Matrix3d Qm = E * r.cwiseProduct(r).asDiagonal() * E.transpose();
-        const Eigen::Vector3d ce = pb + Qm * m / std::sqrt(m.dot(Qm * m));
+        const auto [ce, qe] = ellipsoid_touching(rng, r, pb, m);
         const Eigen::Quaterniond Q = testing::random_rotation(rng);
         const Eigen::Vector3d T = testing::random_vector(rng);
         const Pose pose_a{T, Q}, pose_ell{T + Q * ce, Q * qe};
@@ -371,14 +388,11 @@ TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
         const auto res = swap ? testing::run_pair(ell, pose_ell, a, pose_a, opt) : testing::run_pair(a, pose_a, ell, pose_ell, opt);
         SCOPED_TRACE("swap " + std::to_string(swap) + " kind " + std::to_string(kind) + " trial " +
                      std::to_string(trial) + " gap " + std::to_string(gap));
-        EXPECT_EQ(res.status, Status::converged);
-        EXPECT_NEAR(res.distance, gap, 1e-9);  // GJK's certified gap: opt.tolerance
-        ++trials;
-        one_or_two += res.iterations <= 2 ? 1 : 0;
+        tally.add(res, gap);
       }
     }
   }
-  EXPECT_GE(one_or_two, trials * 9 / 10) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
+  tally.expect_at_least(9, 10);
 }
 
 TEST(WideGjk, StartCellsOfTheLanesAreTheScalarStartCell) {
