@@ -638,8 +638,8 @@ template <class T> struct WideGjk {
     std::int64_t pair[W];      // pair index of each lane, -1 when empty
     std::uint32_t fresh = 0;  // lanes refilled since the last start(): their first support point is pending
     int newton_pair = -1;     // newton_pair_type(A.type, B.type), set by the first refill of the run; -1: not yet
-    // start_candidate_pair() runs of double: each refilled lane's rim_candidate() or box_ellipsoid_candidate() (NaN:
-    // none), which start() takes as the first point where it is closer than the first support point (and
+    // start_candidate_pair() runs of double: each refilled lane's rim_candidate(), box_round_candidate() or
+    // box_ellipsoid_candidate() (NaN: none), which start() takes as the first point where it is closer than the first support point (and
     // side_start()'s). `rim_given`: the source wrote them at refill (WideGjkPairs, from its W-pair set-up); else
     // start() computes them.
     bool rim_given = false;

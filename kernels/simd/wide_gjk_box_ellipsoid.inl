@@ -36,7 +36,8 @@
 /// (NaN candidates, e.g. a centre on a corner, never are). pa, pb in the box's frame.
 /// `Core`: the box itself (kBoxCore), or a box with zero extents standing for a capsule's core, the segment
 /// h = (0, 0, half length) (kSegmentCore: only the edge along z, the segment itself, and its end toward the
-/// ellipsoid; the faces and the other edges are that end again), or for a sphere's core, the point h = 0
+/// ellipsoid; a face's point lies on the segment, so the segment's own candidate is never farther, and the
+/// other edges have zero length: the end again), or for a sphere's core, the point h = 0
 /// (kPointCore: only the vertex, the nearest ellipsoid point, exact up to the Newton steps). Why: sphere- and
 /// capsule-ellipsoid pairs run GJK on the cores to convergence at the witness level, overlapping spheres and
 /// capsules included (their cores are apart); the demo measured 4.3-4.7 mean iterations on them, 14% of its
@@ -156,8 +157,8 @@ AI static void box_ellipsoid_point(const real* E, const V3& c, const real* r, co
 
 /// box_ellipsoid_point() for W pairs of a box_ellipsoid_pair() type, A's frame: R (row-major), t: B's pose in A's
 /// frame; sa, sb: the cores' sizes (a box's half extents, an ellipsoid's radii, a capsule's half length as the
-/// second, kernels/shape_core.hpp; a sphere's core has none). With the ellipsoid as A, the other core's pose in
-/// B's frame is (R^T, -R^T t), and the points are mapped back by R and t. Computed where the pairs are set up, W
+/// second, kernels/shape_core.hpp; a sphere's core has none). With the ellipsoid as A, its pose in the flat
+/// core's (B's) frame is (R^T, -R^T t), and the points are mapped back by R and t. Computed where the pairs are set up, W
 /// at a time (WideGjkPairs' fill_slots()), as rim_candidate(). The sizes by value: passing fill_slots()'s size
 /// arrays by address made it keep its sides' values in memory in every run, boolean runs included (+6
 /// instructions per pair in run_certified(), boolean box-ellipsoid and box-cylinder double, callgrind AVX2).

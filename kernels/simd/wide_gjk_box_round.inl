@@ -12,12 +12,13 @@
 // and GJK's first plain step certifies it (the duality-gap stop is unchanged) or goes on from it.
 
 /// The box edge (the line p + z d, |z| <= hk, d unit) against the rim of radius r at height zr, in the round core's
-/// frame: the rim point px(theta) = (r cos theta, r sin theta, zr) nearest to the line, its foot py on the line, and
-/// `ok` where the foot is on the edge. The squared distance to the line phi = |v|^2 - <v, d>^2 (v = px - p) is,
+/// frame: the rim point px(theta) = (r cos theta, r sin theta, zr) nearest to the line, its foot's parameter z on the
+/// line (`along`), and `ok` where the foot is on the edge. The caller puts the foot on the box as the box's own p0 +
+/// z e_k, exactly on the edge (mapped back from this frame it would be off the box by a few ulps). The squared distance to the line phi = |v|^2 - <v, d>^2 (v = px - p) is,
 /// up to constants, f = <2 r w, m> - (r <d, m> + <w, d>)^2 (m = (cos, sin) theta, w = (0, 0, zr) - p): the best of
 /// kEdgeRimSamples angles (opposite angles share the products), then kEdgeRimNewtonSteps Newton steps on theta
 /// (rim_lateral()'s, for a line: g = phi' / 2, h = phi'' / 2, a turn by dt where h > 0).
-AI static void edge_rim(real r, real zr, const V3& p, const V3& d, real hk, V3& px, V3& py, mask& ok) {
+AI static void edge_rim(real r, real zr, const V3& p, const V3& d, real hk, V3& px, real& along, mask& ok) {
   const real zero = splat(T(0)), one = splat(T(1));
   const V3 w = {-p.x, -p.y, zr - p.z};
   const real tr = T(2) * r;
@@ -50,9 +51,8 @@ AI static void edge_rim(real r, real zr, const V3& p, const V3& d, real hk, V3& 
     S = S1 * inv;
   }
   px = {r * C, r * S, zr};
-  const real vb = dot(sub(px, p), d);
-  py = add(p, scale(vb, d));
-  ok &= (vb <= hk) & (vb >= -hk);
+  along = dot(sub(px, p), d);
+  ok &= (along <= hk) & (along >= -hk);
 }
 
 /// The box (half extents h, centred, axis-aligned: its own frame) against the round core Y (a cylinder, or with
@@ -132,10 +132,11 @@ AI static void box_round_point(const real* Rr, const V3& c, real r, real hy, boo
     const V3 dr = {Rr[3 * k], Rr[3 * k + 1], Rr[3 * k + 2]};
     {  // edge vs rim
       const real zr = cone ? -hy : select(pr.z < zero, -hy, hy);
-      V3 px, py;
+      V3 px;
+      real along;
       mask ok = all;
-      edge_rim(r, zr, pr, dr, hk, px, py, ok);
-      keep(ok, back(py), back(px));
+      edge_rim(r, zr, pr, dr, hk, px, along, ok);
+      keep(ok, add(p0, scale(along, dir)), back(px));
       if (cone) {  // edge vs slant: the generator whose tangent plane is parallel to the edge (in Y's frame)
         const real kr = T(2) * hy;
         const real a2 = dr.x * dr.x + dr.y * dr.y;
@@ -153,8 +154,8 @@ AI static void box_round_point(const real* Rr, const V3& c, real r, real hy, boo
         const real denom = aa * cq - bq * bq;
         const real se = (bq * ee - cq * dd) / denom, tau = (aa * ee - bq * dd) / denom;
         const mask ok2 = (disc > zero) & (g > zero) & (tau >= zero) & (tau <= one) & (se >= -hk) & (se <= hk);
-        const V3 qy = add(pr, scale(se, dr)), qx = {tau * gd.x, tau * gd.y, hy + tau * gd.z};
-        keep(ok2, back(qy), back(qx));
+        const V3 qx = {tau * gd.x, tau * gd.y, hy + tau * gd.z};
+        keep(ok2, add(p0, scale(se, dir)), back(qx));  // the edge's point on the box, as edge_rim()'s
       }
     }
     if (!cone) {  // edge vs side: the edge's point closest to the axis line (Ericson's closest points of two lines)

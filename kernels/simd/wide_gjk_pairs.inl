@@ -130,7 +130,8 @@ template <class T> struct WideGjkPairs {
     std::size_t read = 0;  // pairs[0 .. read) went into a chunk
     bool witness = options.level >= QueryLevel::witness;
     /// Double distance / witness runs of a start_candidate_pair() type: the slots carry start points,
-    /// rim_candidate()'s or (box_ell) box_ellipsoid_candidate()'s. One flag for both where the lanes read them:
+    /// rim_candidate()'s, box_round_candidate()'s or (box_ell) box_ellipsoid_candidate()'s. One flag for all where the
+    /// lanes read them:
     /// a second test in load() cost boolean box-cylinder double +6 instructions per pair (callgrind, AVX2).
     bool rim = std::is_same_v<T, double> && options.level != QueryLevel::boolean && start_candidate_pair(type_a, type_b);
     bool box_ell = rim && box_ellipsoid_pair(type_a, type_b);

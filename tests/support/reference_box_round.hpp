@@ -14,9 +14,9 @@ namespace batchcol::test_reference {
 using namespace batchcol::kernels;
 
 /// wide_gjk_box_round.inl's edge_rim(): the rim point px (radius r, height zr) nearest to the line p + z d, its
-/// foot py; true where the foot is on the edge (|z| <= hk).
+/// foot's z (`along`); true where the foot is on the edge (|z| <= hk).
 template <class T>
-bool edge_rim(T r, T zr, const Vec3<T>& p, const Vec3<T>& d, T hk, Vec3<T>& px, Vec3<T>& py) {
+bool edge_rim(T r, T zr, const Vec3<T>& p, const Vec3<T>& d, T hk, Vec3<T>& px, T& along) {
   const auto dot = [](const Vec3<T>& x, const Vec3<T>& y) { return (x.x() * y.x() + x.y() * y.y()) + x.z() * y.z(); };
   const Vec3<T> w(-p.x(), -p.y(), zr - p.z());
   const T tr = T(2) * r;
@@ -44,9 +44,8 @@ bool edge_rim(T r, T zr, const Vec3<T>& p, const Vec3<T>& d, T hk, Vec3<T>& px, 
   }
   px = Vec3<T>(r * C, r * S, zr);
   const Vec3<T> v(px.x() - p.x(), px.y() - p.y(), px.z() - p.z());
-  const T vb = dot(v, d);
-  py = Vec3<T>(p.x() + vb * d.x(), p.y() + vb * d.y(), p.z() + vb * d.z());
-  return vb <= hk && vb >= -hk;
+  along = dot(v, d);
+  return along <= hk && along >= -hk;
 }
 
 /// wide_gjk_box_round.inl's box_round_point(): Rr row-major (Y's rotation in the box's frame), c Y's centre, r, hy
@@ -104,11 +103,12 @@ void box_round_point(const T* Rr, const T* c, T r, T hy, bool cone, const T* h, 
     const Vec3<T> dr(Rr[3 * k], Rr[3 * k + 1], Rr[3 * k + 2]);
     {
       const T zr = cone ? -hy : (pr.z() < T(0) ? -hy : hy);
-      Vec3<T> px, py;
-      const bool ok = edge_rim(r, zr, pr, dr, hk, px, py);
+      Vec3<T> px;
+      T along;
+      const bool ok = edge_rim(r, zr, pr, dr, hk, px, along);
       T qa[3], qb[3];
       for (int i = 0; i < 3; ++i) {
-        qa[i] = ((Rr[3 * i] * py.x() + Rr[3 * i + 1] * py.y()) + Rr[3 * i + 2] * py.z()) + c[i];
+        qa[i] = p0[i] + along * dir[i];
         qb[i] = ((Rr[3 * i] * px.x() + Rr[3 * i + 1] * px.y()) + Rr[3 * i + 2] * px.z()) + c[i];
       }
       keep(ok, qa, qb);
@@ -129,11 +129,10 @@ void box_round_point(const T* Rr, const T* c, T r, T hy, bool cone, const T* h, 
         const T denom = aa * cq - bq * bq;
         const T se = (bq * ee - cq * dd) / denom, tau = (aa * ee - bq * dd) / denom;
         const bool ok2 = disc > T(0) && g > T(0) && tau >= T(0) && tau <= T(1) && se >= -hk && se <= hk;
-        const T qy[3] = {pr.x() + se * d3[0], pr.y() + se * d3[1], pr.z() + se * d3[2]};
         const T qx[3] = {tau * gd[0], tau * gd[1], hy + tau * gd[2]};
         T ya[3], xb[3];
         for (int i = 0; i < 3; ++i) {
-          ya[i] = ((Rr[3 * i] * qy[0] + Rr[3 * i + 1] * qy[1]) + Rr[3 * i + 2] * qy[2]) + c[i];
+          ya[i] = p0[i] + se * dir[i];
           xb[i] = ((Rr[3 * i] * qx[0] + Rr[3 * i + 1] * qx[1]) + Rr[3 * i + 2] * qx[2]) + c[i];
         }
         keep(ok2, ya, xb);

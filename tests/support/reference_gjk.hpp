@@ -362,7 +362,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
       const bool found = rim_candidate(D, p);
       take_start(found, p);
     }
-    // Box-ellipsoid pairs (double): the closest face / edge / vertex point of D.
+    // Box-, capsule- and sphere-ellipsoid pairs (double): the closest face / edge / vertex point of D.
     if (!params.boolean_only && box_ellipsoid_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
       const bool found = box_ellipsoid_candidate(D, p);
