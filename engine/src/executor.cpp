@@ -295,8 +295,8 @@ void run_tile(const ShapeTable& shapes, const PairBatchView& batch, const QueryO
                                                 type_b(g) == ShapeType::capsule, pairs, count, query, results, left_out);
     } else if (kind == WideClosedForm::point_solids) {
       const bool sphere_a = type_a(g) == ShapeType::sphere;
-      const bool cone = (sphere_a ? type_b(g) : type_a(g)) == ShapeType::cone;
-      fallbacks += kernels::simd::point_solid_pairs(isa, view, sphere_a, cone, pairs, count, query, results, left_out);
+      const auto solid = kernels::simd::point_solid_of(sphere_a ? type_b(g) : type_a(g));
+      fallbacks += kernels::simd::point_solid_pairs(isa, view, sphere_a, solid, pairs, count, query, results, left_out);
     } else {
       fallbacks += kernels::simd::box_pairs_boolean(isa, view, pairs, count, results, left_out);
     }
@@ -353,7 +353,8 @@ void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOp
 }
 
 const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
-  // Sphere-cylinder and sphere-cone have a closed form only in SIMD lanes; the others are what the per-pair setup
+  // Sphere-cylinder and sphere-cone have a closed form only in SIMD lanes (sphere-box also has a per-pair one); the
+  // others are what the per-pair setup
   // answers (it also knows that inflated boxes run GJK).
   if (kernels::simd::wide_closed_form(a.type, b.type, options) == WideClosedForm::point_solids) return "closed form";
   const OwnedShapeView va(a), vb(b);

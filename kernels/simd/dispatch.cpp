@@ -20,7 +20,7 @@ namespace batchcol::kernels::simd {
                             const ClosedFormQuery&, const ResultView&, std::uint32_t*);                          \
   std::size_t box_pairs_boolean(const PairView&, const std::uint32_t*, std::size_t, const ResultView&,             \
                                 std::uint32_t*);                                                                 \
-  std::size_t point_solid_pairs(const PairView&, bool, bool, const std::uint32_t*, std::size_t,                    \
+  std::size_t point_solid_pairs(const PairView&, bool, PointSolid, const std::uint32_t*, std::size_t,              \
                                 const ClosedFormQuery&, const ResultView&, std::uint32_t*);                      \
   std::size_t gjk_pairs_double(const PairView&, ShapeType, ShapeType, const std::uint32_t*, std::size_t,           \
                                const QueryOptions&, const ResultView&, std::uint32_t*);                            \
@@ -139,10 +139,10 @@ std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std:
   return kernels_of(isa).box_pairs_boolean(in, pairs, n, out, fallback);
 }
 
-std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, bool cone,
+std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, PointSolid solid,
                               const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                               const ResultView& out, std::uint32_t* fallback) {
-  return kernels_of(isa).point_solid_pairs(in, sphere_a, cone, pairs, n, query, out, fallback);
+  return kernels_of(isa).point_solid_pairs(in, sphere_a, solid, pairs, n, query, out, fallback);
 }
 
 template <>

@@ -104,14 +104,18 @@ std::size_t segment_pairs(const PairView& in, bool capsule_a, bool capsule_b, co
   return WideSegments::run<false, false>(in, pairs, n, query, out, fallback);
 }
 
-std::size_t point_solid_pairs(const PairView& in, bool sphere_a, bool cone, const std::uint32_t* pairs, std::size_t n,
-                              const ClosedFormQuery& query, const ResultView& out, std::uint32_t* fallback) {
+std::size_t point_solid_pairs(const PairView& in, bool sphere_a, PointSolid solid, const std::uint32_t* pairs,
+                              std::size_t n, const ClosedFormQuery& query, const ResultView& out,
+                              std::uint32_t* fallback) {
+  using S = PointSolid;
   if (sphere_a) {
-    return cone ? WidePointSolids::run<true, true>(in, pairs, n, query, out, fallback)
-                : WidePointSolids::run<true, false>(in, pairs, n, query, out, fallback);
+    if (solid == S::box) return WidePointSolids::run<true, S::box>(in, pairs, n, query, out, fallback);
+    return solid == S::cone ? WidePointSolids::run<true, S::cone>(in, pairs, n, query, out, fallback)
+                            : WidePointSolids::run<true, S::cylinder>(in, pairs, n, query, out, fallback);
   }
-  return cone ? WidePointSolids::run<false, true>(in, pairs, n, query, out, fallback)
-              : WidePointSolids::run<false, false>(in, pairs, n, query, out, fallback);
+  if (solid == S::box) return WidePointSolids::run<false, S::box>(in, pairs, n, query, out, fallback);
+  return solid == S::cone ? WidePointSolids::run<false, S::cone>(in, pairs, n, query, out, fallback)
+                          : WidePointSolids::run<false, S::cylinder>(in, pairs, n, query, out, fallback);
 }
 
 std::size_t box_pairs_boolean(const PairView& in, const std::uint32_t* pairs, std::size_t n, const ResultView& out,

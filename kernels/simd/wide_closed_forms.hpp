@@ -25,15 +25,21 @@ std::size_t segment_pairs(InstructionSet isa, const PairView& in, bool capsule_a
 std::size_t box_pairs_boolean(InstructionSet isa, const PairView& in, const std::uint32_t* pairs, std::size_t n,
                               const ResultView& out, std::uint32_t* fallback);
 
-/// Whether point_solid_pairs() answers pairs of these types: a sphere and a cylinder or cone, either order.
+/// The solids point_solid_pairs() measures a sphere's centre against.
+enum class PointSolid { cylinder, cone, box };
+/// Whether point_solid_pairs() answers pairs of these types: a sphere and a cylinder, cone or box, either order.
 inline bool is_point_solid_pair(ShapeType a, ShapeType b) {
-  const auto revolution = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; };
-  return (a == ShapeType::sphere && revolution(b)) || (b == ShapeType::sphere && revolution(a));
+  const auto solid = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone || t == ShapeType::box; };
+  return (a == ShapeType::sphere && solid(b)) || (b == ShapeType::sphere && solid(a));
+}
+/// The PointSolid of a solid's shape type (cylinder, cone or box).
+inline PointSolid point_solid_of(ShapeType t) {
+  return t == ShapeType::cone ? PointSolid::cone : t == ShapeType::box ? PointSolid::box : PointSolid::cylinder;
 }
 
-/// Sphere-cylinder and sphere-cone pairs (A is the sphere when `sphere_a`, the other side a cone when `cone`, else
-/// a cylinder; `pairs` ascending), at every query level: the sphere's centre against the solid of revolution in
-/// closed form (wide_point_solids.inl). Writes what segment_pairs writes; returns how many it left to the scalar
+/// Sphere-cylinder, sphere-cone and sphere-box pairs (A is the sphere when `sphere_a`, the other side a `solid`;
+/// `pairs` ascending), at every query level: the sphere's centre against the solid in closed form
+/// (wide_point_solids.inl). Writes what segment_pairs writes; returns how many it left to the scalar
 /// path (invalid input, a centre on the solid's boundary to rounding), their indices in fallback[0 .. count).
 /// Which SIMD closed form answers pairs of types (a, b) under `options`, if any: the one rule the executor groups
 /// pairs by, kernel_for() names and the tests exclude from their scalar comparisons. The kernels may still leave
@@ -43,7 +49,8 @@ inline WideClosedForm wide_closed_form(ShapeType a, ShapeType b, const QueryOpti
   if (!options.closed_forms) return WideClosedForm::none;
   const auto segment = [](ShapeType t) { return t == ShapeType::sphere || t == ShapeType::capsule; };
   if (segment(a) && segment(b)) return WideClosedForm::segments;
-  // A sphere's centre against a cylinder or cone: a 2D distance in the solid's section (wide_point_solids.inl).
+  // A sphere's centre against a cylinder or cone (a 2D distance in the solid's section) or a box
+  // (wide_point_solids.inl).
   if (is_point_solid_pair(a, b)) return WideClosedForm::point_solids;
   // As setup_pair(): the separating-axis test is exact for boolean queries with a zero margin.
   if (a == ShapeType::box && b == ShapeType::box && options.level == QueryLevel::boolean && options.margin == 0.0)
@@ -51,7 +58,7 @@ inline WideClosedForm wide_closed_form(ShapeType a, ShapeType b, const QueryOpti
   return WideClosedForm::none;
 }
 
-std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, bool cone,
+std::size_t point_solid_pairs(InstructionSet isa, const PairView& in, bool sphere_a, PointSolid solid,
                               const std::uint32_t* pairs, std::size_t n, const ClosedFormQuery& query,
                               const ResultView& out, std::uint32_t* fallback);
 

@@ -1,4 +1,4 @@
-// Sphere against cylinder and cone in closed form (kernels/simd/wide_point_solids.inl): exact answers on hand-made
+// Sphere against cylinder, cone and box in closed form (kernels/simd/wide_point_solids.inl): exact answers on hand-made
 // placements, agreement with GJK / EPA (closed forms off, tolerance 1e-12) on random pairs in every regime and both
 // orders, the same bits on every instruction set, and invalid lanes left to the scalar path.
 #include "batchcol/batchcol.hpp"
@@ -89,22 +89,37 @@ TEST(PointSolids, ConePlacementsHaveTheirExactAnswers) {
               "cone");
 }
 
-/// Random sphere-cylinder / sphere-cone pairs (sizes 2-40 cm, inflated or not, both orders, distant to deeply
+TEST(PointSolids, BoxPlacementsHaveTheirExactAnswers) {
+  const double r = 0.25, s3 = std::sqrt(3.0);  // sphere radius; box half extents (1, 2, 3)
+  check_cases(Shape::box(1.0, 2.0, 3.0), r,
+              {{{3.0, 0.5, -1.0}, 2.0 - r, {1, 0, 0}},                                   // beside the +x face
+               {{0.2, -0.3, -5.0}, 2.0 - r, {0, 0, -1}},                                 // below the -z face
+               {{2.0, 3.0, 0.0}, std::sqrt(2.0) - r, {std::sqrt(0.5), std::sqrt(0.5), 0}},  // beyond an edge
+               {{-2.0, -3.0, 4.0}, s3 - r, {-1 / s3, -1 / s3, 1 / s3}},                  // beyond a vertex
+               {{0.9, 0.0, 0.0}, -0.1 - r, {1, 0, 0}},                                   // inside, nearer +x
+               {{0.0, -1.7, 0.5}, -0.3 - r, {0, -1, 0}},                                 // inside, nearer -y
+               {{0.0, 0.0, 2.95}, -0.05 - r, {0, 0, 1}},                                 // inside, nearer +z
+               {{-0.6, 1.5, 0.0}, -0.4 - r, {-1, 0, 0}}},                                // inside, nearer -x
+              "box");
+}
+
+/// Random sphere-cylinder / sphere-cone / sphere-box pairs (sizes 2-40 cm, inflated or not, both orders, distant to deeply
 /// overlapping) against GJK and EPA with the closed forms off at tolerance 1e-12.
 TEST(PointSolids, AgreeWithGjkAndEpaOnRandomPairs) {
   Rng rng(11);
   ShapeTable table;
   std::vector<std::uint32_t> spheres, solids;
-  for (int i = 0; i < 40; ++i) {
+  const ShapeType kinds[3] = {ShapeType::cylinder, ShapeType::cone, ShapeType::box};
+  for (int i = 0; i < 60; ++i) {
     Shape sphere = testing::random_shape(rng, ShapeType::sphere);
-    Shape solid = testing::random_shape(rng, i % 2 ? ShapeType::cone : ShapeType::cylinder);
+    Shape solid = testing::random_shape(rng, kinds[i % 3]);
     if (i % 4 == 0) sphere = sphere.inflated(0.01);
-    if (i % 3 == 0) solid = solid.inflated(0.02);
+    if (i % 5 < 2) solid = solid.inflated(0.02);
     spheres.push_back(table.add(sphere));
     solids.push_back(table.add(solid));
   }
   PairBatch batch;
-  for (int i = 0; i < 4000; ++i) {
+  for (int i = 0; i < 6000; ++i) {
     const std::uint32_t a = spheres[rng() % spheres.size()], b = solids[rng() % solids.size()];
     const Pose pa{Eigen::Vector3d::Zero(), testing::random_rotation(rng)};
     const Pose pb{testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.8), testing::random_rotation(rng)};
@@ -137,9 +152,9 @@ TEST(PointSolids, AgreeWithGjkAndEpaOnRandomPairs) {
     }
     inside += got.distance[i] < 0.0;
   }
-  EXPECT_GT(compared, 3900u);
-  EXPECT_GT(inside, 500u);  // the overlapping regime is exercised
-  EXPECT_GT(batch.size() - inside, 500u);
+  EXPECT_GT(compared, 5850u);
+  EXPECT_GT(inside, 750u);  // the overlapping regime is exercised
+  EXPECT_GT(batch.size() - inside, 750u);
   RecordProperty("worst_distance_error", std::to_string(worst));
 }
 
@@ -147,13 +162,14 @@ TEST(PointSolids, EveryInstructionSetGivesTheSameBitsAndInvalidPairsAreRefused) 
   Rng rng(12);
   ShapeTable table;
   const std::uint32_t s = table.add(Shape::sphere(0.1)), cyl = table.add(Shape::cylinder(0.2, 0.3)),
-                      cone = table.add(Shape::cone(0.25, 0.2).inflated(0.01));
+                      cone = table.add(Shape::cone(0.25, 0.2).inflated(0.01)),
+                      box = table.add(Shape::box(0.1, 0.2, 0.15).inflated(0.005));
   PairBatch batch;
   for (int i = 0; i < 1000; ++i) {
     const Pose pa{Eigen::Vector3d::Zero(), testing::random_rotation(rng)};
     Pose pb{testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.6), testing::random_rotation(rng)};
     if (i % 97 == 0) pb.rotation.coeffs() *= 1.1;  // not a unit quaternion: invalid_input
-    const std::uint32_t solid = i % 3 ? cyl : cone;
+    const std::uint32_t solid = i % 3 == 0 ? cone : i % 3 == 1 ? cyl : box;
     if (i % 2) batch.add(s, pa, solid, pb);
     else batch.add(solid, pb, s, pa);
   }
