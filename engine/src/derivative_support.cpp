@@ -6,7 +6,7 @@
 #include "kernels/support.hpp"
 #include "shape_table_access.hpp"
 
-#include <emmintrin.h>  // SSE2: the x86-64 baseline this file is compiled for
+#include <immintrin.h>  // SSE2: the x86-64 baseline this file is compiled for; AVX2 under its target pragma
 
 #include <algorithm>
 #include <cmath>
@@ -334,15 +334,104 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   return J;
 }
 
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace {
+// exposed_feature()'s height pass and mask for a hull of 4..16 vertices, four vertices per AVX2 register: each
+// lane computes (x ux + y uy) + z uz, the scalar expression's operations in its order (no FMA: only AVX2 is
+// enabled here), so every height, the maximum and the mask have the SSE2 pass's bits. The coordinates of four
+// vertices (x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3) become x, y, z rows with three 128-bit loads, three
+// 128-bit inserts and three shuffles. Returns the bit mask of the vertices whose height is >= max - tolerance
+// (ordered compares: a NaN height is never exposed nor the maximum). Why: the SSE2 pass was two thirds of
+// exposed_feature(), 330 instructions per analytic hull pair for both sides (callgrind, AVX2); with this 197.
+__attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices, std::size_t count,
+                                                          const Eigen::Vector3d& u, double tolerance) {
+  const __m256d ux = _mm256_set1_pd(u.x()), uy = _mm256_set1_pd(u.y()), uz = _mm256_set1_pd(u.z());
+  const auto heights = [&](const double* p) {
+    const __m256d xy = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_loadu_pd(p + 6), 1);
+    const __m256d zx = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p + 2)), _mm_loadu_pd(p + 8), 1);
+    const __m256d yz = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p + 4)), _mm_loadu_pd(p + 10), 1);
+    const __m256d x = _mm256_shuffle_pd(xy, zx, 0b1010), y = _mm256_shuffle_pd(xy, yz, 0b0101),
+                  z = _mm256_shuffle_pd(zx, yz, 0b1010);
+    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, ux), _mm256_mul_pd(y, uy)), _mm256_mul_pd(z, uz));
+  };
+  // The largest of a register's lanes (NaN lanes never taken; -inf when all are NaN).
+  const auto largest = [](__m256d top) {
+    const __m128d half = _mm256_extractf128_pd(top, 1), low = _mm256_castpd256_pd128(top);
+    const __m128d top2 = _mm_blendv_pd(low, half, _mm_cmpgt_pd(half, low));
+    return std::max(_mm_cvtsd_f64(top2), _mm_cvtsd_f64(_mm_unpackhi_pd(top2, top2)));
+  };
+  const __m256d none = _mm256_set1_pd(-std::numeric_limits<double>::infinity());
+  if (count == 8) {  // the common 8-vertex hull: two registers, no loop
+    const __m256d h0 = heights(vertices), h1 = heights(vertices + 12);
+    __m256d top = _mm256_blendv_pd(none, h0, _mm256_cmp_pd(h0, none, _CMP_GT_OQ));
+    top = _mm256_blendv_pd(top, h1, _mm256_cmp_pd(h1, top, _CMP_GT_OQ));
+    const __m256d f = _mm256_set1_pd(largest(top) - tolerance);
+    return std::uint32_t(_mm256_movemask_pd(_mm256_cmp_pd(h0, f, _CMP_GE_OQ))) |
+           std::uint32_t(_mm256_movemask_pd(_mm256_cmp_pd(h1, f, _CMP_GE_OQ))) << 4;
+  }
+  __m256d kept[4];
+  __m256d top = none;
+  const std::size_t groups = count / 4;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const __m256d h = heights(vertices + 12 * g);
+    kept[g] = h;
+    top = _mm256_blendv_pd(top, h, _mm256_cmp_pd(h, top, _CMP_GT_OQ));
+  }
+  // The maximum of the lanes (any order gives the same value: NaN never enters top, and +0 / -0 give the same
+  // floor), then the vertices past the last whole group as the scalar pass computes them.
+  double tail[3];
+  double h = largest(top);
+  for (std::size_t k = 4 * groups; k < count; ++k) {
+    const double* p = vertices + 3 * k;
+    const double d = u.x() * p[0] + u.y() * p[1] + u.z() * p[2];
+    tail[k - 4 * groups] = d;
+    h = std::max(h, d);
+  }
+  const double floor = h - tolerance;
+  const __m256d f = _mm256_set1_pd(floor);
+  std::uint32_t mask = 0;
+  for (std::size_t g = 0; g < groups; ++g)
+    mask |= std::uint32_t(_mm256_movemask_pd(_mm256_cmp_pd(kept[g], f, _CMP_GE_OQ))) << (4 * g);
+  for (std::size_t k = 4 * groups; k < count; ++k)
+    if (tail[k - 4 * groups] >= floor) mask |= std::uint32_t{1} << k;
+  return mask;
+}
+}  // namespace
+#pragma GCC pop_options
+
 int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,
-                    Eigen::Vector3d& edge) {
+                    Eigen::Vector3d& edge, InstructionSet isa) {
   const auto vertex = [&](std::size_t k) { return Eigen::Vector3d(vertices[3 * k], vertices[3 * k + 1], vertices[3 * k + 2]); };
   // The same expression in both passes, so that the maximum's own vertex compares equal to it; small hulls keep
   // the heights of the first pass.
   const auto height = [&](std::size_t k) {
     return u.x() * vertices[3 * k] + u.y() * vertices[3 * k + 1] + u.z() * vertices[3 * k + 2];
   };
+  std::size_t first = count, second = count;
+  // Returns true at a face: a third exposed vertex off the line of the first two.
+  const auto exposed = [&](std::size_t k) {
+    if (first == count) {
+      first = k;
+    } else if (second == count) {
+      second = k;
+    } else {
+      const Eigen::Vector3d e1 = vertex(second) - vertex(first), e2 = vertex(k) - vertex(first);
+      return e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm();
+    }
+    return false;
+  };
+  const auto feature = [&] {
+    if (second == count) return 0;
+    edge = vertex(second) - vertex(first);
+    return 1;
+  };
   constexpr std::size_t kKept = 16;
+  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && count >= 4 && count <= kKept) {
+    for (std::uint32_t mask = exposed_mask_avx2(vertices, count, u, tolerance); mask != 0; mask &= mask - 1)
+      if (exposed(std::size_t(__builtin_ctz(mask)))) return 2;
+    return feature();
+  }
   double kept[kKept];
   // Two vertices per SSE2 register (vector extensions, the scalar expression's operations and order: the same
   // bits): the 6 coordinates of vertices k, k + 1 are three unaligned pairs (x y, z x', y' z').
@@ -371,19 +460,6 @@ int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vect
     h = std::max(h, d);
   }
   const double floor = h - tolerance;
-  std::size_t first = count, second = count;
-  // Returns true at a face: a third exposed vertex off the line of the first two.
-  const auto exposed = [&](std::size_t k) {
-    if (first == count) {
-      first = k;
-    } else if (second == count) {
-      second = k;
-    } else {
-      const Eigen::Vector3d e1 = vertex(second) - vertex(first), e2 = vertex(k) - vertex(first);
-      return e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm();
-    }
-    return false;
-  };
   if (count <= kKept) {
     // The kept heights' test two at a time into a bit mask (ordered compares: a NaN height is not exposed, as
     // below), then the exposed vertices in index order: the test and branch per vertex cost ~50 instructions per
@@ -399,9 +475,7 @@ int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vect
     for (k = 0; k < count; ++k)
       if ((k < kKept ? kept[k] : height(k)) >= floor && exposed(k)) return 2;
   }
-  if (second == count) return 0;
-  edge = vertex(second) - vertex(first);
-  return 1;
+  return feature();
 }
 
 SupportJacobian exposed_support_jacobian(const Shape& s, const Eigen::Vector3d& u) {

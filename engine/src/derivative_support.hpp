@@ -7,6 +7,9 @@
 #include "batchcol/types.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <emmintrin.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -50,14 +53,49 @@ constexpr double kExposedFeature = 1e-9;
 
 /// The feature of a hull (`count` vertices, x y z each) exposed by the local direction u: 0 a vertex, 1 an edge
 /// (`edge` = the difference of its two vertices), 2 a face; a vertex is exposed when u.v is within `tolerance` of
-/// the largest (kExposedFeature times the bounding radius).
+/// the largest (kExposedFeature times the bounding radius). `isa` (resolved): AVX2 and AVX-512 compute the heights
+/// four vertices per AVX2 register for hulls of 4..16 vertices, with the same bits as the SSE2 pass.
 int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,
-                    Eigen::Vector3d& edge);
+                    Eigen::Vector3d& edge, InstructionSet isa = InstructionSet::scalar);
 
 /// support_jacobian() of a hull without inflation (s.type == convex, s.inflation == 0) against a polytope, from
 /// the vertices n exposes (kExposedFeature) instead of the face planes through the witness: a scan of the
 /// vertices (2 dot products each) instead of every face's plane test.
 SupportJacobian exposed_support_jacobian(const Shape& s, const Eigen::Vector3d& u);
+
+/// hull_pair()'s two local directions, u_a = q_a.normalized().conjugate() * n and u_b = -(q_b.normalized().conjugate()
+/// * n) (the world normal n in each hull's frame, b's reversed), with the normalised quaternions (an edge's rotation
+/// back to the world), side a in lane 0 and side b in lane 1 of SSE2 registers: each lane does Eigen 3.4's
+/// operations in their order, so both get the bits of those Eigen expressions at about the instructions of one:
+/// normalized() divides each coefficient by sqrt(|q|^2) where |q|^2 > 0 (its SSE2 reduction sums (x^2 + z^2) +
+/// (y^2 + w^2)); conjugate() negates x, y, z; q * v is _transformVector(): uv = q.vec() x v, uv += uv,
+/// (v + w uv) + q.vec() x uv; the sign is a product by +-1 (exact). Tested bitwise against Eigen
+/// (tests/engine/derivatives_lanes_test.cpp).
+inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
+                                 Eigen::Quaterniond& unit_a, Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
+                                 Eigen::Vector3d& u_b) {
+  using V = double __attribute__((vector_size(16)));
+  using M = long long __attribute__((vector_size(16)));
+  V x = {q_a.x(), q_b.x()}, y = {q_a.y(), q_b.y()}, z = {q_a.z(), q_b.z()}, w = {q_a.w(), q_b.w()};
+  const V s = (x * x + z * z) + (y * y + w * w);
+  const V root = _mm_sqrt_pd(s);
+  const M positive = s > 0.0;
+  // positive ? c / root : c, without the vector '?:' (GCC may scalarise it)
+  const auto scale = [&](V c) { return (V)(((M)(c / root) & positive) | ((M)c & ~positive)); };
+  x = scale(x), y = scale(y), z = scale(z), w = scale(w);
+  unit_a = Eigen::Quaterniond(w[0], x[0], y[0], z[0]);
+  unit_b = Eigen::Quaterniond(w[1], x[1], y[1], z[1]);
+  const V cx = -x, cy = -y, cz = -z;  // conjugate()
+  const V n0 = {n.x(), n.x()}, n1 = {n.y(), n.y()}, n2 = {n.z(), n.z()};  // not 0 + n: -0 would become +0
+  V uv0 = cy * n2 - cz * n1, uv1 = cz * n0 - cx * n2, uv2 = cx * n1 - cy * n0;
+  uv0 += uv0, uv1 += uv1, uv2 += uv2;
+  const V sign = {1.0, -1.0};
+  const V r0 = sign * ((n0 + w * uv0) + (cy * uv2 - cz * uv1));
+  const V r1 = sign * ((n1 + w * uv1) + (cz * uv0 - cx * uv2));
+  const V r2 = sign * ((n2 + w * uv2) + (cx * uv1 - cy * uv0));
+  u_a = {r0[0], r1[0], r2[0]};
+  u_b = {r0[1], r1[1], r2[1]};
+}
 
 /// support_jacobian() of a sphere or an ellipsoid (returns false for the other types, leaving H alone) at the unit
 /// WORLD direction n (or -n: the same), in the world frame, R being the shape's rotation: straight from the world

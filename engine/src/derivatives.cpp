@@ -153,15 +153,17 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   g.witness_b = results.witness_b[i];
   g.normal = results.normal[i];
   if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite()) return false;
-  g.H_a.setZero();
-  g.H_b.setZero();
   const auto& hulls = ShapeTableAccess::hulls(shapes);
-  const auto side = [&](std::uint32_t s, const Eigen::Quaterniond& q, double sign, Eigen::Matrix<double, 3, 2>& flat) {
-    const Eigen::Quaterniond unit = q.normalized();
-    const Eigen::Vector3d u = sign * (unit.conjugate() * g.normal);
+  // n in each hull's frame (b's reversed), both sides in one SSE2 register with the bits of the per-side Eigen
+  // expressions (q.normalized(), sign * (unit.conjugate() * n)).
+  Eigen::Quaterniond unit_a, unit_b;
+  Eigen::Vector3d u_a, u_b;
+  hull_pair_directions(batch.rotation_a[i], batch.rotation_b[i], g.normal, unit_a, unit_b, u_a, u_b);
+  const auto side = [&](std::uint32_t s, const Eigen::Quaterniond& unit, const Eigen::Vector3d& u,
+                        Eigen::Matrix<double, 3, 2>& flat) {
     Eigen::Vector3d edge;
     const int feature =
-        exposed_feature(hulls[s].vertices, hulls[s].vertex_count, u, kExposedFeature * radii[s], edge);
+        exposed_feature(hulls[s].vertices, hulls[s].vertex_count, u, kExposedFeature * radii[s], edge, out.isa);
     if (feature == 1) {
       Eigen::Vector3d e = unit * edge;
       const double length = e.norm();
@@ -174,8 +176,8 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
     }
     return feature;  // a face's flats are only needed by the general path below (PolytopeLanes uses n)
   };
-  g.flats_a = side(a, batch.rotation_a[i], 1.0, g.flat_a);
-  g.flats_b = side(b, batch.rotation_b[i], -1.0, g.flat_b);
+  g.flats_a = side(a, unit_a, u_a, g.flat_a);
+  g.flats_b = side(b, unit_b, u_b, g.flat_b);
   const DerivativeStatus status =
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
@@ -189,6 +191,9 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
       return true;
     }
   }
+  // The general path below reads the (zero) curvature; PolytopeLanes does not.
+  g.H_a.setZero();
+  g.H_b.setZero();
   // A face's flats: the tangent plane of n (support_jacobian() projects them on it too).
   const auto face = [&](int flats, Eigen::Matrix<double, 3, 2>& flat) {
     if (flats != 2) return;

@@ -2,7 +2,8 @@
 // quaternion (derivative_lanes.inl). The analytic derivatives must keep the bits they had when each pair converted
 // its quaternions with Eigen's q.normalized().toRotationMatrix(): a lane given the quaternion must write what a lane
 // given that Eigen rotation's curvature matrix writes.
-#include "derivative_ift.hpp"  // engine/src
+#include "derivative_ift.hpp"      // engine/src
+#include "derivative_support.hpp"  // engine/src
 #include "support/same_results.hpp"
 
 #include <Eigen/Geometry>
@@ -98,6 +99,45 @@ TEST(DerivativesLanes, LaneRotationsGiveEigensBits) {
   }
   EXPECT_GT(nonzero, compared * int(L - 1) * 60);  // the outputs are not trivially zero
   std::printf("%d blocks compared\n", compared);
+}
+
+// hull_pair_directions() (two sides per SSE2 register) must give the bits of the Eigen expressions hull_pair()
+// evaluated per side: q.normalized(), sign * (q.normalized().conjugate() * n), on quaternions of any magnitude
+// (1e-3 .. 1e3, unit, with zero coefficients, all zero) and normals with signed zeros.
+TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
+  std::mt19937_64 rng(20261127);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_int_distribution<int> pick(0, 9);
+  const auto quaternion = [&] {
+    Eigen::Quaterniond q(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
+    const int kind = pick(rng);
+    if (kind == 0) q.normalize();
+    else if (kind == 1) q.coeffs()[pick(rng) % 4] = 0.0;
+    else if (kind == 2) q.coeffs().setZero();
+    else if (kind == 3) q = Eigen::Quaterniond::Identity();
+    else q.coeffs() *= std::pow(10.0, exponent(rng));
+    return q;
+  };
+  const auto same = [](const double* x, const double* y, int count) { return std::memcmp(x, y, count * sizeof(double)) == 0; };
+  int mismatches = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const Eigen::Quaterniond q_a = quaternion(), q_b = quaternion();
+    Eigen::Vector3d n(coefficient(rng), coefficient(rng), coefficient(rng));
+    if (pick(rng) == 0) n[pick(rng) % 3] = pick(rng) % 2 ? 0.0 : -0.0;
+    n.normalize();
+    Eigen::Quaterniond unit_a, unit_b;
+    Eigen::Vector3d u_a, u_b;
+    detail::hull_pair_directions(q_a, q_b, n, unit_a, unit_b, u_a, u_b);
+    const Eigen::Quaterniond ea = q_a.normalized(), eb = q_b.normalized();
+    const Eigen::Vector3d eu_a = 1.0 * (ea.conjugate() * n), eu_b = -1.0 * (eb.conjugate() * n);
+    const bool ok = same(unit_a.coeffs().data(), ea.coeffs().data(), 4) &&
+                    same(unit_b.coeffs().data(), eb.coeffs().data(), 4) && same(u_a.data(), eu_a.data(), 3) &&
+                    same(u_b.data(), eu_b.data(), 3);
+    if (!ok && ++mismatches <= 3)
+      ADD_FAILURE() << "trial " << trial << ": u_a " << u_a.transpose() << " vs " << eu_a.transpose() << ", u_b "
+                    << u_b.transpose() << " vs " << eu_b.transpose();
+  }
+  EXPECT_EQ(mismatches, 0);
 }
 
 }  // namespace
