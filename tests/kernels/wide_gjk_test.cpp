@@ -425,7 +425,8 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
       }
     }
   }
-  tally.expect_at_least(3, 4);
+  // Measured 471 of 500 (the facing-rim choices miss a few rim-rim contacts, which then take a few more iterations).
+  tally.expect_at_least(9, 10);
 }
 
 /// Sphere and capsule against an ellipsoid at a known gap (the ellipsoid touching the plane through pb = pa + (gap +
