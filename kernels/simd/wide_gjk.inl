@@ -806,11 +806,17 @@ template <class T> struct WideGjk {
     else rim_candidate(ta, tb, R, t, a[0], a[1], b[0], b[1], pa, pb);
   }
 
-  /// The closest of the rim-lateral points of D (rim_lateral()) of W pairs of a rim_start_pair() type: A's rims
-  /// against B's lateral surface (A's frame), then B's against A's (B's frame: A's centre -R^T t, axis R^T e_z;
-  /// mapped back by R and t), a cylinder's rim at +h before -h; a later one only where strictly closer. R
-  /// (row-major), t: B's pose in A's frame; a0, a1 / b0, b1: the cores' radius and half-height (a capsule's
-  /// half-length). pa, pb: A's and B's points in A's frame, NaN where no candidate is valid.
+  /// The closest start candidate of W pairs of a rim_start_pair() type (A's frame; a later candidate only where
+  /// strictly closer). Cylinder / cone pairs: the rim-lateral points of D (rim_lateral()): A's rims against B's
+  /// lateral surface, then B's against A's (B's frame: A's centre -R^T t, axis R^T e_z; mapped back by R and t), a
+  /// cylinder's rim at +h before -h; then round_round() (wide_gjk_rim_rim.inl) in A's frame (rim vs rim, A's rim vs
+  /// B's cap, A's apex) and in B's (B's rim vs A's cap, B's apex), and a cylinder's side against a cone's slant
+  /// (side_slant(), in the cone's frame). A capsule against a cylinder / cone: round_segment()
+  /// in the round core's frame (the segment's ends, the rim and a cone's slant and apex against the segment; its
+  /// rim against the segment replaces rim_lateral()'s, whose start finds the far one of the line distance's two
+  /// minima). Kept only where the candidate's direction separates the cores (round_apart()). R (row-major), t: B's
+  /// pose in A's frame; a0, a1 / b0, b1: the cores' radius and half-height (a capsule's half-length). pa, pb: A's
+  /// and B's points in A's frame, NaN where no candidate is valid.
   /// Computed where the pairs are set up, W at a time (WideGjkPairs' fill_slots()): per refilled lane its ~50
   /// divisions and square roots made cylinder-cylinder slower in wall time although 34% fewer instructions.
   __attribute__((noinline)) static void rim_candidate(ShapeType ta, ShapeType tb, const real* R, const real* t,
@@ -827,36 +833,60 @@ template <class T> struct WideGjk {
       best = select(take, n2, best);
       has |= take;
     };
-    if (rim_core(ta) && lateral_core(tb)) {
-      const V3 c = {t[0], t[1], t[2]}, b = {R[2], R[5], R[8]};
-      const real ry = tb == ShapeType::capsule ? zero : b0;
+    const V3 c = {t[0], t[1], t[2]}, b = {R[2], R[5], R[8]};
+    // B's frame: A's centre and axis.
+    const V3 ca = {-((R[0] * t[0] + R[3] * t[1]) + R[6] * t[2]), -((R[1] * t[0] + R[4] * t[1]) + R[7] * t[2]),
+                   -((R[2] * t[0] + R[5] * t[1]) + R[8] * t[2])};
+    const V3 a = {R[6], R[7], R[8]};
+    const auto back = [&](const V3& q) {
+      return V3{((R[0] * q.x + R[1] * q.y) + R[2] * q.z) + t[0], ((R[3] * q.x + R[4] * q.y) + R[5] * q.z) + t[1],
+                ((R[6] * q.x + R[7] * q.y) + R[8] * q.z) + t[2]};
+    };
+    if (ta == ShapeType::capsule || tb == ShapeType::capsule) {
+      if (tb == ShapeType::capsule) {  // A round: the segment t + z b in A's frame; its points R (0, 0, z) + t
+        round_segment(a0, a1, ta == ShapeType::cone, c, b, b1,
+                      [&](mask ok, const V3& px, const real& z) { keep(ok, px, back(V3{zero, zero, z})); });
+      } else {  // B round: the segment in B's frame; its points (0, 0, z) in A's frame
+        round_segment(b0, b1, tb == ShapeType::cone, ca, a, a1,
+                      [&](mask ok, const V3& px, const real& z) { keep(ok, V3{zero, zero, z}, back(px)); });
+      }
+    } else {
       for (int sg = ta == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
         V3 qa, qb;
         mask ok = splat_mask(-1);
-        rim_lateral(a0, T(sg) * a1, c, b, ry, b1, tb == ShapeType::cone, qa, qb, ok);
+        rim_lateral(a0, T(sg) * a1, c, b, b0, b1, tb == ShapeType::cone, qa, qb, ok);
         keep(ok, qa, qb);
       }
-    }
-    if (rim_core(tb) && lateral_core(ta)) {
-      const V3 c = {-((R[0] * t[0] + R[3] * t[1]) + R[6] * t[2]), -((R[1] * t[0] + R[4] * t[1]) + R[7] * t[2]),
-                    -((R[2] * t[0] + R[5] * t[1]) + R[8] * t[2])};
-      const V3 a = {R[6], R[7], R[8]};
-      const real ry = ta == ShapeType::capsule ? zero : a0;
-      const auto back = [&](const V3& q) {
-        return V3{((R[0] * q.x + R[1] * q.y) + R[2] * q.z) + t[0], ((R[3] * q.x + R[4] * q.y) + R[5] * q.z) + t[1],
-                  ((R[6] * q.x + R[7] * q.y) + R[8] * q.z) + t[2]};
-      };
       for (int sg = tb == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
         V3 qb, qa;
         mask ok = splat_mask(-1);
-        rim_lateral(b0, T(sg) * b1, c, a, ry, a1, ta == ShapeType::cone, qb, qa, ok);
+        rim_lateral(b0, T(sg) * b1, ca, a, a0, a1, ta == ShapeType::cone, qb, qa, ok);
         keep(ok, back(qa), back(qb));
       }
+      round_round(a0, a1, ta == ShapeType::cone, c, b, b0, b1, tb == ShapeType::cone, true,
+                  [&](mask ok, const V3& px, const V3& py) { keep(ok, px, py); });
+      round_round(b0, b1, tb == ShapeType::cone, ca, a, a0, a1, ta == ShapeType::cone, false,
+                  [&](mask ok, const V3& px, const V3& py) { keep(ok, back(py), back(px)); });
+      if (ta == ShapeType::cone && tb == ShapeType::cylinder) {
+        V3 px, py;
+        mask ok = splat_mask(-1);
+        side_slant(b0, b1, a0, a1, c, b, px, py, ok);
+        keep(ok, px, py);
+      } else if (ta == ShapeType::cylinder && tb == ShapeType::cone) {
+        V3 px, py;
+        mask ok = splat_mask(-1);
+        side_slant(a0, a1, b0, b1, ca, a, px, py, ok);
+        keep(ok, back(py), back(px));
+      }
     }
+    const mask apart = round_apart(ta, tb, R, t, a0, a1, b0, b1, pa, pb);
+    pa = pick(apart, pa, V3{nan, nan, nan});
+    pb = pick(apart, pb, V3{nan, nan, nan});
   }
 
 #include "kernels/simd/wide_gjk_box_ellipsoid.inl"
 #include "kernels/simd/wide_gjk_box_round.inl"
+#include "kernels/simd/wide_gjk_rim_rim.inl"
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
   struct SideStart {

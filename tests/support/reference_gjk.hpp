@@ -20,6 +20,7 @@
 #include "kernels/minkowski.hpp"
 #include "support/reference_box_ellipsoid.hpp"
 #include "support/reference_box_round.hpp"
+#include "support/reference_rim_rim.hpp"
 #include "support/reference_simplex_projection.hpp"
 
 #include <algorithm>
@@ -278,7 +279,10 @@ bool rim_lateral(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool
   return vb <= hy && vb >= -hy && rho > ry;
 }
 
-/// wide_gjk.inl's rim_candidate() for one pair: the closest valid rim-lateral point of D (false: none).
+/// wide_gjk.inl's rim_candidate() for one pair: the closest valid candidate point of D, only where its direction
+/// separates the cores (false: none). Cylinder / cone pairs: rim_lateral() both ways, round_round() both ways, then
+/// side_slant() (cylinder-cone);
+/// a capsule against a cylinder / cone: round_segment() in the round core's frame (reference_rim_rim.hpp).
 template <class T> bool rim_candidate(const MinkowskiDifference<T>& D, SupportPoint<T>& p) {
   const ShapeType ta = D.A->type, tb = D.B->type;
   const T a0 = D.A->size.x(), a1 = D.A->size.y(), b0 = D.B->size.x(), b1 = D.B->size.y();
@@ -296,34 +300,54 @@ template <class T> bool rim_candidate(const MinkowskiDifference<T>& D, SupportPo
       has = true;
     }
   };
-  if (rim_core(ta) && lateral_core(tb)) {
-    const Vec3<T> c = t, b(R(0, 2), R(1, 2), R(2, 2));
-    const T ry = tb == ShapeType::capsule ? T(0) : b0;
+  const Vec3<T> c = t, b(R(0, 2), R(1, 2), R(2, 2));
+  const Vec3<T> ca(-((R(0, 0) * t.x() + R(1, 0) * t.y()) + R(2, 0) * t.z()),
+                   -((R(0, 1) * t.x() + R(1, 1) * t.y()) + R(2, 1) * t.z()),
+                   -((R(0, 2) * t.x() + R(1, 2) * t.y()) + R(2, 2) * t.z()));
+  const Vec3<T> a(R(2, 0), R(2, 1), R(2, 2));
+  const auto back = [&](const Vec3<T>& q) {
+    return Vec3<T>(((R(0, 0) * q.x() + R(0, 1) * q.y()) + R(0, 2) * q.z()) + t.x(),
+                   ((R(1, 0) * q.x() + R(1, 1) * q.y()) + R(1, 2) * q.z()) + t.y(),
+                   ((R(2, 0) * q.x() + R(2, 1) * q.y()) + R(2, 2) * q.z()) + t.z());
+  };
+  if (ta == ShapeType::capsule || tb == ShapeType::capsule) {
+    if (tb == ShapeType::capsule) {
+      round_segment(a0, a1, ta == ShapeType::cone, c, b, b1,
+                    [&](bool ok, const Vec3<T>& px, T z) { keep(ok, px, back(Vec3<T>(T(0), T(0), z))); });
+    } else {
+      round_segment(b0, b1, tb == ShapeType::cone, ca, a, a1,
+                    [&](bool ok, const Vec3<T>& px, T z) { keep(ok, Vec3<T>(T(0), T(0), z), back(px)); });
+    }
+  } else {
     for (int sg = ta == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
       Vec3<T> qa, qb;
-      const bool ok = rim_lateral(a0, T(sg) * a1, c, b, ry, b1, tb == ShapeType::cone, qa, qb);
+      const bool ok = rim_lateral(a0, T(sg) * a1, c, b, b0, b1, tb == ShapeType::cone, qa, qb);
       keep(ok, qa, qb);
     }
-  }
-  if (rim_core(tb) && lateral_core(ta)) {
-    const Vec3<T> c(-((R(0, 0) * t.x() + R(1, 0) * t.y()) + R(2, 0) * t.z()),
-                    -((R(0, 1) * t.x() + R(1, 1) * t.y()) + R(2, 1) * t.z()),
-                    -((R(0, 2) * t.x() + R(1, 2) * t.y()) + R(2, 2) * t.z()));
-    const Vec3<T> a(R(2, 0), R(2, 1), R(2, 2));
-    const T ry = ta == ShapeType::capsule ? T(0) : a0;
-    const auto back = [&](const Vec3<T>& q) {
-      return Vec3<T>(((R(0, 0) * q.x() + R(0, 1) * q.y()) + R(0, 2) * q.z()) + t.x(),
-                     ((R(1, 0) * q.x() + R(1, 1) * q.y()) + R(1, 2) * q.z()) + t.y(),
-                     ((R(2, 0) * q.x() + R(2, 1) * q.y()) + R(2, 2) * q.z()) + t.z());
-    };
     for (int sg = tb == ShapeType::cone ? -1 : 1; sg >= -1; sg -= 2) {
       Vec3<T> qb, qa;
-      const bool ok = rim_lateral(b0, T(sg) * b1, c, a, ry, a1, ta == ShapeType::cone, qb, qa);
+      const bool ok = rim_lateral(b0, T(sg) * b1, ca, a, a0, a1, ta == ShapeType::cone, qb, qa);
       keep(ok, back(qa), back(qb));
     }
+    round_round(a0, a1, ta == ShapeType::cone, c, b, b0, b1, tb == ShapeType::cone, true,
+                [&](bool ok, const Vec3<T>& px, const Vec3<T>& py) { keep(ok, px, py); });
+    round_round(b0, b1, tb == ShapeType::cone, ca, a, a0, a1, ta == ShapeType::cone, false,
+                [&](bool ok, const Vec3<T>& px, const Vec3<T>& py) { keep(ok, back(py), back(px)); });
+    if (ta == ShapeType::cone && tb == ShapeType::cylinder) {
+      Vec3<T> px, py;
+      const bool ok = side_slant(b0, b1, a0, a1, c, b, px, py);
+      keep(ok, px, py);
+    } else if (ta == ShapeType::cylinder && tb == ShapeType::cone) {
+      Vec3<T> px, py;
+      const bool ok = side_slant(a0, a1, b0, b1, ca, a, px, py);
+      keep(ok, back(py), back(px));
+    }
   }
-  if (has) p.w = wsub(p.a, p.b);
-  return has;
+  if (!has) return false;
+  const T Rr[9] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)};
+  if (!round_apart(ta, tb, Rr, t, a0, a1, b0, b1, p.a, p.b)) return false;
+  p.w = wsub(p.a, p.b);
+  return true;
 }
 
 template <class T>
