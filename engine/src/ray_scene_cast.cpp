@@ -74,7 +74,7 @@ double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
 class Caster {
  public:
   Caster(const RaySceneIndex::State& s, const RayOptions& o, int isa)
-      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse(isa)) {}
+      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse(isa)), isa_(isa) {}
 
   // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
   // call, and on trees larger than the L2 pushed nodes are prefetched.
@@ -95,8 +95,8 @@ class Caster {
     const kr::RayShape<double>& shape = s_.prepared.shapes[obj.shape];
     const kr::LocalHit<double> h =
         shape.core.type == ShapeType::convex && !(shape.inflation > 0.0) && ball_entry == ball_entry
-            ? kr::ray_local_hull(shape, o, d, t_max, ball_entry)
-            : kr::ray_local(shape, o, d, t_max, gjk_, ball_entry);
+            ? kr::ray_local_hull(shape, o, d, t_max, ball_entry, isa_)
+            : kr::ray_local(shape, o, d, t_max, gjk_, ball_entry, isa_);
     capped = capped || h.status != kr::LocalStatus::converged;
     if (!h.hit) return false;
     hit = {h.t, kernels::mul(obj.R, h.normal), obj.handle};
@@ -235,6 +235,7 @@ class Caster {
   const RaySceneIndex::State& s_;
   kr::RayGjkSettings gjk_;
   WideTraverse wide_;
+  int isa_;  // RayOptions::isa (ray_isa_index()): the hulls' clipping loop follows it as the traversal does
 };
 
 void store(RayResults& out, std::size_t i, const Hit& h) {

@@ -61,7 +61,7 @@ struct LaneContext {
 
 template <class T>
 void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const kernels::rays::RayGjkSettings& gjk,
-                const LaneContext& lanes, std::size_t begin, std::size_t end, RayResults& r) {
+                const LaneContext& lanes, int isa, std::size_t begin, std::size_t end, RayResults& r) {
   const RayBatch& rays = b.rays;
   kr::LaneOut out{reinterpret_cast<std::uint8_t*>(r.status.data()), r.hit.data(), r.t.data(), r.normal.x.data(),
                   r.normal.y.data(), r.normal.z.data()};
@@ -84,7 +84,8 @@ void cast_range(const PreparedShapes<T>& prepared, const ShapeRayBatch& b, const
     // t_max rounded up to T, so that no hit inside the requested range is lost.
     T t_max = T(rays.t_max[i]);
     if (double(t_max) < rays.t_max[i]) t_max = std::nextafter(t_max, kernels::rays::infinity<T>());
-    const kernels::rays::LocalHit<T> h = kernels::rays::ray_local(prepared.shapes[b.shape[i]], ol, dl, t_max, gjk);
+    const kernels::rays::LocalHit<T> h = kernels::rays::ray_local(prepared.shapes[b.shape[i]], ol, dl, t_max, gjk,
+                                                                        kernels::quiet_nan<T>(), isa);
     r.status[i] = h.status == kernels::rays::LocalStatus::converged ? RayStatus::ok : RayStatus::max_iterations;
     if (!h.hit) continue;
     r.hit[i] = 1;
@@ -104,7 +105,8 @@ kr::LaneCasts lane_casts_at_most(int isa) {
 template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& b, const RayOptions& o, RayResults& r) {
   const PreparedShapes<T> prepared(shapes);
   const kernels::rays::RayGjkSettings gjk{o.tolerance, o.max_iterations};
-  const kr::LaneCasts wide = lane_casts_at_most(detail::ray_isa_index(o.isa)), single = kr::lane_casts_for(0);
+  const int isa = detail::ray_isa_index(o.isa);
+  const kr::LaneCasts wide = lane_casts_at_most(isa), single = kr::lane_casts_for(0);
   const bool dbl = std::is_same_v<T, double>;
   const LaneContext lanes{lane_shapes(shapes, prepared),
                           {b.rays.origin.x.data(), b.rays.origin.y.data(), b.rays.origin.z.data(),
@@ -120,7 +122,7 @@ template <class T> void cast_all(const ShapeTable& shapes, const ShapeRayBatch& 
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t c = range.begin(); c != range.end(); ++c) {
         const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
-        cast_range(prepared, b, gjk, lanes, begin, end, r);
+        cast_range(prepared, b, gjk, lanes, isa, begin, end, r);
       }
     });
   });

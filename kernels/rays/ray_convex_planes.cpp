@@ -7,7 +7,8 @@
 // inequalities above replace by the first face of each kind. Only the 8 lane winners are divided at the end, so the
 // reported t is exactly dist_f / denom_f of the chosen face (two faces whose t differ by a rounding may swap).
 // The loop uses GCC vector extensions with 8 lanes whatever the instruction set (one zmm, two ymm or four xmm
-// registers per value), compiled three times below and picked per call by __builtin_cpu_supports.
+// registers per value), compiled three times below and picked per call (select_clip_planes(): the caller's cap on
+// the instruction set, RayOptions::isa, and the processor's features).
 #include "kernels/rays/ray_convex_planes.hpp"
 
 #include <limits>
@@ -67,20 +68,20 @@ ClipPlaneVariants clip_planes_for(int isa) {
   return v;
 }
 
+ClipPlaneVariants select_clip_planes(int isa) {
+  for (isa = isa > 2 ? 2 : isa; isa > 0; --isa)
+    if (const ClipPlaneVariants v = clip_planes_for(isa); v.d != nullptr) return v;
+  return clip_planes_for(0);
+}
+
 PlaneClip<double> clip_planes(const double* nx, const double* ny, const double* nz, const double* c, std::size_t n,
-                              const double* o, const double* d) {
-  if (__builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
-    return clip_avx512::d::clip(nx, ny, nz, c, n, o, d);
-  if (__builtin_cpu_supports("avx2")) return clip_avx2::d::clip(nx, ny, nz, c, n, o, d);
-  return clip_baseline::d::clip(nx, ny, nz, c, n, o, d);
+                              const double* o, const double* d, int isa) {
+  return select_clip_planes(isa).d(nx, ny, nz, c, n, o, d);
 }
 
 PlaneClip<float> clip_planes(const float* nx, const float* ny, const float* nz, const float* c, std::size_t n,
-                             const float* o, const float* d) {
-  if (__builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
-    return clip_avx512::f::clip(nx, ny, nz, c, n, o, d);
-  if (__builtin_cpu_supports("avx2")) return clip_avx2::f::clip(nx, ny, nz, c, n, o, d);
-  return clip_baseline::f::clip(nx, ny, nz, c, n, o, d);
+                             const float* o, const float* d, int isa) {
+  return select_clip_planes(isa).f(nx, ny, nz, c, n, o, d);
 }
 
 }  // namespace batchcol::kernels::rays

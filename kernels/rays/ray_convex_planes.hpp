@@ -17,11 +17,13 @@ template <class T> struct PlaneClip {
   bool outside;
 };
 
-/// n is a multiple of 8; planes <(nx, ny, nz)_i, x> <= c_i; o, d the ray in the hull's frame.
+/// n is a multiple of 8; planes <(nx, ny, nz)_i, x> <= c_i; o, d the ray in the hull's frame. `isa` caps the
+/// instruction set (0 baseline, 1 AVX2, 2 AVX-512: RayOptions::isa through ray_isa_index()); the loop of the highest
+/// set at most `isa` that the processor runs is used (select_clip_planes()). Every set gives the same bits.
 PlaneClip<double> clip_planes(const double* nx, const double* ny, const double* nz, const double* c, std::size_t n,
-                              const double* o, const double* d);
+                              const double* o, const double* d, int isa = 2);
 PlaneClip<float> clip_planes(const float* nx, const float* ny, const float* nz, const float* c, std::size_t n,
-                             const float* o, const float* d);
+                             const float* o, const float* d, int isa = 2);
 
 /// One instruction set's loop, for the tests: isa 0 baseline, 1 AVX2, 2 AVX-512; null when the processor lacks it.
 struct ClipPlaneVariants {
@@ -31,5 +33,7 @@ struct ClipPlaneVariants {
                         const float*) = nullptr;
 };
 ClipPlaneVariants clip_planes_for(int isa);
+/// The loops clip_planes() runs for the cap `isa`: those of the highest set <= isa this processor has.
+ClipPlaneVariants select_clip_planes(int isa);
 
 }  // namespace batchcol::kernels::rays

@@ -19,17 +19,19 @@ namespace {
 // One hull lane in its local frame, as ray_local() does it for an uninflated hull (polar walk, all-plane clipping
 // when the walk gives up), after the caller's lane-wise bounding-ball test: `ball_enter` is where the ray enters the
 // ball. Compiled once, outside the instruction-set regions, and called by every build: the same bits on every set
-// (and the same as ray_local's: the walk's answer does not depend on where it starts).
+// (and the same as ray_local's: the walk's answer does not depend on where it starts). `isa`: the calling build's
+// own set (kLaneIsa), which caps the clipping loop's as it caps the lanes' (the scalar build, which also takes a
+// batch's last rays under every cap, runs the baseline loop: the same bits).
 template <class T>
 __attribute__((noinline)) void hull_lane(const HullPlanes<T>& planes, double bound, const T o[3], const T d[3], T t_max,
-                                         T ball_enter, T& enter, T nl[3]) {
+                                         T ball_enter, T& enter, T nl[3], int isa) {
   const Vec3<T> vo(o[0], o[1], o[2]), vd(d[0], d[1], d[2]);
   enter = infinity<T>();
   LocalHit<T> h;
   bool ok = false;
   if (planes.walk.planes() > 0)
     h = ray_hull_walk(planes.walk, vo, vd, t_max, ok, hull_walk_start(ball_enter, vo, vd, T(bound)));
-  if (!ok) h = finish(ray_convex(vo, vd, planes), vd, t_max);
+  if (!ok) h = finish(ray_convex(vo, vd, planes, isa), vd, t_max);
   if (!h.hit) return;
   enter = h.t;
   nl[0] = h.normal.x(), nl[1] = h.normal.y(), nl[2] = h.normal.z();
@@ -80,7 +82,7 @@ __attribute__((noinline)) void hull_lane(const HullPlanes<T>& planes, double bou
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
 namespace lanes_avx512 {
-constexpr int W = 8;
+constexpr int W = 8, kLaneIsa = 2;
 typedef double VD __attribute__((vector_size(64)));
 typedef float VF __attribute__((vector_size(32)));
 inline VD lsqrt(VD a) { return _mm512_sqrt_pd(a); }
@@ -93,7 +95,7 @@ BATCHCOL_LANE_VECTOR_HELPERS
 #pragma GCC push_options
 #pragma GCC target("avx2")
 namespace lanes_avx2 {
-constexpr int W = 4;
+constexpr int W = 4, kLaneIsa = 1;
 typedef double VD __attribute__((vector_size(32)));
 typedef float VF __attribute__((vector_size(16)));
 inline VD lsqrt(VD a) { return _mm256_sqrt_pd(a); }
@@ -106,7 +108,7 @@ BATCHCOL_LANE_VECTOR_HELPERS
 #undef BATCHCOL_LANE_VECTOR_HELPERS
 
 namespace lanes_scalar {
-constexpr int W = 1;
+constexpr int W = 1, kLaneIsa = 0;
 using VD = double;
 using VF = float;
 inline double loadd(const double* p) { return *p; }

@@ -194,7 +194,7 @@ template <class T> bool cast(const LaneShapeTable& shapes, const LaneRays& r, st
         const T o[3] = {lane_get(lox, l), lane_get(loy, l), lane_get(loz, l)};
         const T d[3] = {lane_get(ldx, l), lane_get(ldy, l), lane_get(ldz, l)};
         T enter, nl[3];
-        hull_lane<T>(*hull[l], sa[l], o, d, tm_l, ball_enter, enter, nl);
+        hull_lane<T>(*hull[l], sa[l], o, d, tm_l, ball_enter, enter, nl, kLaneIsa);
         lane_set(in.enter, l, enter);
         if (enter < infinity<T>()) {
           lane_set(in.exit, l, infinity<T>());

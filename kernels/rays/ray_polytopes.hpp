@@ -78,11 +78,13 @@ template <class T> HullPlanes<T> make_hull_planes(const HullView& hull) {
 }
 
 /// Cyrus-Beck: enter = max over faces turned against d of dist_i / denom_i, exit = min over the others; a face
-/// parallel to the ray empties the interval when the line is outside it (loop in ray_convex_planes.cpp).
-template <class T> RayInterval<T> ray_convex(const Vec3<T>& o, const Vec3<T>& d, const HullPlanes<T>& planes) {
+/// parallel to the ray empties the interval when the line is outside it (loop in ray_convex_planes.cpp; `isa` caps
+/// its instruction set, see clip_planes()).
+template <class T>
+RayInterval<T> ray_convex(const Vec3<T>& o, const Vec3<T>& d, const HullPlanes<T>& planes, int isa = 2) {
   const T oa[3] = {o.x(), o.y(), o.z()}, da[3] = {d.x(), d.y(), d.z()};
   const PlaneClip<T> clip = clip_planes(planes.nx.data(), planes.ny.data(), planes.nz.data(), planes.c.data(),
-                                        planes.nx.size(), oa, da);
+                                        planes.nx.size(), oa, da, isa);
   if (clip.outside) return RayInterval<T>::nothing();
   RayInterval<T> in;
   in.enter = clip.enter, in.exit = clip.exit;

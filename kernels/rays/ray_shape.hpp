@@ -39,22 +39,23 @@ inline bool uses_ray_gjk(const ShapeView& shape) {
 /// the walk from there, or every plane clipped when the walk gives up. ray_local()'s convex case, callable on its own
 /// so that a caller that already knows the shape type (the scene's leaf visits) skips the dispatch (~18 instructions
 /// a call); always inlined, since as a call its frame and the copy of the result cost ~45 more (callgrind, 10k hulls).
+/// `isa` caps the clipping loop's instruction set (clip_planes()).
 template <class T>
 [[gnu::always_inline]] inline LocalHit<T> ray_local_hull(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d,
-                                                         T t_max, T ball_entry) {
+                                                         T t_max, T ball_entry, int isa = 2) {
   if (s.planes->walk.planes() > 0) {
     bool ok = false;
     const LocalHit<T> h = ray_hull_walk(s.planes->walk, o, d, t_max, ok, ball_entry);
     if (ok) return h;
   }
-  return finish(ray_convex(o, d, *s.planes), d, t_max);
+  return finish(ray_convex(o, d, *s.planes, isa), d, t_max);
 }
 
 /// `ball_entry`: when the caller has already found that the segment [0, t_max] meets a ball about the local origin of
 /// radius at least `bound` (the scene's world-frame filter), the parameter where the ray enters that ball; hulls
-/// then skip their own ball test and start the walk there. NaN (the default): not known.
+/// then skip their own ball test and start the walk there. NaN (the default): not known. `isa`: as ray_local_hull().
 template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o, const Vec3<T>& d, T t_max,
-                                         const RayGjkSettings& settings, T ball_entry = quiet_nan<T>()) {
+                                         const RayGjkSettings& settings, T ball_entry = quiet_nan<T>(), int isa = 2) {
   const ShapeCore<T>& c = s.core;
   if (c.type == ShapeType::halfspace) {
     return finish(ray_halfspace(o, d, c.halfspace_normal, c.halfspace_offset + s.inflation), d, t_max);
@@ -77,7 +78,7 @@ template <class T> LocalHit<T> ray_local(const RayShape<T>& s, const Vec3<T>& o,
         if (ball.empty() || ball.exit < T(0) || ball.enter > t_max) return {};
         ball_entry = hull_walk_start(ball.enter, o, d, s.bound);
       }
-      return ray_local_hull(s, o, d, t_max, ball_entry);
+      return ray_local_hull(s, o, d, t_max, ball_entry, isa);
     }
     case ShapeType::triangle:
       return finish(ray_triangle(o, d, c.triangle[0], c.triangle[1], c.triangle[2]), d, t_max);

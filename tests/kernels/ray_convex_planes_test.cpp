@@ -50,9 +50,14 @@ template <class T> void check_hull(const Shape& hull, Rng& rng, int rays, int& c
                                    << base.face;
       ++compared;
     }
-    // The dispatcher picks one of them: the same bits again.
+    // The dispatcher picks one of them, for the processor and for every cap: the same bits again.
     const kr::PlaneClip<T> picked = kr::clip_planes(p.nx.data(), p.ny.data(), p.nz.data(), p.c.data(), p.nx.size(), oa, da);
     EXPECT_TRUE(same(picked, base));
+    for (int cap = 0; cap <= 2; ++cap) {
+      const kr::PlaneClip<T> capped =
+          kr::clip_planes(p.nx.data(), p.ny.data(), p.nz.data(), p.c.data(), p.nx.size(), oa, da, cap);
+      EXPECT_TRUE(same(capped, base)) << "cap " << cap;
+    }
   }
 }
 
@@ -73,6 +78,29 @@ TEST(RayConvexPlanes, EveryInstructionSetGivesTheSameBits) {
   }
   EXPECT_GT(entered, 5000);  // the rays do cross the hulls
   EXPECT_GT(parallel, 50);   // and the parallel-outside branch is exercised
+}
+
+TEST(RayConvexPlanes, TheCapPicksEachSetsOwnLoop) {
+  // RayOptions::isa (`batchcol rays --isa`) reaches the hulls' clipping through ray_isa_index() and clip_planes(...,
+  // isa): each cap runs its own set's loop when the processor has it, else the next lower one, never a higher one.
+  const auto expect_same = [](const kr::ClipPlaneVariants& a, const kr::ClipPlaneVariants& b, const char* what) {
+    EXPECT_EQ(a.d, b.d) << what;
+    EXPECT_EQ(a.f, b.f) << what;
+  };
+  ASSERT_NE(kr::clip_planes_for(0).d, nullptr);
+  expect_same(kr::select_clip_planes(0), kr::clip_planes_for(0), "cap 0");
+  expect_same(kr::select_clip_planes(-1), kr::clip_planes_for(0), "cap -1");
+  if (kr::clip_planes_for(1).d != nullptr) {
+    expect_same(kr::select_clip_planes(1), kr::clip_planes_for(1), "cap 1");
+    EXPECT_NE(kr::select_clip_planes(1).d, kr::select_clip_planes(0).d);
+  }
+  if (kr::clip_planes_for(2).d != nullptr) {
+    expect_same(kr::select_clip_planes(2), kr::clip_planes_for(2), "cap 2");
+    expect_same(kr::select_clip_planes(3), kr::clip_planes_for(2), "cap 3");
+    EXPECT_NE(kr::select_clip_planes(2).d, kr::select_clip_planes(1).d);
+  } else {
+    expect_same(kr::select_clip_planes(2), kr::select_clip_planes(1), "cap 2 without AVX-512");
+  }
 }
 
 }  // namespace
