@@ -1482,7 +1482,7 @@ template <class T> struct WideGjk {
         L.d_prev = pick(steps, d, L.d_prev);
         L.last_s = pick(steps, sw, L.last_s);
         // Newton's direction for the next iteration (newton_direction()), where this support point gives one:
-        //  - lb > 0 (separated cores: H + lb I is positive definite);
+        //  - lb > 0 (separated cores: H + lb I is positive definite); not on polytope pairs (flat_newton_side());
         //  - the step turns the direction by at most kNewtonSwitch (|delta| estimates the angle to the optimal
         //    direction; beyond it the linearisation is not trusted and GJK's own steps bring the lane closer);
         //  - a lane that just took a Newton step keeps them only if this step is at most half the last one
@@ -1504,10 +1504,10 @@ template <class T> struct WideGjk {
         if (newton_live) {
           newton_gap = next_xn - L.lower;
           gap_open = newton_gap > T(kNewtonPlainGap) * tol;
-          read = flat_run ? newton_lanes & (lb > zero) & gap_open &
-                                ~(newton_step & ~(newton_gap <= T(0.5) * L.newton_gap))
+          // Polytope pairs take feature steps whatever the sign of lb (flat_newton_side() says why).
+          read = flat_run ? newton_lanes & gap_open & ~(newton_step & ~(newton_gap <= T(0.5) * L.newton_gap))
                           : newton_lanes & (newton_step | ((lb > zero) & gap_open));
-          if (flat_run && !any(read) && any(newton_lanes & (lb > zero)))
+          if (flat_run && !any(read) && any(newton_lanes))
             L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
         }
         if (newton_live && any(read)) {
@@ -1516,7 +1516,7 @@ template <class T> struct WideGjk {
           V3 nd;
           real shrunk;  // the step2 a lane that just took a Newton step must reach to keep them
           if (flat_run) {
-            nd = feature_direction(L, n, sa, sb, newton_lanes & (lb > zero), step2);
+            nd = feature_direction(L, n, sa, sb, newton_lanes, step2);
             // Tilted by eps towards x's offset from the line along nd: on a polytope's face or edge (the tie the
             // Newton direction lands on) the support then takes the vertex plain GJK would (the one opposite x's
             // offset), which the simplex needs to settle x along F, while the curved side's support moves by
@@ -1531,7 +1531,7 @@ template <class T> struct WideGjk {
             nd = newton_direction(L, n, sa, sb, r, lb, step2);
             shrunk = T(0.25) * L.newton_step2;
           }
-          const mask valid = lb > zero;
+          const mask valid = flat_run ? splat_mask(-1) : lb > zero;
           const mask failed = newton_lanes & newton_step & ~(valid & (step2 <= shrunk));
           mask skip = splat_mask(0);  // lanes that take a plain (or momentum) step before the next Newton one
           if (flat_run) {
