@@ -197,9 +197,19 @@ constexpr double kEdgeRimSin[kEdgeRimSamples / 2] = {0.0, 0.5, 0.866025403784438
 constexpr int kEdgeRimNewtonSteps = 3;
 /// The core box_ellipsoid_point() takes: the box, a capsule's segment, a sphere's point.
 constexpr int kBoxCore = 0, kSegmentCore = 1, kPointCore = 2;
+/// Pair types whose double distance / witness lanes may start from a cylinder- or cone-ellipsoid Newton point
+/// (kernels/simd/wide_gjk_round_ellipsoid.inl): the round core's cap, rim, apex, side or slant against the ellipsoid.
+constexpr bool round_ellipsoid_pair(ShapeType a, ShapeType b) {
+  const auto round = [](ShapeType t) { return t == ShapeType::cylinder || t == ShapeType::cone; };
+  return (round(a) && b == ShapeType::ellipsoid) || (a == ShapeType::ellipsoid && round(b));
+}
+/// Newton steps on the contact normal against a rim or the cone's apex (disk_ellipsoid()) and on the normal's angle
+/// against a cylinder's side or a cone's slant (side_ellipsoid()).
+constexpr int kRoundEllipsoidNewtonSteps = 3;
+constexpr int kRoundEllipsoidSideSteps = 3;
 /// Pair types with any closed-form start candidate (start() takes the lane's rim_a / rim_b).
 constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
-  return rim_start_pair(a, b) || box_ellipsoid_pair(a, b) || box_round_pair(a, b);
+  return rim_start_pair(a, b) || box_ellipsoid_pair(a, b) || box_round_pair(a, b) || round_ellipsoid_pair(a, b);
 }
 /// Newton steps on the edge angle and on the vertex's Lagrange multiplier (box_ellipsoid_point()).
 constexpr int kBoxEdgeNewtonSteps = 3;

@@ -803,6 +803,7 @@ template <class T> struct WideGjk {
                                  const real (&a)[3], const real (&b)[3], V3& pa, V3& pb) {
     if (box_ell) box_ellipsoid_candidate(ta, tb, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
     else if (box_round_pair(ta, tb)) box_round_candidate(ta, tb, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
+    else if (round_ellipsoid_pair(ta, tb)) round_ellipsoid_candidate(ta, tb, R, t, a[0], a[1], a[2], b[0], b[1], b[2], pa, pb);
     else rim_candidate(ta, tb, R, t, a[0], a[1], b[0], b[1], pa, pb);
   }
 
@@ -887,6 +888,7 @@ template <class T> struct WideGjk {
 #include "kernels/simd/wide_gjk_box_ellipsoid.inl"
 #include "kernels/simd/wide_gjk_box_round.inl"
 #include "kernels/simd/wide_gjk_rim_rim.inl"
+#include "kernels/simd/wide_gjk_round_ellipsoid.inl"
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
   struct SideStart {

@@ -21,6 +21,7 @@
 #include "support/reference_box_ellipsoid.hpp"
 #include "support/reference_box_round.hpp"
 #include "support/reference_rim_rim.hpp"
+#include "support/reference_round_ellipsoid.hpp"
 #include "support/reference_simplex_projection.hpp"
 
 #include <algorithm>
@@ -396,6 +397,12 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     if (!params.boolean_only && box_round_pair(D.A->type, D.B->type)) {
       SupportPoint<T> p;
       const bool found = box_round_candidate(D, p);
+      take_start(found, p);
+    }
+    // Cylinder- / cone-ellipsoid pairs (double): the closest cap / rim / apex / side / slant Newton point of D.
+    if (!params.boolean_only && round_ellipsoid_pair(D.A->type, D.B->type)) {
+      SupportPoint<T> p;
+      const bool found = round_ellipsoid_candidate(D, p);
       take_start(found, p);
     }
   }
