@@ -213,6 +213,11 @@ struct StartTally {
     ++trials;
     one_or_two += res.iterations <= 2 ? 1 : 0;
   }
+  /// Runs X against Y, or Y against X when `swap` (a start must work in both orders), and adds the result.
+  void run(const Shape& x, const Pose& px, const Shape& y, const Pose& py, bool swap, const QueryOptions& opt,
+           double gap) {
+    add(swap ? testing::run_pair(y, py, x, px, opt) : testing::run_pair(x, px, y, py, opt), gap);
+  }
   void expect_at_least(int num, int den) const {
     EXPECT_GE(one_or_two, trials * num / den) << one_or_two << " of " << trials << " pairs in <= 2 iterations";
   }
@@ -265,11 +270,9 @@ TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
         const Eigen::Vector3d T = testing::random_vector(rng);
         const Pose pose_box{T, Q}, pose_ell{T + Q * ce, Q * qe};
         const Shape box = Shape::box(h), ell = Shape::ellipsoid(r.x(), r.y(), r.z());
-        const auto res = swap ? testing::run_pair(ell, pose_ell, box, pose_box, opt)
-                              : testing::run_pair(box, pose_box, ell, pose_ell, opt);
         SCOPED_TRACE("swap " + std::to_string(swap) + " vertex " + std::to_string(vertex) + " trial " +
                      std::to_string(trial) + " gap " + std::to_string(gap));
-        tally.add(res, gap);
+        tally.run(box, pose_box, ell, pose_ell, swap, opt, gap);
       }
     }
   }
@@ -337,11 +340,9 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
           const Eigen::Vector3d T = testing::random_vector(rng);
           const Pose pose_round{T, Q}, pose_box{T + Q * centre, Q * Eigen::Quaterniond(Rb)};
           const Shape box = Shape::box(h), round = cone ? Shape::cone(r, hy) : Shape::cylinder(r, hy);
-          const auto res = swap ? testing::run_pair(round, pose_round, box, pose_box, opt)
-                                : testing::run_pair(box, pose_box, round, pose_round, opt);
           SCOPED_TRACE("cone " + std::to_string(cone) + " swap " + std::to_string(swap) + " vertex " +
                        std::to_string(vertex) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));
-          tally.add(res, gap);
+          tally.run(box, pose_box, round, pose_round, swap, opt, gap);
         }
       }
     }
@@ -415,11 +416,10 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
             const Pose pose_y{T, Q}, pose_x{T + Q * centre, Q * Eigen::Quaterniond(Rx)};
             const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx);
             const Shape sy = ycone ? Shape::cone(ry, hy) : Shape::cylinder(ry, hy);
-            const auto res = swap ? testing::run_pair(sy, pose_y, sx, pose_x, opt) : testing::run_pair(sx, pose_x, sy, pose_y, opt);
             SCOPED_TRACE("kind " + std::to_string(kind) + " xcone " + std::to_string(xcone) + " ycone " +
                          std::to_string(ycone) + " swap " + std::to_string(swap) + " trial " + std::to_string(trial) +
                          " gap " + std::to_string(gap));
-            tally.add(res, gap);
+            tally.run(sx, pose_x, sy, pose_y, swap, opt, gap);
           }
         }
       }
@@ -463,10 +463,9 @@ TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
         const Pose pose_a{T, Q}, pose_ell{T + Q * ce, Q * qe};
         const Shape a = kind == 0 ? Shape::sphere(radius) : Shape::capsule(radius, half);
         const Shape ell = Shape::ellipsoid(r.x(), r.y(), r.z());
-        const auto res = swap ? testing::run_pair(ell, pose_ell, a, pose_a, opt) : testing::run_pair(a, pose_a, ell, pose_ell, opt);
         SCOPED_TRACE("swap " + std::to_string(swap) + " kind " + std::to_string(kind) + " trial " +
                      std::to_string(trial) + " gap " + std::to_string(gap));
-        tally.add(res, gap);
+        tally.run(a, pose_a, ell, pose_ell, swap, opt, gap);
       }
     }
   }
@@ -523,11 +522,9 @@ TEST(WideGjk, CylinderAndConeAgainstEllipsoidStartByNewton) {
           const Pose pose_round{T, Q}, pose_ell{T + Q * ce, Q * qe};
           const Shape round = cone ? Shape::cone(r, hy) : Shape::cylinder(r, hy);
           const Shape ell = Shape::ellipsoid(rad.x(), rad.y(), rad.z());
-          const auto res = swap ? testing::run_pair(ell, pose_ell, round, pose_round, opt)
-                                : testing::run_pair(round, pose_round, ell, pose_ell, opt);
           SCOPED_TRACE("cone " + std::to_string(cone) + " swap " + std::to_string(swap) + " kind " +
                        std::to_string(kind) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));
-          tally.add(res, gap);
+          tally.run(round, pose_round, ell, pose_ell, swap, opt, gap);
         }
       }
     }
