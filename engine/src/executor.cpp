@@ -354,8 +354,7 @@ void collide(const ShapeTable& shapes, const PairBatchView& batch, const QueryOp
 
 const char* kernel_for(const Shape& a, const Shape& b, const QueryOptions& options) {
   // Sphere-cylinder and sphere-cone have a closed form only in SIMD lanes (sphere-box also has a per-pair one); the
-  // others are what the per-pair setup
-  // answers (it also knows that inflated boxes run GJK).
+  // others are what the per-pair setup answers (it also knows that inflated boxes run GJK).
   if (kernels::simd::wide_closed_form(a.type, b.type, options) == WideClosedForm::point_solids) return "closed form";
   const OwnedShapeView va(a), vb(b);
   kernels::RelativePose apart;

@@ -46,9 +46,11 @@ BATCHCOL_DECLARE_ISA(avx512)
 bool cpu_has(InstructionSet isa) {
   switch (isa) {
     case InstructionSet::avx512:
+      // AVX2 too: code of the avx512 set may run AVX2 paths (the derivatives' exposed_mask_avx2()), and a VM's
+      // CPUID could hide AVX2 while exposing AVX-512.
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
              __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
-             __builtin_cpu_supports("fma");
+             __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     case InstructionSet::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     default: return true;
   }

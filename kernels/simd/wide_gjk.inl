@@ -1493,8 +1493,9 @@ template <class T> struct WideGjk {
         //  - the certified gap after this step is still above kNewtonPlainGap x tol: below it, a plain step at x
         //    certifies the witness (the duality gap along x itself, which the termination test needs).
         const mask newton_lanes = steps & L.newton & ~boolean_only;
-        // The direction is computed only when some lane reads it: a lane that may choose it (lb > 0 and the gap
-        // still open: `want` below; polytope pairs: and not skipping after a step that did not halve the gap) or
+        // The direction is computed only when some lane reads it: a lane that may choose it (the gap still open
+        // and, curved pairs, lb > 0: `want` below; polytope pairs whatever lb (flat_newton_side()), but not while
+        // skipping after a step that did not halve the gap) or
         // one whose last step was Newton's (the shrink test that ends the sequence, curved pairs). The others'
         // results were never read: skipping them changes no bit. About half of the calls of the curved pairs
         // (lb <= 0 in the first iterations, the gap closed in the last; scalar reference, close ellipsoid pairs:

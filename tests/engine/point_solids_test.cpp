@@ -103,6 +103,34 @@ TEST(PointSolids, BoxPlacementsHaveTheirExactAnswers) {
               "box");
 }
 
+/// A centre at the same depth under two or three faces takes x before y before z (sphere_box()'s order). Identity
+/// poses: check_cases()'s random poses would break the ties by rounding.
+TEST(PointSolids, BoxDepthTiesTakeXThenYThenZ) {
+  const double r = 0.25;
+  struct Tie {
+    Eigen::Vector3d half, centre, normal;
+    double depth;
+  };
+  const Tie ties[] = {{{1, 2, 3}, {0, 1, 0}, {1, 0, 0}, 1.0},     // x and y
+                      {{1, 2, 3}, {0, 0, -2}, {1, 0, 0}, 1.0},    // x and z
+                      {{2, 1, 1}, {0, 0, 0}, {0, 1, 0}, 1.0},     // y and z
+                      {{1, 1, 1}, {0, 0, 0}, {1, 0, 0}, 1.0},     // all three, the box's centre
+                      {{1, 1, 1}, {-0.5, 0.5, 0}, {-1, 0, 0}, 0.5}};  // x and y, negative x
+  for (const Tie& k : ties) {
+    ShapeTable table;
+    const std::uint32_t box = table.add(Shape::box(k.half)), sphere = table.add(Shape::sphere(r));
+    PairBatch batch;
+    batch.add(box, Pose{}, sphere, Pose{k.centre, Eigen::Quaterniond::Identity()});
+    QueryOptions o;
+    o.level = QueryLevel::penetration;
+    PairResults res;
+    collide(table, batch, o, res);
+    ASSERT_EQ(res.status[0], Status::converged);
+    EXPECT_EQ(res.distance[0], -k.depth - r) << k.centre.transpose();
+    EXPECT_EQ(res.normal[0], k.normal) << k.centre.transpose();
+  }
+}
+
 /// Random sphere-cylinder / sphere-cone / sphere-box pairs (sizes 2-40 cm, inflated or not, both orders, distant to deeply
 /// overlapping) against GJK and EPA with the closed forms off at tolerance 1e-12.
 TEST(PointSolids, AgreeWithGjkAndEpaOnRandomPairs) {
