@@ -206,6 +206,13 @@ namespace {
 /// The closed-form start tests below: every pair's certified distance is the gap it was built with, and the share
 /// of pairs done in <= 2 iterations (the start certified by the first plain step) is counted.
 struct StartTally {
+  /// The start tests' query: witness level at tolerance 1e-9, the bound add() checks the distance against.
+  static QueryOptions options() {
+    QueryOptions opt;
+    opt.level = QueryLevel::witness;
+    opt.tolerance = 1e-9;
+    return opt;
+  }
   int trials = 0, one_or_two = 0;
   void add(const testing::SingleResult& res, double gap) {
     EXPECT_EQ(res.status, Status::converged);
@@ -242,9 +249,7 @@ std::pair<Eigen::Vector3d, Eigen::Quaterniond> ellipsoid_touching(Rng& rng, cons
 /// certifies the start in almost every lane, in either pair order.
 TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
   Rng rng(2027);
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-9;
+  const QueryOptions opt = StartTally::options();
   StartTally tally;
   for (const bool swap : {false, true}) {
     for (const bool vertex : {false, true}) {
@@ -289,9 +294,7 @@ TEST(WideGjk, BoxEllipsoidEdgeAndVertexContactsStartInClosedForm) {
 TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
   Rng rng(2028);
   const double two_pi = 6.283185307179586;
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-9;
+  const QueryOptions opt = StartTally::options();
   StartTally tally;
   for (const bool cone : {false, true}) {
     for (const bool swap : {false, true}) {
@@ -363,9 +366,7 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
 TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
   Rng rng(2029);
   const double two_pi = 6.283185307179586;
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-9;
+  const QueryOptions opt = StartTally::options();
   StartTally tally;
   enum Kind { rim_rim, rim_cap, apex_side };
   for (const Kind kind : {rim_rim, rim_cap, apex_side}) {
@@ -436,9 +437,7 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
 /// close witness double (20000 pairs): sphere-ellipsoid 4.91, capsule-ellipsoid 6.77 mean iterations.
 TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
   Rng rng(2028);
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-9;
+  const QueryOptions opt = StartTally::options();
   StartTally tally;
   for (const bool swap : {false, true}) {
     for (const int kind : {0, 1, 2}) {  // sphere, capsule side, capsule end
@@ -477,14 +476,12 @@ TEST(WideGjk, SphereAndCapsuleAgainstEllipsoidStartInClosedForm) {
 /// the lateral normal; side / slant: the lateral normal; cap: the axis; apex: around the axis, inside the apex's
 /// normal cone 2 hy m_z >= r |m_xy|), the ellipsoid touching the plane through pb = x + gap m orthogonal to m from
 /// beyond (ellipsoid_touching()), so gap is the distance. Close witness double cylinder-ellipsoid took 13.3 mean
-/// bench iterations (cone-ellipsoid 14.4) before wide_gjk_round_ellipsoid.inl's start point; with it the first plain step certifies the start
-/// in almost every lane, in either pair order.
+/// bench iterations (cone-ellipsoid 14.4) before wide_gjk_round_ellipsoid.inl's start point; with it the first
+/// plain step certifies the start in almost every lane, in either pair order.
 TEST(WideGjk, CylinderAndConeAgainstEllipsoidStartByNewton) {
   Rng rng(2029);
   const double two_pi = 6.283185307179586;
-  QueryOptions opt;
-  opt.level = QueryLevel::witness;
-  opt.tolerance = 1e-9;
+  const QueryOptions opt = StartTally::options();
   StartTally tally;
   for (const bool cone : {false, true}) {
     for (const bool swap : {false, true}) {
