@@ -141,6 +141,79 @@ TEST(WideGjk, EqualsReferenceBitwiseDouble) {
   }
 }
 
+// The penetration level: GjkParams::penetration keeps polytope-ellipsoid lanes' feature steps at lb > 0.
+TEST(WideGjk, EqualsReferenceBitwisePenetration) {
+  for (const Solver solver : {Solver::gjk, Solver::polyak}) check_all_types<double>(solver, QueryLevel::penetration);
+}
+
+// Polytope-ellipsoid pairs at the penetration level, separated and overlapping: the lanes are bitwise the reference
+// with its lb > 0 gate (GjkParams::penetration), the gate changes the run of some pairs (so the test sees it), and
+// the separated pairs' distances stay within the tolerance of a tight reference (tolerance 1e-13, plain GJK).
+TEST(WideGjk, PolytopeEllipsoidPenetrationLanesTakeFeatureStepsAtPositiveLb) {
+  Rng rng(3031);
+  QueryOptions options;
+  options.level = QueryLevel::penetration;
+  options.solver = Solver::polyak;  // resolve_solver()'s choice for hull-ellipsoid pairs
+  options.tolerance = 1e-9;
+  QueryOptions tight = options;
+  tight.level = QueryLevel::witness;
+  tight.solver = Solver::gjk;
+  tight.tolerance = 1e-13;
+  int compared = 0, gated = 0, separated = 0;
+  for (const ShapeType poly_type : {ShapeType::convex, ShapeType::capsule}) {
+    for (const bool swap : {false, true}) {
+      std::deque<OwnedShapeView> keep;
+      std::vector<kernels::PairSetup<double>> setups, tights;
+      for (int i = 0; i < 150; ++i) {
+        keep.emplace_back(poly_type == ShapeType::convex ? Shape::convex(testing::random_hull_points(rng, 8, 0.05, 0.3))
+                                                         : testing::random_shape(rng, poly_type));
+        const ShapeView& poly = keep.back().view;
+        keep.emplace_back(testing::random_shape(rng, ShapeType::ellipsoid));
+        const ShapeView& ell = keep.back().view;
+        kernels::RelativePose X;
+        X.R = testing::random_rotation(rng).toRotationMatrix();
+        X.t = testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.5);
+        const Eigen::Vector3d warm = Eigen::Vector3d::Constant(std::nan(""));
+        const ShapeView& a = swap ? ell : poly;
+        const ShapeView& b = swap ? poly : ell;
+        const kernels::PairSetup<double> s = kernels::setup_pair<double>(a, b, X, warm, options);
+        if (s.done) continue;
+        ASSERT_TRUE(s.params.penetration);
+        setups.push_back(s);
+        tights.push_back(kernels::setup_pair<double>(a, b, X, warm, tight));
+      }
+      std::vector<kernels::GjkResult<double>> want;
+      for (std::size_t i = 0; i < setups.size(); ++i) {
+        const auto& s = setups[i];
+        want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
+        kernels::GjkParams<double> ungated = s.params;
+        ungated.penetration = false;
+        const auto other = test_reference::gjk(s.difference(), s.initial_direction, ungated);
+        gated += other.iterations != want[i].iterations || other.newton_steps != want[i].newton_steps ? 1 : 0;
+        if (want[i].status != kernels::GjkStatus::converged) continue;
+        const auto& t = tights[i];
+        const auto ref = test_reference::gjk(t.difference(), t.initial_direction, t.params);
+        if (ref.status != kernels::GjkStatus::converged) continue;
+        // |x| is at most the tolerance above the distance, the tight run's |x| at most 1e-13 (both >= it).
+        EXPECT_LE(std::abs(want[i].x.norm() - ref.x.norm()), 1e-9 + 1e-13) << "pair " << i << " swap " << swap;
+        ++separated;
+      }
+      for (const InstructionSet isa : runnable_sets()) {
+        std::vector<kernels::GjkResult<double>> got(setups.size());
+        kernels::simd::gjk_lanes<double>(isa, setups.data(), setups.size(), got.data(), options.solver);
+        for (std::size_t i = 0; i < setups.size(); ++i) {
+          ASSERT_EQ(compare(want[i], got[i]), "") << to_string(poly_type) << " pair " << i << " swap " << swap
+                                                  << " isa " << to_string(isa);
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 300);
+  EXPECT_GT(separated, 50) << "too few separated pairs to check the distances";
+  EXPECT_GT(gated, 10) << "the lb > 0 gate should change the run of some overlapping pairs";
+}
+
 TEST(WideGjk, EqualsReferenceBitwiseFloat) {
   for (const Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
     check_all_types<float>(solver, QueryLevel::witness);
