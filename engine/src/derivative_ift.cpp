@@ -77,7 +77,7 @@ template <std::size_t kLanes> bool whole_block(std::size_t count, const std::siz
 // v) writing entry e of the register to out[e][column[lane]]. Compiled twice, so that the common case (a full block
 // of whole registers to consecutive columns) has a fixed trip count, whole-vector stores and no per-store test.
 template <std::size_t kLanes, class Body>
-void run_lanes(std::size_t count, const std::size_t* column, double* const* out, const Body& body) {
+void run_lanes(std::size_t count, const std::size_t* column, double* const* out, std::size_t at, const Body& body) {
   const bool columns_in_order = whole_block<kLanes>(count, column);
   const auto run = [&](auto in_order_tag) {
     constexpr bool in_order = decltype(in_order_tag)::value;
@@ -87,12 +87,12 @@ void run_lanes(std::size_t count, const std::size_t* column, double* const* out,
       // Typed stores (a vector of doubles, 8-byte aligned), not memcpy: a memcpy may alias anything, so the compiler
       // reloaded out and l through the closure before each of the 120 stores (~300 instructions per pair).
       using Unaligned = double __attribute__((vector_size(16), aligned(8)));
-      const auto put = [out, column, l, both](int e, V v) {
+      const auto put = [out, at, column, l, both](int e, V v) {
         if (in_order && both) {
-          *reinterpret_cast<Unaligned*>(out[e] + l) = v;
+          *reinterpret_cast<Unaligned*>(out[e] + at + l) = v;
         } else {
-          out[e][column[l]] = v[0];
-          if (both) out[e][column[l + 1]] = v[1];
+          out[e][at + column[l]] = v[0];
+          if (both) out[e][at + column[l + 1]] = v[1];
         }
       };
       body(l, put);
@@ -170,25 +170,25 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 //   I - sd K),   dn/dxi_a = -(I - n n^T) y;
 // the twist of b by the rigid-motion identity (as write_from_twist_a()); the lanes' arithmetic is in
 // derivative_lanes.inl. Here: which set's lanes run a block (the wide ones only for a whole block on AVX2 / AVX-512).
-void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa) const {
+void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa, std::size_t at) const {
   if (normal_b_only) {
-    if (!curved) solve_lanes<true, false, true>(out, isa);
-    else if (given) solve_lanes<true, true, true>(out, isa);
-    else solve_lanes<true, true, false>(out, isa);
+    if (!curved) solve_lanes<true, false, true>(out, isa, at);
+    else if (given) solve_lanes<true, true, true>(out, isa, at);
+    else solve_lanes<true, true, false>(out, isa, at);
   } else {
-    if (!curved) solve_lanes<false, false, true>(out, isa);
-    else if (given) solve_lanes<false, true, true>(out, isa);
-    else solve_lanes<false, true, false>(out, isa);
+    if (!curved) solve_lanes<false, false, true>(out, isa, at);
+    else if (given) solve_lanes<false, true, true>(out, isa, at);
+    else solve_lanes<false, true, false>(out, isa, at);
   }
 }
 
 template <bool kNormalB, bool kCurved, bool kGiven>
-void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa) const {
+void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa, std::size_t at) const {
   if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
-    return lanes_avx512::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out);
+    return lanes_avx512::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out, at);
   if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
-    return lanes_avx2::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out);
-  run_lanes<kLanes>(count, column, out, [&](std::size_t l, const auto& put) {
+    return lanes_avx2::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out, at);
+  run_lanes<kLanes>(count, column, out, at, [&](std::size_t l, const auto& put) {
     lanes_base::smooth_lanes<kNormalB, kCurved, kGiven, V>(*this, l, put);
   });
 }
@@ -202,18 +202,27 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
   const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
   const Eigen::Vector3d& nv = g.normal;
   const std::size_t l = count;
-  // The case's P, G, W built in locals and each lane entry stored once (zeroing the lane's 27 entries first and
-  // storing the case's over them cost ~170 instructions per hull pair, callgrind).
-  double p[9] = {}, gm[9] = {}, w[9] = {};
+  // Each case stores the lane's 27 entries of P, G, W once, each an expression of its (i, j) that folds after
+  // unrolling (zeros as stores of 0). Zeroing the 27 entries first and storing the case's over them cost ~170
+  // instructions per hull pair (callgrind); building them in local arrays and copying those ~150.
+  const auto put = [&](const auto& pf, const auto& gf, const auto& wf) __attribute__((always_inline)) {
+#pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i)
+#pragma GCC unroll 3
+      for (int j = 0; j < 3; ++j) P[3 * i + j][l] = pf(i, j), G[3 * i + j][l] = gf(i, j), W[3 * i + j][l] = wf(i, j);
+  };
+  const auto zero = [](int, int) { return 0.0; };
+  const auto identity = [](int i, int j) { return i == j ? 1.0 : 0.0; };
+  const auto tangent = [&](int i, int j) { return (i == j ? 1.0 : 0.0) - nv(i) * nv(j); };  // I - n n^T
   if (k == 1) {  // one edge (flats are unit and orthogonal to n): P = c c^T; G = P [n]x = c (c x n)^T for a's edge
     const Eigen::Vector3d c = ka > 0 ? g.flat_a.col(0) : g.flat_b.col(0);
-    const Eigen::Vector3d cn = c.cross(nv);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        p[3 * i + j] = c(i) * c(j);
-        if (ka > 0) gm[3 * i + j] = c(i) * cn(j);
-      }
-    if (kb > 0) w[0] = w[4] = w[8] = 1.0;
+    const auto edge = [&](int i, int j) { return c(i) * c(j); };
+    if (ka > 0) {
+      const Eigen::Vector3d cn = c.cross(nv);
+      put(edge, [&](int i, int j) { return c(i) * cn(j); }, zero);
+    } else {
+      put(edge, zero, identity);
+    }
   } else if (k == 2) {  // two independent flats orthogonal to n span its tangent plane: P = I - n n^T
     if (ka == 1) {  // edge A against edge B; independent when A . (n x B) = +-|A x B| is not ~0 (polytope_jacobians'
                     // test: what is left of one unit flat after removing the other)
@@ -222,17 +231,17 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
       const double s = A.dot(B_perp);
       if (!(std::abs(s) > 1e-6)) return false;
       const double t = B.dot(A_perp);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) gm[3 * i + j] = B_perp(i) * (An(j) / s), w[3 * i + j] = B(i) * (A_perp(j) / t);
+      put(tangent, [&](int i, int j) { return B_perp(i) * (An(j) / s); },
+          [&](int i, int j) { return B(i) * (A_perp(j) / t); });
     } else if (ka == 2) {  // a's face against b's vertex: G = P [n]x = [n]x (n^T [n]x = 0)
-      gm[1] = -nv.z(), gm[2] = nv.y(), gm[3] = nv.z(), gm[5] = -nv.x(), gm[6] = -nv.y(), gm[7] = nv.x();
+      const double cross[9] = {0.0, -nv.z(), nv.y(), nv.z(), 0.0, -nv.x(), -nv.y(), nv.x(), 0.0};
+      put(tangent, [&](int i, int j) { return cross[3 * i + j]; }, zero);
     } else {  // a's vertex against b's face
-      w[0] = w[4] = w[8] = 1.0;
+      put(tangent, zero, identity);
     }
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) p[3 * i + j] = (i == j ? 1.0 : 0.0) - nv(i) * nv(j);
+  } else {  // no flats: both points rigid
+    put(zero, zero, zero);
   }
-  for (int e = 0; e < 9; ++e) P[e][l] = p[e], G[e][l] = gm[e], W[e][l] = w[e];
   ++count;
   column[l] = col;
   sd[l] = g.distance;
@@ -240,12 +249,12 @@ bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
   return true;
 }
 
-void PolytopeLanes::solve(double* const* out, InstructionSet isa) const {
+void PolytopeLanes::solve(double* const* out, InstructionSet isa, std::size_t at) const {
   if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
-    return lanes_avx512::polytope_block<V8>(*this, out);
+    return lanes_avx512::polytope_block<V8>(*this, out, at);
   if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
-    return lanes_avx2::polytope_block<V8>(*this, out);
-  run_lanes<kLanes>(count, column, out,
+    return lanes_avx2::polytope_block<V8>(*this, out, at);
+  run_lanes<kLanes>(count, column, out, at,
                     [&](std::size_t l, const auto& put) { lanes_base::polytope_lanes<V>(*this, l, put); });
 }
 

@@ -135,10 +135,14 @@ struct SmoothLanes {
   /// normal_b_only: only normal_wrt_b's 18 entries (the other rows of `out` are left as they were).
   /// isa: a whole block (count == kLanes, columns 0, 1, 2, ...) runs in one 8-lane register of that set (AVX-512,
   /// AVX2); the same bits on every set.
-  void solve(double* const* out, bool normal_b_only = false, InstructionSet isa = InstructionSet::scalar) const;
+  /// at: added to every out[e] (out[e] + at is column 0): StoreBlock passes the output arrays' rows of pair 0 once
+  /// computed and the block's first pair, instead of building 120 row pointers per flush.
+  void solve(double* const* out, bool normal_b_only = false, InstructionSet isa = InstructionSet::scalar,
+             std::size_t at = 0) const;
 
  private:
-  template <bool kNormalB, bool kCurved, bool kGiven> void solve_lanes(double* const* out, InstructionSet isa) const;
+  template <bool kNormalB, bool kCurved, bool kGiven>
+  void solve_lanes(double* const* out, InstructionSet isa, std::size_t at) const;
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two
@@ -162,7 +166,7 @@ struct PolytopeLanes {
   /// edges): the general path decides.
   bool add(std::size_t column, const PairGeometry& g);
   /// As SmoothLanes::solve().
-  void solve(double* const* out, InstructionSet isa = InstructionSet::scalar) const;
+  void solve(double* const* out, InstructionSet isa = InstructionSet::scalar, std::size_t at = 0) const;
 };
 
 /// True when the pair can take PolytopeLanes (no curvature, separated, at most two flats).

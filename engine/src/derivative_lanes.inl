@@ -206,16 +206,17 @@ inline __attribute__((always_inline)) void polytope_lanes(const PolytopeLanes& l
 }
 
 // A whole block of kLanes pairs to output columns 0 .. kLanes - 1, one register of V: every entry one store.
+// out[e] + at: column 0 of entry e (at: the block's first pair when out holds the output arrays' rows of pair 0).
 template <class V, bool kNormalB, bool kCurved, bool kGiven>
-void smooth_block(const SmoothLanes& s, double* const* out) {
+void smooth_block(const SmoothLanes& s, double* const* out, std::size_t at) {
   static_assert(sizeof(V) == SmoothLanes::kLanes * sizeof(double));
-  smooth_lanes<kNormalB, kCurved, kGiven, V>(s, 0,
-                                             [out](int e, const V& v) { __builtin_memcpy(out[e], &v, sizeof v); });
+  smooth_lanes<kNormalB, kCurved, kGiven, V>(
+      s, 0, [out, at](int e, const V& v) { __builtin_memcpy(out[e] + at, &v, sizeof v); });
 }
 
-template <class V> void polytope_block(const PolytopeLanes& lanes, double* const* out) {
+template <class V> void polytope_block(const PolytopeLanes& lanes, double* const* out, std::size_t at) {
   static_assert(sizeof(V) == PolytopeLanes::kLanes * sizeof(double));
-  polytope_lanes<V>(lanes, 0, [out](int e, const V& v) { __builtin_memcpy(out[e], &v, sizeof v); });
+  polytope_lanes<V>(lanes, 0, [out, at](int e, const V& v) { __builtin_memcpy(out[e] + at, &v, sizeof v); });
 }
 
 }  // namespace

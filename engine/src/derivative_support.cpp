@@ -529,8 +529,7 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u) {
 }
 
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
-                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
-                                          InstructionSet isa) {
+                                          const double* const* z) {
   const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
@@ -539,19 +538,16 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     return p;
   };
   const Eigen::Vector3d s0 = support(u);
-  // gaussian_vector<4>(seed, pair, k, stream) for every antithetic pair k, drawn W at a time by the SIMD kernels
-  // (the same bits): one scalar draw cost ~375 instructions, more than the support call it feeds. Then all the
-  // directions, then the support points, then their sums, each in its own loop: the support call clobbers every
-  // vector register, so whatever a loop around it kept (the noise, u, e, the sums) lived on the stack.
+  // The noise z comes drawn (the caller draws both sides' at once). All the directions, then the support points,
+  // then their sums, each in its own loop: the support call clobbers every vector register, so whatever a loop
+  // around it kept (the noise, u, e, the sums) lived on the stack.
   const std::size_t draws = static_cast<std::size_t>(samples + 1) / 2;
   const std::size_t n = static_cast<std::size_t>(samples), n4 = (n + 3) & ~std::size_t(3);
   thread_local std::vector<double> buffer;
-  if (buffer.size() < 4 * draws + 3 * n4 + 3 * n) buffer.resize(4 * draws + 3 * n4 + 3 * n);
-  double* const z[4] = {buffer.data(), buffer.data() + draws, buffer.data() + 2 * draws, buffer.data() + 3 * draws};
-  double* const d[3] = {buffer.data() + 4 * draws, buffer.data() + 4 * draws + n4,
-                        buffer.data() + 4 * draws + 2 * n4};  // u + e z_j by coordinate, padded with zeros to 4
-  double* const q = buffer.data() + 4 * draws + 3 * n4;       // S(u + e z_j) - s0, 3 per sample
-  kernels::simd::draw_gaussians4(isa, splitmix64(splitmix64(seed) ^ pair), stream, 0, draws, z);
+  if (buffer.size() < 3 * n4 + 3 * n) buffer.resize(3 * n4 + 3 * n);
+  double* const d[3] = {buffer.data(), buffer.data() + n4,
+                        buffer.data() + 2 * n4};  // u + e z_j by coordinate, padded with zeros to 4
+  double* const q = buffer.data() + 3 * n4;       // S(u + e z_j) - s0, 3 per sample
   // Sample 2k adds e z_k, its antithetic copy 2k+1 subtracts it: u + e (-z) and u - e z are the same bits.
   for (int c = 0; c < 3; ++c) {
     const double uc = u[c];

@@ -120,11 +120,11 @@ void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B);
 /// 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k}
 /// (the baseline S(u) cancels within a pair), symmetrised. The Hessian of the smoothed convex support function is
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
-/// implicit-function matrix singular, a bias that vanishes as M grows. Noise keyed by (seed, pair, sample,
-/// stream), drawn by `isa`'s kernels (resolved; every set gives the same bits). `view`: the shape's plain record
-/// (ShapeTableAccess::view()).
+/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
+/// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
+/// caller draws it: kernels::simd::draw_gaussians4_streams() for both sides of a pair). `view`: the shape's plain
+/// record (ShapeTableAccess::view()).
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
-                                          std::uint64_t seed, std::uint64_t pair, std::uint64_t stream,
-                                          InstructionSet isa);
+                                          const double* const* z);
 
 }  // namespace batchcol::detail
