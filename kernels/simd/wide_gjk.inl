@@ -664,10 +664,19 @@ template <class T> struct WideGjk {
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     if constexpr (std::is_same_v<T, double>) {
       if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
-        if (!L.rim_given)
+        mask want = m & ~L.boolean_only;
+        if (!L.rim_given) {
+          // Lanes whose cores overlap cannot keep a candidate (wide_gjk_start_gate.inl): computed only when a
+          // fresh lane may (overlap-regime penetration runs mostly skip it).
+          want &= ~cores_overlap(L, sa, sb);
+          if (!any(want)) {
+            L.fresh = 0;
+            return;
+          }
           start_candidate(box_ellipsoid_pair(L.A.type, L.B.type), L.A.type, L.B.type, L.R, L.t,
                           {L.A.s0, L.A.s1, L.A.s2}, {L.B.s0, L.B.s1, L.B.s2}, L.rim_a, L.rim_b);
-        take_start(L, m & ~L.boolean_only, L.rim_a, L.rim_b);
+        }
+        take_start(L, want, L.rim_a, L.rim_b);
       }
     }
     L.fresh = 0;
@@ -890,6 +899,7 @@ template <class T> struct WideGjk {
 #include "kernels/simd/wide_gjk_box_round.inl"
 #include "kernels/simd/wide_gjk_rim_rim.inl"
 #include "kernels/simd/wide_gjk_round_ellipsoid.inl"
+#include "kernels/simd/wide_gjk_start_gate.inl"
 
   /// One side of a lane's pair: what the support functions read (ShapeCore's size, triangle, hull).
   struct SideStart {

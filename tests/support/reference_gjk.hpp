@@ -23,6 +23,7 @@
 #include "support/reference_rim_rim.hpp"
 #include "support/reference_round_ellipsoid.hpp"
 #include "support/reference_simplex_projection.hpp"
+#include "support/reference_start_gate.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -357,6 +358,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   if (!(norm2(initial_direction) > T(0))) initial_direction = Vec3<T>::UnitX();
   Simplex<T>& S = r.simplex;
   S.v[0] = D.support(-initial_direction);
+  [[maybe_unused]] const SupportPoint<T> first = S.v[0];  // the start gate's points (side_start() may replace S.v[0])
   S.lambda[0] = T(1);
   S.count = 1;
   Vec3<T> x = S.v[0].w;
@@ -380,30 +382,34 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     const bool found = side_start(D, p);
     take_start(found, p);
   }
+  // Pairs whose cores certainly overlap (their first support point's points inside the other core) compute no
+  // closed-form candidate: none could separate the cores (wide_gjk.inl's start(), reference_start_gate.hpp).
   if constexpr (std::is_same_v<T, double>) {
-    // Rim-lateral pairs (double): the closest rim-lateral point of D.
-    if (!params.boolean_only && rim_start_pair(D.A->type, D.B->type)) {
-      SupportPoint<T> p;
-      const bool found = rim_candidate(D, p);
-      take_start(found, p);
-    }
-    // Box-, capsule- and sphere-ellipsoid pairs (double): the closest face / edge / vertex point of D.
-    if (!params.boolean_only && box_ellipsoid_pair(D.A->type, D.B->type)) {
-      SupportPoint<T> p;
-      const bool found = box_ellipsoid_candidate(D, p);
-      take_start(found, p);
-    }
-    // Box-cylinder / box-cone pairs (double): the closest face / edge / vertex / apex point of D.
-    if (!params.boolean_only && box_round_pair(D.A->type, D.B->type)) {
-      SupportPoint<T> p;
-      const bool found = box_round_candidate(D, p);
-      take_start(found, p);
-    }
-    // Cylinder- / cone-ellipsoid pairs (double): the closest cap / rim / apex / side / slant Newton point of D.
-    if (!params.boolean_only && round_ellipsoid_pair(D.A->type, D.B->type)) {
-      SupportPoint<T> p;
-      const bool found = round_ellipsoid_candidate(D, p);
-      take_start(found, p);
+    if (!params.boolean_only && start_candidate_pair(D.A->type, D.B->type) && !cores_overlap(D, first)) {
+      // Rim-lateral pairs (double): the closest rim-lateral point of D.
+      if (rim_start_pair(D.A->type, D.B->type)) {
+        SupportPoint<T> p;
+        const bool found = rim_candidate(D, p);
+        take_start(found, p);
+      }
+      // Box-, capsule- and sphere-ellipsoid pairs (double): the closest face / edge / vertex point of D.
+      if (box_ellipsoid_pair(D.A->type, D.B->type)) {
+        SupportPoint<T> p;
+        const bool found = box_ellipsoid_candidate(D, p);
+        take_start(found, p);
+      }
+      // Box-cylinder / box-cone pairs (double): the closest face / edge / vertex / apex point of D.
+      if (box_round_pair(D.A->type, D.B->type)) {
+        SupportPoint<T> p;
+        const bool found = box_round_candidate(D, p);
+        take_start(found, p);
+      }
+      // Cylinder- / cone-ellipsoid pairs (double): the closest cap / rim / apex / side / slant Newton point of D.
+      if (round_ellipsoid_pair(D.A->type, D.B->type)) {
+        SupportPoint<T> p;
+        const bool found = round_ellipsoid_candidate(D, p);
+        take_start(found, p);
+      }
     }
   }
   T lower_bound = -std::numeric_limits<T>::infinity();
