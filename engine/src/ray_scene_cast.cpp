@@ -32,17 +32,17 @@ struct Hit {
   ObjectHandle object;
 };
 
-// Batches from this size on are cast in RayOrder (below) when what a ray reads at random, the wide nodes and the
-// leaf records (RayLeaf: the leaf's ball and object), takes at least kRandomReadBytes; records of rays this far ahead
-// in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies); it pays when those
-// arrays do not stay in a core's L2 (2 MB on the Xeons measured, shared with the shapes' data and the rays): 100k
-// mixed objects (26 MB of nodes, 13 MB of leaves), +20% rays/s, and 10k hulls of 250 vertices (0.67 MB of nodes,
-// 1.28 MB of leaves, ~0.6 MB of hull walk data), where perf put 25% of the traversal's samples on the first load of
-// a node and 13% on the leaf's ball in input order (14% and 8% in this order), and the order measured +5% rays per
-// CPU second (1 thread, 4 alternating rounds) and +12% in the same-run ratio to Embree (2 threads, median of 8
-// alternating pairs; Emerald Rapids VM at 2.1 GHz; the nodes alone, the previous criterion, are below 1 MiB there).
-// The traversal prefetches pushed nodes on trees whose nodes alone exceed it (kLargeTreeBytes): on 10k hulls in this
-// order that prefetching measured 0.83-1.00 of the rays per CPU second without it (4 rounds).
+// Batches from this size on are cast in RayOrder (below) when what a ray reads at random, the wide nodes and the leaf
+// records (RayLeaf: the leaf's ball and object), takes at least kRandomReadBytes; records of rays this far ahead in
+// that order are prefetched. The order costs ~280 instructions a ray (AVX2: key 118, sort 120, scatter 38); it pays
+// when those arrays do not stay in a core's L2 (2 MB on the Xeons measured, shared with the shapes' data and the rays):
+// 100k mixed objects (26 MB of nodes, 13 MB of leaves), +20% rays/s, and 10k hulls of 250 vertices (0.67 MB of nodes,
+// 1.28 MB of leaves, ~0.6 MB of hull walk data), where perf put 25% of the traversal's samples on the first load of a
+// node and 13% on the leaf's ball in input order (14% and 8% in this order), and the order measured +5% rays per CPU
+// second (1 thread, 4 alternating rounds) and +12% in the same-run ratio to Embree (2 threads, median of 8 alternating
+// pairs; Emerald Rapids VM at 2.1 GHz; the nodes alone, the previous criterion, are below 1 MiB there). The traversal
+// prefetches pushed nodes on trees whose nodes alone exceed it (kLargeTreeBytes): on 10k hulls in this order that
+// prefetching measured 0.83-1.00 of the rays per CPU second without it (4 rounds).
 constexpr std::size_t kSortedCastMin = 4096;
 constexpr std::size_t kRandomReadBytes = std::size_t(1) << 20;
 constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
@@ -368,11 +368,11 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   const bool ordered =
       !all && n >= kSortedCastMin && n < (std::size_t(1) << 32) &&
       state_->wide.nodes().size() * sizeof(WideNode) + state_->leaves.size() * sizeof(RayLeaf) >= kRandomReadBytes;
+  const int isa = detail::ray_isa_index(options.isa);  // InputError when this CPU lacks the requested set
   if (ordered)
     size_unfilled(out, n);
   else
     detail::size_ray_results(out, n, true);
-  const int isa = detail::ray_isa_index(options.isa);  // InputError when this CPU lacks the requested set
   const Caster caster(*state_, options, isa);
   std::vector<std::vector<Hit>> chunk_hits(all ? chunks : 0);
   std::vector<std::vector<std::uint32_t>> chunk_counts(all ? chunks : 0);
