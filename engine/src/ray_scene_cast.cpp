@@ -4,6 +4,8 @@
 // Closest-hit pruning: a subtree is skipped when its box starts beyond the best hit so far. Ties in t go to the lower
 // object slot, so the answer does not depend on the traversal order. Rays are split into fixed chunks; all-hit rows
 // are collected per chunk and concatenated in ray order: bitwise the same for any thread count.
+#include "ray_cast_arena.hpp"
+#include "ray_order_keys.hpp"
 #include "ray_scene_state.hpp"
 #include "ray_wide_traverse.hpp"
 #include "rays_common.hpp"
@@ -14,8 +16,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <mutex>
+#include <new>
 
 namespace batchcol {
 namespace {
@@ -29,17 +32,17 @@ struct Hit {
   ObjectHandle object;
 };
 
-// Batches from this size on are cast in RayOrder (below) when what a ray reads at random, the wide nodes and the
-// leaf records (RayLeaf: the leaf's ball and object), takes at least kRandomReadBytes; records of rays this far ahead
-// in that order are prefetched. The order costs ~380 instructions a ray (key, sort, copies); it pays when those
-// arrays do not stay in a core's L2 (2 MB on the Xeons measured, shared with the shapes' data and the rays): 100k
-// mixed objects (26 MB of nodes, 13 MB of leaves), +20% rays/s, and 10k hulls of 250 vertices (0.67 MB of nodes,
-// 1.28 MB of leaves, ~0.6 MB of hull walk data), where perf put 25% of the traversal's samples on the first load of
-// a node and 13% on the leaf's ball in input order (14% and 8% in this order), and the order measured +5% rays per
-// CPU second (1 thread, 4 alternating rounds) and +12% in the same-run ratio to Embree (2 threads, median of 8
-// alternating pairs; Emerald Rapids VM at 2.1 GHz; the nodes alone, the previous criterion, are below 1 MiB there).
-// The traversal prefetches pushed nodes on trees whose nodes alone exceed it (kLargeTreeBytes): on 10k hulls in this
-// order that prefetching measured 0.83-1.00 of the rays per CPU second without it (4 rounds).
+// Batches from this size on are cast in RayOrder (below) when what a ray reads at random, the wide nodes and the leaf
+// records (RayLeaf: the leaf's ball and object), takes at least kRandomReadBytes; records of rays this far ahead in
+// that order are prefetched. The order costs ~280 instructions a ray (AVX2: key 118, sort 120, scatter 38); it pays
+// when those arrays do not stay in a core's L2 (2 MB on the Xeons measured, shared with the shapes' data and the rays):
+// 100k mixed objects (26 MB of nodes, 13 MB of leaves), +20% rays/s, and 10k hulls of 250 vertices (0.67 MB of nodes,
+// 1.28 MB of leaves, ~0.6 MB of hull walk data), where perf put 25% of the traversal's samples on the first load of a
+// node and 13% on the leaf's ball in input order (14% and 8% in this order), and the order measured +5% rays per CPU
+// second (1 thread, 4 alternating rounds) and +12% in the same-run ratio to Embree (2 threads, median of 8 alternating
+// pairs; Emerald Rapids VM at 2.1 GHz; the nodes alone, the previous criterion, are below 1 MiB there). The traversal
+// prefetches pushed nodes on trees whose nodes alone exceed it (kLargeTreeBytes): on 10k hulls in this order that
+// prefetching measured 0.83-1.00 of the rays per CPU second without it (4 rounds).
 constexpr std::size_t kSortedCastMin = 4096;
 constexpr std::size_t kRandomReadBytes = std::size_t(1) << 20;
 constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
@@ -245,34 +248,27 @@ void store(RayResults& out, std::size_t i, const Hit& h) {
   out.object[i] = h.object;
 }
 
-// The low 5 bits of v spread to every sixth bit (bits 0, 6, ..., 24), by table (a loop costs ~30 instructions).
-constexpr std::array<std::uint32_t, 32> kSpread6 = [] {
-  std::array<std::uint32_t, 32> t{};
-  for (std::uint32_t v = 0; v < 32; ++v)
-    for (int b = 0; b < 5; ++b) t[v] |= ((v >> b) & 1u) << (6 * b);
-  return t;
-}();
+// detail::size_ray_results() without its default values, for a cast that writes every field of every ray.
+void size_unfilled(RayResults& r, std::size_t n) {
+  r.status.resize(n), r.hit.resize(n), r.t.resize(n), r.normal.resize(n), r.object.resize(n);
+  r.hit_begin.clear(), r.all_t.clear(), r.all_normal.resize(0), r.all_object.clear();
+}
 
 // Ray order for a large batch: rays that enter the scene near each other in similar directions are cast one after
-// the other, so that the nodes one ray loads are still in cache for the next (random rays over a 100k-object scene
-// otherwise miss the L2 on most wide nodes). Only the order of work changes: each ray's answer depends on that ray
-// alone, so the results are bitwise those of input order. The key is a 30-bit Morton code over 6 dimensions, 5 bits
-// each: where the ray enters the scene's box (its origin when inside) and its unit direction; rays that miss the box,
-// and invalid rays, get the largest key (they cost little and are cast last). Word = key << 32 | ray index; the radix
-// sort is stable and splits its work independently of the thread count.
+// the other (the key: ray_order_keys.hpp), so that the nodes one ray loads are still in cache for the next (random
+// rays over a 100k-object scene otherwise miss the L2 on most wide nodes). Only the order of work changes: each ray's
+// answer depends on that ray alone, so the results are bitwise those of input order. Word = key << 32 | ray index;
+// the radix sort is stable and splits its work independently of the thread count.
 // Reading the caller's 7 input and writing its 7 result arrays at the scattered indices of that order cost more than
 // the order saved (10k hulls, whose tree fits the L2: 0.57 -> 0.38 M rays/s on one thread, prefetching or not; the
 // page walks of 14 random lines a ray): the rays are copied once, in input order, into one 64-byte record each, the
 // results go to a buffer in cast order, and a last pass writes the caller's arrays in input order, so a ray touches
 // 3 scattered lines (its record, its slot of the inverse order, its result), not 14.
-// The ordered cast's buffers (~130 bytes a ray, fresh for every cast) on huge pages when large (ray_huge_pages.hpp):
-// 1M rays fault 130 MB in, ~33k page faults with 4 KiB pages, and the records and results are then read at scattered
-// places in the cast order and the scatter, one TLB entry per ray with small pages, one per 2 MiB with huge ones.
-template <class T> using CastBuffer = std::vector<T, detail::HugePageAllocator<T>>;
-
+// The buffers (~130 bytes a ray) are the index's RayCastArena (ray_cast_arena.hpp), on huge pages when large: the
+// records and results are read at scattered places in the cast order and the scatter, one TLB entry per ray with
+// small pages, one per 2 MiB with huge ones; mapped once, not faulted in and cleared by the kernel for every cast.
 struct alignas(64) PackedRay {  // one cache line
   double o[3], d[3], t_max;
-  std::uint32_t valid;
 };
 
 struct CastResult {
@@ -280,33 +276,35 @@ struct CastResult {
   bool found;
   RayStatus status;
 };
+static_assert(sizeof(CastResult) >= sizeof(std::uint64_t), "the sort's scratch words alias the results");
 
 class RayOrder {
  public:
-  RayOrder(const RayBatch& rays, const WideNode& root) : n_(rays.size()), packed_(n_), words_(n_) {
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    const float* rl[3] = {root.lo_x, root.lo_y, root.lo_z};
-    const float* rh[3] = {root.hi_x, root.hi_y, root.hi_z};
-    for (int c = 0; c < kWideArity; ++c)
-      if (root.child[c] != kWideEmpty)
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], rl[k][c]), hi[k] = std::max(hi[k], rh[k][c]);
-    double scale[3];
-    for (int k = 0; k < 3; ++k) {
-      const double extent = double(hi[k]) - double(lo[k]);
-      scale[k] = extent > 0.0 && std::isfinite(extent) ? 32.0 / extent : 0.0;
-    }
+  /// The arena's bytes for n rays.
+  static std::size_t bytes(std::size_t n) { return results_at(n) + n * sizeof(CastResult); }
+
+  RayOrder(const RayBatch& rays, const WideNode& root, int isa, detail::RayCastArena& arena) : n_(rays.size()) {
+    char* const base = static_cast<char*>(arena.get(bytes(n_)));
+    packed_ = reinterpret_cast<PackedRay*>(base);
+    words_ = reinterpret_cast<std::uint64_t*>(base + n_ * sizeof(PackedRay));
+    results_ = reinterpret_cast<CastResult*>(base + results_at(n_));
+    const detail::RayOrderBox box = detail::ray_order_box(root);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        PackedRay& p = packed_[i];
-        p = {{rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]},
-             {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]},
-             rays.t_max[i],
-             detail::ray_is_valid(rays, i) ? 1u : 0u};
-        words_[i] = std::uint64_t(p.valid ? key(p, lo, hi, scale) : kMissKey) << 32 | std::uint64_t(i);
+      std::uint32_t keys[kKeyBlock];
+      for (std::size_t b = r.begin(); b < r.end(); b += kKeyBlock) {
+        const std::size_t m = std::min(kKeyBlock, r.end() - b);
+        detail::ray_order_keys(rays, b, m, box, keys, isa);
+        for (std::size_t l = 0; l < m; ++l) {
+          const std::size_t i = b + l;
+          packed_[i] = {{rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]},
+                        {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]},
+                        rays.t_max[i]};
+          words_[i] = std::uint64_t(keys[l]) << 32 | std::uint64_t(i);
+        }
       }
     });
-    CastBuffer<std::uint64_t> scratch(n_);
-    broadphase::radix_sort(words_.data(), scratch.data(), n_, broadphase::digit_shifts(32, 62));
+    // The sort's scratch words share the results' bytes: the cast writes the results after the sort.
+    broadphase::radix_sort(words_, reinterpret_cast<std::uint64_t*>(results_), n_, broadphase::digit_shifts(32, 62));
   }
 
   std::size_t size() const { return n_; }
@@ -314,48 +312,45 @@ class RayOrder {
   std::size_t index(std::size_t k) const { return std::size_t(words_[k] & 0xffffffffu); }
   const PackedRay& ray(std::size_t k) const { return packed_[index(k)]; }
   void prefetch(std::size_t k) const { __builtin_prefetch(&packed_[index(k)]); }
+  /// The result of the k-th ray in cast order (default-initialised: the caller sets every field it reads back).
+  CastResult& result(std::size_t k) { return *::new (static_cast<void*>(results_ + k)) CastResult; }
 
-  /// Writes results[k] (cast order) to out (input order); frees the records first (`packed_ = {}` only cleared
-  /// them: an empty braced list picks the initializer-list assignment, which keeps the capacity).
-  void scatter(const CastBuffer<CastResult>& results, RayResults& out) {
-    CastBuffer<PackedRay>().swap(packed_);
-    CastBuffer<std::uint32_t> position(n_);
+  /// Writes the results (cast order) to out (input order); the inverse order takes the records' bytes (read no
+  /// more by then).
+  void scatter(RayResults& out) {
+    std::uint32_t* const position = reinterpret_cast<std::uint32_t*>(packed_);
+    const double nan = std::nan("");
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k < r.end(); ++k) position[index(k)] = static_cast<std::uint32_t>(k);
     });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        const CastResult& c = results[position[i]];
+        const CastResult& c = results_[position[i]];
         out.status[i] = c.status;
-        if (c.found) store(out, i, c.best);
+        if (c.found) {
+          store(out, i, c.best);
+        } else {  // the defaults of detail::size_ray_results()
+          out.hit[i] = 0;
+          out.t[i] = nan;
+          out.normal.set(i, Vec3<double>(nan, nan, nan));
+          out.object[i] = ObjectHandle{};
+        }
       }
     });
   }
 
  private:
-  static constexpr std::uint32_t kMissKey = 0x3fffffffu;
+  static constexpr std::size_t kKeyBlock = 64;
 
-  static std::uint32_t key(const PackedRay& p, const float lo[3], const float hi[3], const double scale[3]) {
-    double t0 = 0.0, t1 = p.t_max;
-    for (int k = 0; k < 3; ++k) {
-      const double inv = 1.0 / p.d[k], a = (lo[k] - p.o[k]) * inv, b = (hi[k] - p.o[k]) * inv;
-      t0 = std::max(t0, std::min(a, b));  // NaN (origin on a plane of a flat axis) is dropped by min / max
-      t1 = std::min(t1, std::max(a, b));
-    }
-    if (!(t0 <= t1)) return kMissKey;
-    const double len = std::sqrt(p.d[0] * p.d[0] + p.d[1] * p.d[1] + p.d[2] * p.d[2]);
-    const auto q = [](double x) { return static_cast<std::uint32_t>(std::min(31.0, std::max(0.0, x))); };
-    std::uint32_t code = 0;
-    for (int k = 0; k < 3; ++k) {
-      code |= kSpread6[q((p.o[k] + t0 * p.d[k] - lo[k]) * scale[k])] << (5 - k);
-      code |= kSpread6[q((p.d[k] / len + 1.0) * 16.0)] << (2 - k);
-    }
-    return code;
+  // The results' offset in the arena: after the records and the words, on a cache line of their own.
+  static std::size_t results_at(std::size_t n) {
+    return (n * (sizeof(PackedRay) + sizeof(std::uint64_t)) + 63) & ~std::size_t(63);
   }
 
   std::size_t n_;
-  CastBuffer<PackedRay> packed_;
-  CastBuffer<std::uint64_t> words_;
+  PackedRay* packed_;
+  std::uint64_t* words_;
+  CastResult* results_;
 };
 
 }  // namespace
@@ -365,19 +360,29 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
   detail::check_ray_batch(rays);
   if (!state_->ready) throw InputError("RaySceneIndex::cast: call update(scene) first");
   const std::size_t n = rays.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
-  detail::size_ray_results(out, n, true);
-  const int isa = detail::ray_isa_index(options.isa);  // InputError when this CPU lacks the requested set
-  const Caster caster(*state_, options, isa);
   const bool all = options.query == RayQuery::all;
+  // Closest and any hits of large batches are cast in RayOrder (all-hit rows are gathered per chunk in input order,
+  // so that query keeps the input order; small batches gain nothing from the sort). Its scatter writes every field
+  // of every ray, so the results are only sized here, not filled with defaults first (a serial pass of 42 bytes a
+  // ray).
+  const bool ordered =
+      !all && n >= kSortedCastMin && n < (std::size_t(1) << 32) &&
+      state_->wide.nodes().size() * sizeof(WideNode) + state_->leaves.size() * sizeof(RayLeaf) >= kRandomReadBytes;
+  const int isa = detail::ray_isa_index(options.isa);  // InputError when this CPU lacks the requested set
+  if (ordered)
+    size_unfilled(out, n);
+  else
+    detail::size_ray_results(out, n, true);
+  const Caster caster(*state_, options, isa);
   std::vector<std::vector<Hit>> chunk_hits(all ? chunks : 0);
   std::vector<std::vector<std::uint32_t>> chunk_counts(all ? chunks : 0);
-  // Closest and any hits of large batches are cast in RayOrder (all-hit rows are gathered per chunk in input order,
-  // so that query keeps the input order; small batches gain nothing from the sort).
-  if (!all && n >= kSortedCastMin && n < (std::size_t(1) << 32) &&
-      state_->wide.nodes().size() * sizeof(WideNode) + state_->leaves.size() * sizeof(RayLeaf) >= kRandomReadBytes) {
+  if (ordered) {
+    // The index's arena, unless another cast holds it (a concurrent one takes memory of its own).
+    std::unique_lock<std::mutex> lock(state_->cast_arena.mutex, std::try_to_lock);
+    detail::RayCastArena own;
+    detail::RayCastArena& arena = lock.owns_lock() ? state_->cast_arena : own;
     detail::run_with_threads(options.threads, [&] {
-      RayOrder order(rays, state_->wide.nodes()[0]);
-      CastBuffer<CastResult> results(n);
+      RayOrder order(rays, state_->wide.nodes()[0], isa, arena);
       const bool any = options.query == RayQuery::any;
       const WideRaySetup setup = select_wide_ray_setup(isa);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -401,7 +406,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
               caster.prepare(wide, m);
             }
             const PackedRay& p = order.ray(k);
-            CastResult& res = results[k];
+            CastResult& res = order.result(k);
             res.found = false, res.status = RayStatus::invalid_input;
             if (status[lane] == kWideRayInvalid) continue;
             RayContext r;
@@ -417,7 +422,7 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
           }
         }
       });
-      order.scatter(results, out);
+      order.scatter(out);
     });
     return;
   }

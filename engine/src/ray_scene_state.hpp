@@ -6,6 +6,7 @@
 #include "broadphase/aabb_soa.hpp"
 #include "kernels/math.hpp"
 #include "ray_bvh.hpp"
+#include "ray_cast_arena.hpp"
 #include "ray_huge_pages.hpp"
 #include "ray_prepared.hpp"
 #include "ray_wide_bvh.hpp"
@@ -50,6 +51,9 @@ struct RaySceneIndex::State {
   // Read at random by the rays (a leaf each visit): on huge pages when large (ray_huge_pages.hpp).
   std::vector<RayLeaf, detail::HugePageAllocator<RayLeaf>> leaves;  // leaf k = object bvh.leaf_object()[k]
   std::vector<RayObject> halfspaces;  // tested against every ray
+  // The ordered cast's scratch memory, kept from one cast to the next (written by const casts, hence mutable; the
+  // arena's mutex lets one cast at a time use it).
+  mutable detail::RayCastArena cast_arena;
   RaySceneTimings timings;
   bool rebuilt = false;
   bool ready = false;

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <thread>
 #include <vector>
 
 namespace batchcol {
@@ -371,6 +372,52 @@ TEST(RayScene, CastOrderOfLargeBatchesGivesTheSameBits) {
       EXPECT_EQ(whole.status[0], RayStatus::invalid_input);
       EXPECT_EQ(whole.status[5], RayStatus::invalid_input);
     }
+  }
+}
+
+// The ordered cast's memory is the index's, kept from one cast to the next (ray_cast_arena.hpp): what an earlier,
+// larger or different batch left there must not show in a later cast, and casts running at the same time on one index
+// (one holds the memory, the other takes its own) give the bits of casts one after the other.
+TEST(RayScene, ReusedCastMemoryGivesTheSameBits) {
+  Rng rng(17);
+  World w = make_world(rng, 60000, true);
+  const RayBatch big = random_rays(rng, 12000), small = random_rays(rng, 5000);
+  const auto same = [](const RayResults& a, const RayResults& b) {
+    return same_bits(a.status, b.status) && same_bits(a.hit, b.hit) && same_bits(a.t, b.t) &&
+           same_bits(a.normal.x, b.normal.x) && same_bits(a.normal.y, b.normal.y) &&
+           same_bits(a.normal.z, b.normal.z) && same_bits(a.object, b.object);
+  };
+  for (RayQuery q : {RayQuery::closest, RayQuery::any}) {
+    SCOPED_TRACE(to_string(q));
+    RayOptions o;
+    o.query = q;
+    o.threads = 2;
+    const auto fresh = [&](const RayBatch& rays) {
+      RaySceneIndex index;
+      index.update(w.scene, 2);
+      RayResults r;
+      index.cast(rays, o, r);
+      return r;
+    };
+    const RayResults big_fresh = fresh(big), small_fresh = fresh(small);
+    int hits = 0;
+    for (std::uint8_t h : small_fresh.hit) hits += h;
+    EXPECT_GT(hits, 500);
+    RaySceneIndex index;
+    index.update(w.scene, 2);
+    RayResults r;
+    index.cast(big, o, r);
+    EXPECT_TRUE(same(r, big_fresh));
+    index.cast(small, o, r);  // a smaller batch in the larger batch's memory
+    EXPECT_TRUE(same(r, small_fresh));
+    index.cast(big, o, r);
+    EXPECT_TRUE(same(r, big_fresh));
+    RayResults a, b;
+    std::thread other([&] { index.cast(small, o, b); });
+    index.cast(big, o, a);
+    other.join();
+    EXPECT_TRUE(same(a, big_fresh));
+    EXPECT_TRUE(same(b, small_fresh));
   }
 }
 
