@@ -45,9 +45,6 @@ template <class T> struct GjkParams {
   T relative_tolerance = T(0);
   int max_iterations = 128;
   bool boolean_only = false;
-  /// The query goes on to EPA when the cores overlap (QueryLevel::penetration): polytope-ellipsoid pairs then take
-  /// feature Newton steps only at lb > 0 (flat_newton_side() says why).
-  bool penetration = false;
   T core_margin = T(0);            // boolean: the cores collide when their distance is <= core_margin
   bool normalize_momentum = true;  // normalised Nesterov directions (shapes not strictly convex)
   /// |x| at or below this is indistinguishable from 0 in the working precision: the cores touch or overlap and
@@ -107,11 +104,10 @@ constexpr bool polytope_core(ShapeType t) { return t == ShapeType::convex || t =
 /// an edge or vertex step uses lb of the feature's own point, and kNewtonSwitch and the shrink / halving tests
 /// refuse a step whose linearisation is off, as before. Measured (close witness double ellipsoid-convex8, mean
 /// iterations, 20000 bench pairs): 12.55 -> 11.52, err_max 9.88e-9 -> 9.86e-9; distant unchanged (lb > 0 there
-/// from the first iterations). Not at the penetration level (GjkParams::penetration): there the cores mostly
-/// overlap (lb < 0 until GJK proves it), GJK's end simplex is EPA's start, and feature steps at any lb took
-/// overlap penetration ellipsoid-convex8 (5000 bench pairs) from 23.84 to 24.06 mean iterations and err_max
-/// 9.72e-9 -> 9.81e-9, so penetration lanes keep the lb > 0 gate; capsule- and box-ellipsoid unchanged
-/// (1.17 / 20.36). Near lb = 0 the vertex step's
+/// from the first iterations). Overlapping pairs at the penetration level (lb < 0 until GJK proves the overlap)
+/// now take feature steps too: overlap penetration ellipsoid-convex8 (5000 bench pairs) 23.84 -> 24.06 mean
+/// iterations, err_max 9.72e-9 -> 9.81e-9 (within the 1e-8 tolerance; keeping the lb > 0 gate for penetration
+/// lanes is untried); capsule- and box-ellipsoid unchanged (1.17 / 20.36). Near lb = 0 the vertex step's
 /// H + lb I is near singular along n (the ellipsoid's Hessian has n in its kernel): kNewtonSwitch and the
 /// halving test refuse the resulting step. A gate lb > -c |x| instead (c = 0.5 / 2, scalar reference, 2000 pairs): 11.64 /
 /// 11.48 against 11.41 without.

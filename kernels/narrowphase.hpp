@@ -77,7 +77,7 @@ template <class T> T tolerance_floor(T scale) { return T(16) * machine_epsilon<T
 template <class T> struct GjkLimits {
   T radii, scale, floor, tolerance, relative, core_margin, touch;
   int max_iterations;
-  bool boolean_only, penetration;
+  bool boolean_only;
 };
 template <class T>
 GjkLimits<T> gjk_limits(T radius_a, T radius_b, double bounding_a, double bounding_b, double t_norm,
@@ -90,7 +90,6 @@ GjkLimits<T> gjk_limits(T radius_a, T radius_b, double bounding_a, double boundi
   g.relative = T(opt.relative_tolerance);
   g.max_iterations = opt.max_iterations;
   g.boolean_only = opt.level == QueryLevel::boolean;
-  g.penetration = opt.level == QueryLevel::penetration;
   g.core_margin = T(opt.margin) + g.radii;
   g.touch = g.floor;  // 16 ulps of the problem size
   return g;
@@ -111,7 +110,6 @@ void set_gjk_parameters(PairSetup<T>& s, double bounding_a, double bounding_b, d
   params.relative_tolerance = g.relative;
   params.max_iterations = g.max_iterations;
   params.boolean_only = g.boolean_only;
-  params.penetration = g.penetration;
   params.core_margin = g.core_margin;
   params.normalize_momentum = !(s.A.strictly_convex() && s.B.strictly_convex());
   params.touch_tolerance = g.touch;

@@ -628,7 +628,6 @@ template <class T> struct WideGjk {
     V3 x, d_prev, last_s, direction;
     real lower{};
     mask momentum{}, normalize{}, boolean_only{};
-    mask penetration{};  // GjkParams::penetration: polytope-ellipsoid feature steps only at lb > 0
     // Newton directions: `newton` = lanes that may take them (witness / distance lanes of a curved pair type,
     // until a Newton step fails to progress), `newton_next` = the next iteration steps along newton_dir.
     mask newton{}, newton_next{}, newton_steps{};
@@ -956,7 +955,7 @@ template <class T> struct WideGjk {
     SideStart A, B;
     Vec3<T> initial_direction;
     int max_iterations;
-    bool momentum, normalize, boolean_only, penetration;
+    bool momentum, normalize, boolean_only;
     T tolerance, relative, touch, core_margin;
   };
 
@@ -986,7 +985,6 @@ template <class T> struct WideGjk {
     L.momentum[l] = momentum ? -1 : 0;
     L.normalize[l] = normalize ? -1 : 0;
     L.boolean_only[l] = g.boolean_only ? -1 : 0;
-    L.penetration[l] = g.penetration ? -1 : 0;
     L.tolerance[l] = g.tolerance;
     L.relative[l] = g.relative;
     L.touch[l] = g.touch;
@@ -1050,7 +1048,6 @@ template <class T> struct WideGjk {
     q.momentum = solver != Solver::gjk;
     q.normalize = s.params.normalize_momentum;
     q.boolean_only = s.params.boolean_only;
-    q.penetration = s.params.penetration;
     q.tolerance = s.params.tolerance;
     q.relative = s.params.relative_tolerance;
     q.touch = s.params.touch_tolerance;
@@ -1516,17 +1513,15 @@ template <class T> struct WideGjk {
         // Only in Newton runs: computed unconditionally, the masks cost the other pair types ~0.5% (box-cylinder
         // witness double 6134 -> 6168 instructions per pair, AVX2).
         real newton_gap{};
-        mask gap_open{}, read = splat_mask(0), flat_lanes = splat_mask(0);
+        mask gap_open{}, read = splat_mask(0);
         if (newton_live) {
           newton_gap = next_xn - L.lower;
           gap_open = newton_gap > T(kNewtonPlainGap) * tol;
-          // Polytope pairs take feature steps whatever the sign of lb, but penetration lanes only at lb > 0
-          // (flat_newton_side() says why): `flat_lanes`, the lanes whose Newton block runs.
-          if (flat_run) flat_lanes = newton_lanes & (~L.penetration | (lb > zero));
-          read = flat_run ? flat_lanes & gap_open & ~(newton_step & ~(newton_gap <= T(0.5) * L.newton_gap))
+          // Polytope pairs take feature steps whatever the sign of lb (flat_newton_side() says why).
+          read = flat_run ? newton_lanes & gap_open & ~(newton_step & ~(newton_gap <= T(0.5) * L.newton_gap))
                           : newton_lanes & (newton_step | ((lb > zero) & gap_open));
-          if (flat_run && !any(read) && any(flat_lanes))
-            L.newton_gap = select(flat_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
+          if (flat_run && !any(read) && any(newton_lanes))
+            L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
         }
         if (newton_live && any(read)) {
           const V3 n = scale(one / dnorm, d);  // one division (face()'s weights say why)
@@ -1534,7 +1529,7 @@ template <class T> struct WideGjk {
           V3 nd;
           real shrunk;  // the step2 a lane that just took a Newton step must reach to keep them
           if (flat_run) {
-            nd = feature_direction(L, n, sa, sb, flat_lanes, step2);
+            nd = feature_direction(L, n, sa, sb, newton_lanes, step2);
             // Tilted by eps towards x's offset from the line along nd: on a polytope's face or edge (the tie the
             // Newton direction lands on) the support then takes the vertex plain GJK would (the one opposite x's
             // offset), which the simplex needs to settle x along F, while the curved side's support moves by
@@ -1549,7 +1544,7 @@ template <class T> struct WideGjk {
             nd = newton_direction(L, n, sa, sb, r, lb, step2);
             shrunk = T(0.25) * L.newton_step2;
           }
-          const mask valid = flat_run ? ~L.penetration | (lb > zero) : lb > zero;
+          const mask valid = flat_run ? splat_mask(-1) : lb > zero;
           const mask failed = newton_lanes & newton_step & ~(valid & (step2 <= shrunk));
           mask skip = splat_mask(0);  // lanes that take a plain (or momentum) step before the next Newton one
           if (flat_run) {
@@ -1559,7 +1554,7 @@ template <class T> struct WideGjk {
             // (measured, mean iterations: box-ellipsoid 13.0 -> 12.2, ellipsoid-convex8 14.7 -> 13.3). Near the
             // optimum (step2 ~ eps^2, the tilt) only the certified gap tells progress: it must halve per Newton step.
             skip = failed | (newton_lanes & newton_step & ~(newton_gap <= T(0.5) * L.newton_gap));
-            L.newton_gap = select(flat_lanes, newton_gap, L.newton_gap);
+            L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);
           } else {
             L.newton &= ~failed;
           }

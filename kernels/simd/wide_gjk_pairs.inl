@@ -157,7 +157,6 @@ template <class T> struct WideGjkPairs {
       L.relative = G::splat(T(options.relative_tolerance));
       L.normalize = G::truth(normalize);
       L.boolean_only = G::truth(options.level == QueryLevel::boolean);
-      L.penetration = G::truth(options.level == QueryLevel::penetration);
       L.rim_given = rim;
     }
 

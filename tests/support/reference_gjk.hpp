@@ -504,8 +504,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
     d_prev = d;
     last_s = s.w;
     // Newton's direction for the next iteration (wide_gjk.inl: when, and why).
-    // Polytope pairs too whatever the sign of lb, but at the penetration level only at lb > 0 (wide_gjk.inl).
-    if (newton && (!flat_pair || !params.penetration || lb > T(0))) {
+    if (newton) {  // polytope pairs too whatever the sign of lb (wide_gjk.inl)
       const T inv_norm = T(1) / d_norm;
       const Vec3<T> n(inv_norm * d.x(), inv_norm * d.y(), inv_norm * d.z());
       T step2 = T(0);
@@ -524,7 +523,7 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
         nd = newton_direction(D, n, s, res, lb, step2);
         shrunk = T(0.25) * newton_step2;
       }
-      const bool valid = (flat_pair && !params.penetration) || lb > T(0);
+      const bool valid = flat_pair || lb > T(0);
       const bool failed = newton_step && !(valid && step2 <= shrunk);
       bool skip = false;  // flat pairs: a failed step skips one Newton choice instead of ending them
       if (flat_pair) {
