@@ -243,9 +243,8 @@ template <class T> bool side_start(const MinkowskiDifference<T>& D, SupportPoint
 /// where the foot py is not on the surface or px not outside it.
 template <class T>
 bool rim_lateral(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool cone, Vec3<T>& px, Vec3<T>& py) {
-  const Vec3<T> q = wadd(c, wscale(dot3(wsub(Vec3<T>(T(0), T(0), zr), c), b), b));
-  const T inv0 = T(1) / std::sqrt(q.x() * q.x() + q.y() * q.y());
-  T C = q.x() * inv0, S = q.y() * inv0;
+  T C, S;
+  lateral_start(r, zr, c, b, ry, hy, cone, C, S);
   const T kr = T(2) * hy;
   for (int it = 0; it < kRimNewtonSteps; ++it) {
     const Vec3<T> v(r * C - c.x(), r * S - c.y(), zr - c.z());
@@ -258,7 +257,8 @@ bool rim_lateral(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool
       const T ir = T(1) / std::sqrt(dot3(v, v) - vb * vb);
       const T r1 = g * ir, r2 = (h - r1 * r1) * ir;
       const T f1 = kr * r1 + ry * v1b, f2 = kr * r2 + ry * v2b;
-      dt = f2 > T(0) ? -f1 / f2 : T(0);
+      const T den = f2 + (f1 * r1) * ir;
+      dt = den > T(0) ? -f1 / den : T(0);
     } else {
       dt = h > T(0) ? -g / h : T(0);
     }
@@ -283,7 +283,7 @@ bool rim_lateral(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool
 
 /// wide_gjk.inl's rim_candidate() for one pair: the closest valid candidate point of D, only where its direction
 /// separates the cores (false: none). Cylinder / cone pairs: rim_lateral() both ways, round_round() both ways, then
-/// side_slant() (cylinder-cone);
+/// side_slant() (cylinder-cone) or slant_slant() (cone-cone);
 /// a capsule against a cylinder / cone: round_segment() in the round core's frame (reference_rim_rim.hpp).
 template <class T> bool rim_candidate(const MinkowskiDifference<T>& D, SupportPoint<T>& p) {
   const ShapeType ta = D.A->type, tb = D.B->type;
@@ -343,6 +343,10 @@ template <class T> bool rim_candidate(const MinkowskiDifference<T>& D, SupportPo
       Vec3<T> px, py;
       const bool ok = side_slant(a0, a1, b0, b1, ca, a, px, py);
       keep(ok, back(py), back(px));
+    } else if (ta == ShapeType::cone && tb == ShapeType::cone) {
+      Vec3<T> px, py;
+      const bool ok = slant_slant(a0, a1, c, b, b0, b1, px, py);
+      keep(ok, px, py);
     }
   }
   if (!has) return false;

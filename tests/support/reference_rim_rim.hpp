@@ -45,6 +45,31 @@ template <class T> Vec3<T> solid_point(const Vec3<T>& w, const Vec3<T>& c, const
   return add(add(c, scale(zq, b)), scale(f, e));
 }
 
+/// wide_gjk_rim_rim.inl's lateral_start(): rim_lateral()'s start angle (C, S), the best of kEdgeRimSamples angles.
+template <class T>
+void lateral_start(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool cone, T& C, T& S) {
+  const Vec3<T> w(-c.x(), -c.y(), zr - c.z());
+  const T tr = T(2) * r, kr = T(2) * hy;
+  const T twx = tr * w.x(), twy = tr * w.y(), rbx = r * b.x(), rby = r * b.y();
+  const T wb = dot3(w, b), base = dot3(w, w) + r * r;
+  T best = std::numeric_limits<T>::infinity();
+  C = T(1);
+  S = T(0);
+  for (int j = 0; j < kEdgeRimSamples / 2; ++j) {
+    const T cj = T(kEdgeRimCos[j]), sj = T(kEdgeRimSin[j]);
+    const T A = cj * twx + sj * twy, B = cj * rbx + sj * rby;
+    const T up = wb + B, dn = wb - B;
+    const T pp = (base + A) - up * up, pm = (base - A) - dn * dn;
+    T fp = pp, fm = pm;
+    if (cone) {
+      fp = kr * std::sqrt(pp > T(0) ? pp : T(0)) + ry * B;
+      fm = kr * std::sqrt(pm > T(0) ? pm : T(0)) - ry * B;
+    }
+    if (fp < best) best = fp, C = cj, S = sj;
+    if (fm < best) best = fm, C = -cj, S = -sj;
+  }
+}
+
 /// wide_gjk_rim_rim.inl's rim_rim(): X's rim (r, zr) against Y's rim (centre q, axis b, radius ry); false where
 /// py is undefined.
 template <class T>
@@ -136,6 +161,36 @@ bool side_slant(T rc, T hc, T r, T hx, const Vec3<T>& p, const Vec3<T>& d, Vec3<
   const T un = std::sqrt(dot3(u, u));
   py = add(q, scale(rc / un, u));
   return ok && un > rc;
+}
+
+/// wide_gjk_rim_rim.inl's slant_slant(): cone X (r, hx, own frame) against cone Y (c, b, ry, hy) slant to slant;
+/// false where the generators' closest points are not both interior or Y is not beyond X along the normal.
+template <class T>
+bool slant_slant(T r, T hx, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, Vec3<T>& px, Vec3<T>& py) {
+  using namespace rim_ops;
+  const T kx = T(2) * hx, ky = T(2) * hy;
+  const T ax = r / std::sqrt(kx * kx + r * r), ay = ry / std::sqrt(ky * ky + ry * ry);
+  const T beta = b.z(), s2 = T(1) - beta * beta;
+  const T x = (ax + ay * beta) / s2, y = -(ay + ax * beta) / s2;
+  const T z2 = ((T(1) - x * ax) + y * ay) / s2;
+  const T cab = c.y() * b.x() - c.x() * b.y();
+  const T zm = std::sqrt(z2 > T(0) ? z2 : T(0));
+  const T z = cab < T(0) ? -zm : zm;
+  const Vec3<T> n(y * b.x() - z * b.y(), y * b.y() + z * b.x(), x + y * b.z());
+  const T kn = r / std::sqrt(n.x() * n.x() + n.y() * n.y());
+  const Vec3<T> d1(kn * n.x(), kn * n.y(), -kx);
+  const Vec3<T> e = add(n, scale(ay, b));
+  const T ke = ry / std::sqrt(dot3(e, e));
+  const Vec3<T> d2 = sub(scale(-ke, e), scale(ky, b));
+  const Vec3<T> ox(T(0), T(0), hx), oy = add(c, scale(hy, b));
+  const Vec3<T> w0 = sub(ox, oy);
+  const T aa = dot3(d1, d1), bq = dot3(d1, d2), cq = dot3(d2, d2), dd = dot3(d1, w0), ee = dot3(d2, w0);
+  const T denom = aa * cq - bq * bq;
+  const T tau = (bq * ee - cq * dd) / denom, sig = (aa * ee - bq * dd) / denom;
+  px = add(ox, scale(tau, d1));
+  py = add(oy, scale(sig, d2));
+  return s2 > T(0) && z2 > T(0) && tau >= T(0) && tau <= T(1) && sig >= T(0) && sig <= T(1) &&
+         dot3(sub(py, px), n) > T(0);
 }
 
 /// wide_gjk_rim_rim.inl's round_round(): X (own frame) against Y (c, b, ry, hy); keep(ok, px, py).
