@@ -240,6 +240,29 @@ std::pair<Eigen::Vector3d, Eigen::Quaterniond> ellipsoid_touching(Rng& rng, cons
   return {pb + Qm * m / std::sqrt(m.dot(Qm * m)), qe};
 }
 
+/// X placed against Y for the rim / slant start tests: X's feature xf (X's frame) with outward normal nx goes to Y's
+/// point x (Y's frame) moved out by a gap of 1e-5..1e-1 along Y's outward normal m, spun about nx; then both are
+/// posed by one random pose. The random draws in this order: spin, gap, rotation, translation.
+struct FeaturePlacement {
+  Eigen::Matrix3d Rx;      // X's rotation in Y's frame
+  Eigen::Vector3d centre;  // X's origin in Y's frame
+  double gap;
+  Pose pose_x, pose_y;
+};
+FeaturePlacement place_feature(Rng& rng, const Eigen::Vector3d& x, const Eigen::Vector3d& m,
+                               const Eigen::Vector3d& xf, const Eigen::Vector3d& nx) {
+  const Eigen::AngleAxisd spin(testing::uniform(rng, 0, 6.283185307179586), nx);
+  FeaturePlacement f;
+  f.Rx = (Eigen::Quaterniond::FromTwoVectors(nx, -m) * spin).toRotationMatrix();
+  f.gap = std::pow(10.0, testing::uniform(rng, -5, -1));
+  f.centre = x + f.gap * m - f.Rx * xf;
+  const Eigen::Quaterniond Q = testing::random_rotation(rng);
+  const Eigen::Vector3d T = testing::random_vector(rng);
+  f.pose_y = Pose{T, Q};
+  f.pose_x = Pose{T + Q * f.centre, Q * Eigen::Quaterniond(f.Rx)};
+  return f;
+}
+
 }  // namespace
 
 /// Box edge and vertex contacts with an ellipsoid, built with a known gap: the ellipsoid touches the plane through
@@ -408,13 +431,7 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
               xf = Eigen::Vector3d(rx, 0, zx * hx);
               nx = ((1 - mu) * lat_x + mu * zx * ez).normalized();
             }
-            const Eigen::AngleAxisd spin(testing::uniform(rng, 0, two_pi), nx);
-            const Eigen::Matrix3d Rx = (Eigen::Quaterniond::FromTwoVectors(nx, -m) * spin).toRotationMatrix();
-            const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
-            const Eigen::Vector3d centre = x + gap * m - Rx * xf;
-            const Eigen::Quaterniond Q = testing::random_rotation(rng);
-            const Eigen::Vector3d T = testing::random_vector(rng);
-            const Pose pose_y{T, Q}, pose_x{T + Q * centre, Q * Eigen::Quaterniond(Rx)};
+            const auto [Rx, centre, gap, pose_x, pose_y] = place_feature(rng, x, m, xf, nx);
             const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx);
             const Shape sy = ycone ? Shape::cone(ry, hy) : Shape::cylinder(ry, hy);
             SCOPED_TRACE("kind " + std::to_string(kind) + " xcone " + std::to_string(xcone) + " ycone " +
@@ -472,13 +489,7 @@ TEST(WideGjk, ConeRimSlantAndSlantSlantContactsStartNearTheOptimum) {
             xf = Eigen::Vector3d(sx * rx, 0, hx - 2 * hx * sx);
             nx = Eigen::Vector3d(2 * hx, 0, rx).normalized();
           }
-          const Eigen::AngleAxisd spin(testing::uniform(rng, 0, two_pi), nx);
-          const Eigen::Matrix3d Rx = (Eigen::Quaterniond::FromTwoVectors(nx, -m) * spin).toRotationMatrix();
-          const double gap = std::pow(10.0, testing::uniform(rng, -5, -1));
-          const Eigen::Vector3d centre = x + gap * m - Rx * xf;
-          const Eigen::Quaterniond Q = testing::random_rotation(rng);
-          const Eigen::Vector3d T = testing::random_vector(rng);
-          const Pose pose_y{T, Q}, pose_x{T + Q * centre, Q * Eigen::Quaterniond(Rx)};
+          const auto [Rx, centre, gap, pose_x, pose_y] = place_feature(rng, x, m, xf, nx);
           const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx), sy = Shape::cone(ry, hy);
           SCOPED_TRACE("kind " + std::to_string(kind) + " xcone " + std::to_string(xcone) + " swap " +
                        std::to_string(swap) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));

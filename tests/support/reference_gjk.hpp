@@ -390,30 +390,23 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   // closed-form candidate: none could separate the cores (wide_gjk.inl's start(), reference_start_gate.hpp).
   if constexpr (std::is_same_v<T, double>) {
     if (!params.boolean_only && start_candidate_pair(D.A->type, D.B->type) && !cores_overlap(D, first)) {
-      // Rim-lateral pairs (double): the closest rim-lateral point of D.
-      if (rim_start_pair(D.A->type, D.B->type)) {
+      // Each type pair's candidate (double): computed where the pair type has one, kept by take_start().
+      const auto candidate = [&](bool pair, auto&& find) {
+        if (!pair) return;
         SupportPoint<T> p;
-        const bool found = rim_candidate(D, p);
+        const bool found = find(D, p);
         take_start(found, p);
-      }
-      // Box-, capsule- and sphere-ellipsoid pairs (double): the closest face / edge / vertex point of D.
-      if (box_ellipsoid_pair(D.A->type, D.B->type)) {
-        SupportPoint<T> p;
-        const bool found = box_ellipsoid_candidate(D, p);
-        take_start(found, p);
-      }
-      // Box-cylinder / box-cone pairs (double): the closest face / edge / vertex / apex point of D.
-      if (box_round_pair(D.A->type, D.B->type)) {
-        SupportPoint<T> p;
-        const bool found = box_round_candidate(D, p);
-        take_start(found, p);
-      }
-      // Cylinder- / cone-ellipsoid pairs (double): the closest cap / rim / apex / side / slant Newton point of D.
-      if (round_ellipsoid_pair(D.A->type, D.B->type)) {
-        SupportPoint<T> p;
-        const bool found = round_ellipsoid_candidate(D, p);
-        take_start(found, p);
-      }
+      };
+      // Rim-lateral pairs: the closest rim-lateral point of D.
+      candidate(rim_start_pair(D.A->type, D.B->type), [](const auto& d, auto& p) { return rim_candidate(d, p); });
+      // Box-, capsule- and sphere-ellipsoid pairs: the closest face / edge / vertex point of D.
+      candidate(box_ellipsoid_pair(D.A->type, D.B->type),
+                [](const auto& d, auto& p) { return box_ellipsoid_candidate(d, p); });
+      // Box-cylinder / box-cone pairs: the closest face / edge / vertex / apex point of D.
+      candidate(box_round_pair(D.A->type, D.B->type), [](const auto& d, auto& p) { return box_round_candidate(d, p); });
+      // Cylinder- / cone-ellipsoid pairs: the closest cap / rim / apex / side / slant Newton point of D.
+      candidate(round_ellipsoid_pair(D.A->type, D.B->type),
+                [](const auto& d, auto& p) { return round_ellipsoid_candidate(d, p); });
     }
   }
   T lower_bound = -std::numeric_limits<T>::infinity();
