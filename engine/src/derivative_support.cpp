@@ -334,6 +334,32 @@ SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const
   return J;
 }
 
+namespace {
+// The feature of the exposed vertices `mask` (bits in index order, as exposed_feature()'s scans visit them): one
+// vertex, or two (an edge: second - first), need no test; from the third on, a vertex off the line of the first two
+// makes a face (exposed_feature()'s collinearity test, the same expression). On distant convex8 pairs 72% of the
+// sides expose one vertex, 26% two and 2% more (callgrind's branch counts), so the one- and two-bit cases skip the
+// walk's per-bit bookkeeping.
+inline __attribute__((always_inline)) int feature_of_mask(const double* vertices, std::uint32_t mask,
+                                                          Eigen::Vector3d& edge) {
+  const auto vertex = [&](std::size_t k) {
+    return Eigen::Vector3d(vertices[3 * k], vertices[3 * k + 1], vertices[3 * k + 2]);
+  };
+  if ((mask & (mask - 1)) == 0) return 0;  // none (all heights NaN) or one vertex
+  const std::size_t first = std::size_t(__builtin_ctz(mask));
+  mask &= mask - 1;
+  const std::size_t second = std::size_t(__builtin_ctz(mask));
+  mask &= mask - 1;
+  for (; mask != 0; mask &= mask - 1) {
+    const std::size_t k = std::size_t(__builtin_ctz(mask));
+    const Eigen::Vector3d e1 = vertex(second) - vertex(first), e2 = vertex(k) - vertex(first);
+    if (e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm()) return 2;
+  }
+  edge = vertex(second) - vertex(first);
+  return 1;
+}
+}  // namespace
+
 #pragma GCC push_options
 #pragma GCC target("avx2")
 namespace {
@@ -344,8 +370,9 @@ namespace {
 // 128-bit inserts and three shuffles. Returns the bit mask of the vertices whose height is >= max - tolerance
 // (ordered compares: a NaN height is never exposed nor the maximum). Why: the SSE2 pass was two thirds of
 // exposed_feature(), 330 instructions per analytic hull pair for both sides (callgrind, AVX2); with this 197.
-__attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices, std::size_t count,
-                                                          const Eigen::Vector3d& u, double tolerance) {
+inline __attribute__((always_inline)) std::uint32_t exposed_mask_avx2_body(const double* vertices, std::size_t count,
+                                                                           const Eigen::Vector3d& u,
+                                                                           double tolerance) {
   const __m256d ux = _mm256_set1_pd(u.x()), uy = _mm256_set1_pd(u.y()), uz = _mm256_set1_pd(u.z());
   const auto heights = [&](const double* p) {
     const __m256d xy = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_loadu_pd(p + 6), 1);
@@ -397,7 +424,22 @@ __attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices
     if (tail[k - 4 * groups] >= floor) mask |= std::uint32_t{1} << k;
   return mask;
 }
+__attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices, std::size_t count,
+                                                          const Eigen::Vector3d& u, double tolerance) {
+  return exposed_mask_avx2_body(vertices, count, u, tolerance);
+}
 }  // namespace
+// Both hulls of a pair in one call, masks and walks (exposed_feature_pair()): one call and return instead of four,
+// and GCC interleaves the two sides' independent height passes. The walk (feature_of_mask(), SSE2 code inlined
+// here) computes in the same operations and order under VEX encoding (no FMA: only AVX2 is enabled), so its face
+// test and edge have the bits of exposed_feature()'s.
+void exposed_features_avx2(const HullView& a, const HullView& b, const Eigen::Vector3d* u, const double* tolerance,
+                           int* feature, Eigen::Vector3d* edge) {
+  const std::uint32_t mask_a = exposed_mask_avx2_body(a.vertices, a.vertex_count, u[0], tolerance[0]);
+  const std::uint32_t mask_b = exposed_mask_avx2_body(b.vertices, b.vertex_count, u[1], tolerance[1]);
+  feature[0] = feature_of_mask(a.vertices, mask_a, edge[0]);
+  feature[1] = feature_of_mask(b.vertices, mask_b, edge[1]);
+}
 #pragma GCC pop_options
 
 int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,

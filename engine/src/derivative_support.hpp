@@ -58,6 +58,25 @@ constexpr double kExposedFeature = 1e-9;
 int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,
                     Eigen::Vector3d& edge, InstructionSet isa = InstructionSet::scalar);
 
+/// exposed_feature() of both hulls of a pair (a, b; local directions u, tolerances; feature[0] and edge[0] for a,
+/// [1] for b) on AVX2 / AVX-512 for hulls of 4..16 vertices: both height passes and walks in one call of AVX2 code,
+/// the same features and edges (callgrind AVX2, convex8 analytic: 116 + 81 instructions per pair for the masks and
+/// the walks in four calls, 156 in this one).
+void exposed_features_avx2(const HullView& a, const HullView& b, const Eigen::Vector3d* u, const double* tolerance,
+                           int* feature, Eigen::Vector3d* edge);
+
+/// exposed_feature() of both hulls of a pair, through exposed_features_avx2() where it applies.
+inline void exposed_feature_pair(const HullView& a, const HullView& b, const Eigen::Vector3d u[2],
+                                 const double tolerance[2], int feature[2], Eigen::Vector3d edge[2],
+                                 InstructionSet isa) {
+  constexpr std::uint32_t kKept = 16;
+  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count >= 4 &&
+      a.vertex_count <= kKept && b.vertex_count >= 4 && b.vertex_count <= kKept)
+    return exposed_features_avx2(a, b, u, tolerance, feature, edge);
+  feature[0] = exposed_feature(a.vertices, a.vertex_count, u[0], tolerance[0], edge[0], isa);
+  feature[1] = exposed_feature(b.vertices, b.vertex_count, u[1], tolerance[1], edge[1], isa);
+}
+
 /// support_jacobian() of a hull without inflation (s.type == convex, s.inflation == 0) against a polytope, from
 /// the vertices n exposes (kExposedFeature) instead of the face planes through the witness: a scan of the
 /// vertices (2 dot products each) instead of every face's plane test.

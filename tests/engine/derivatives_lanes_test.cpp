@@ -140,5 +140,59 @@ TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
   EXPECT_EQ(mismatches, 0);
 }
 
+// exposed_feature_pair() (both hulls' height passes and walks in one AVX2 call on the wide sets) must find the
+// features and edges exposed_feature() finds side by side on the baseline: hulls of 4..16 vertices on a coarse
+// integer grid (so that directions along the axes and diagonals tie exactly: vertices, edges, faces, and three or
+// more collinear exposed vertices), and random directions.
+TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
+  std::mt19937_64 rng(20261128);
+  std::uniform_int_distribution<int> grid(-2, 2), size(4, 16), pick(0, 3);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0);
+  const auto hull = [&] {
+    std::vector<double> v(3 * std::size_t(size(rng)));
+    for (double& c : v) c = 0.5 * grid(rng);
+    return v;
+  };
+  const auto direction = [&] {
+    Eigen::Vector3d u = pick(rng) == 0 ? Eigen::Vector3d(coefficient(rng), coefficient(rng), coefficient(rng))
+                                       : Eigen::Vector3d(grid(rng), grid(rng), grid(rng));
+    if (u.isZero()) u = Eigen::Vector3d::UnitZ();
+    return u.normalized();
+  };
+  const auto view = [](const std::vector<double>& v) {
+    HullView h;
+    h.vertices = v.data();
+    h.vertex_count = std::uint32_t(v.size() / 3);
+    return h;
+  };
+  int mismatches = 0, features[3] = {0, 0, 0};
+  for (int trial = 0; trial < 20000; ++trial) {
+    const std::vector<double> va = hull(), vb = hull();
+    const Eigen::Vector3d u[2] = {direction(), direction()};
+    const double tolerance[2] = {1e-9, 1e-9};
+    int want[2];
+    Eigen::Vector3d want_edge[2];
+    want[0] = detail::exposed_feature(va.data(), va.size() / 3, u[0], tolerance[0], want_edge[0]);
+    want[1] = detail::exposed_feature(vb.data(), vb.size() / 3, u[1], tolerance[1], want_edge[1]);
+    ++features[want[0]], ++features[want[1]];
+    for (const auto isa : vector_isas_here()) {
+      int got[2];
+      Eigen::Vector3d edge[2];
+      detail::exposed_feature_pair(view(va), view(vb), u, tolerance, got, edge, isa);
+      for (int s = 0; s < 2; ++s) {
+        const bool ok = got[s] == want[s] &&
+                        (want[s] != 1 || std::memcmp(edge[s].data(), want_edge[s].data(), 3 * sizeof(double)) == 0);
+        if (!ok && ++mismatches <= 3)
+          ADD_FAILURE() << "trial " << trial << " side " << s << " " << to_string(isa) << ": feature " << got[s]
+                        << " vs " << want[s];
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  // The grid ties vertices along the axes and diagonals: each kind of feature must be common (not a test of one).
+  std::printf("sides: %d vertices, %d edges, %d faces\n", features[0], features[1], features[2]);
+  for (int f = 0; f < 3; ++f) EXPECT_GT(features[f], 2000) << "feature " << f;
+}
+
 }  // namespace
 }  // namespace batchcol::testing
