@@ -189,9 +189,10 @@ TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
     }
   }
   EXPECT_EQ(mismatches, 0);
-  // The grid ties vertices along the axes and diagonals: each kind of feature must be common (not a test of one).
+  // The grid ties vertices along the axes and diagonals: each kind of feature must be common, so that the test is
+  // one of edges and faces too (this seed: 30693 vertices, 7289 edges, 2018 faces of 40000 sides).
   std::printf("sides: %d vertices, %d edges, %d faces\n", features[0], features[1], features[2]);
-  for (int f = 0; f < 3; ++f) EXPECT_GT(features[f], 2000) << "feature " << f;
+  for (int f = 0; f < 3; ++f) EXPECT_GT(features[f], 1000) << "feature " << f;
 }
 
 }  // namespace
