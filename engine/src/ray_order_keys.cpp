@@ -1,4 +1,5 @@
-// The ordered cast's Morton key (ray_order_keys.hpp), per ray and in lanes.
+// The ordered cast's Morton key (ray_order_keys.hpp) in lanes; the one-ray reference is the tests'
+// (tests/support/ray_order_key_reference.hpp).
 #include "ray_order_keys.hpp"
 
 #include <immintrin.h>
@@ -63,28 +64,6 @@ RayOrderBox ray_order_box(const WideNode& root) {
     box.scale[k] = extent > 0.0 && std::isfinite(extent) ? 32.0 / extent : 0.0;
   }
   return box;
-}
-
-std::uint32_t ray_order_key(const RayBatch& rays, std::size_t i, const RayOrderBox& box) {
-  if (!ray_is_valid(rays, i)) return kRayOrderMissKey;
-  const double o[3] = {rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]};
-  const double d[3] = {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]};
-  double t0 = 0.0, t1 = rays.t_max[i];
-  for (int k = 0; k < 3; ++k) {
-    const double inv = 1.0 / d[k], a = (box.lo[k] - o[k]) * inv, b = (box.hi[k] - o[k]) * inv;
-    t0 = std::max(t0, std::min(a, b));  // NaN (origin on a plane of a flat axis)
-                                        // is dropped by min / max
-    t1 = std::min(t1, std::max(a, b));
-  }
-  if (!(t0 <= t1)) return kRayOrderMissKey;
-  const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  const auto q = [](double x) { return static_cast<std::uint32_t>(std::min(31.0, std::max(0.0, x))); };
-  std::uint32_t code = 0;
-  for (int k = 0; k < 3; ++k) {
-    code |= spread6(q((o[k] + t0 * d[k] - box.lo[k]) * box.scale[k])) << (5 - k);
-    code |= spread6(q((d[k] / len + 1.0) * 16.0)) << (2 - k);
-  }
-  return code;
 }
 
 void ray_order_keys(const RayBatch& rays, std::size_t begin, std::size_t n, const RayOrderBox& box, std::uint32_t* keys,

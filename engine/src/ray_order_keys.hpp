@@ -23,11 +23,10 @@ struct RayOrderBox {
 };
 RayOrderBox ray_order_box(const WideNode& root);
 
-/// The key of ray i, one ray at a time: the reference the lanes below are tested against.
-std::uint32_t ray_order_key(const RayBatch& rays, std::size_t i, const RayOrderBox& box);
-/// keys[l] = ray_order_key(rays, begin + l, box) for l < n, bitwise, 4 rays per vector (the same IEEE operations lane
-/// by lane, the data-dependent choices as masks): the scalar key cost ~229 instructions a ray (AVX2 callgrind, 10k
-/// hulls), mostly its divisions and branches on random data. isa (ray_isa_index(): 0 baseline, >= 1 AVX2 when the
+/// keys[l] = the key of ray begin + l for l < n, 4 rays per vector (the key's IEEE operations lane by lane, the
+/// data-dependent choices as masks; tests/support/ray_order_key_reference.hpp is the one-ray form they are tested
+/// against): a scalar key cost ~229 instructions a ray (AVX2 callgrind, 10k hulls), mostly its divisions and branches
+/// on random data. isa (ray_isa_index(): 0 baseline, >= 1 AVX2 when the
 /// processor has it) picks the lanes' instruction set; every set gives the same bits.
 void ray_order_keys(const RayBatch& rays, std::size_t begin, std::size_t n, const RayOrderBox& box, std::uint32_t* keys,
                     int isa);

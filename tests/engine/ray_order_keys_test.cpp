@@ -1,8 +1,9 @@
-// The ordered cast's sort key (engine/src/ray_order_keys.hpp): the lanes give the scalar key's bits for every ray, the
-// special ones included (invalid, missing the box, starting inside it, zero direction components, origins on a slab
-// plane, a flat box), at every offset and group length, on the baseline and AVX2; the box is the union of the root's
-// used children.
+// The ordered cast's sort key (engine/src/ray_order_keys.hpp): the lanes give the one-ray reference's bits
+// (tests/support/ray_order_key_reference.hpp) for every ray, the special ones included (invalid, missing the box,
+// starting inside it, zero direction components, origins on a slab plane, a flat box), at every offset and group
+// length, on the baseline and AVX2; the box is the union of the root's used children.
 #include "engine/src/ray_order_keys.hpp"
+#include "support/ray_order_key_reference.hpp"
 
 #include <gtest/gtest.h>
 
@@ -73,7 +74,7 @@ void expect_lanes_match(const RayBatch& rays, const RayOrderBox& box) {
         keys.assign(keys.size(), 0xdeadbeefu);
         ray_order_keys(rays, begin, n, box, keys.data(), isa);
         for (std::size_t l = 0; l < n; ++l) {
-          const std::uint32_t expected = ray_order_key(rays, begin + l, box);
+          const std::uint32_t expected = testing::ray_order_key_reference(rays, begin + l, box);
           ASSERT_EQ(keys[l], expected) << "ray " << begin + l << " of " << n << " from " << begin << ", isa " << isa;
           (expected == kRayOrderMissKey ? misses : others) += 1;
         }
@@ -91,7 +92,7 @@ TEST(RayOrderKeys, LanesGiveTheScalarKey) {
   expect_lanes_match(rays, box_of(lo, hi));
   // Invalid rays take the miss key whatever their numbers give.
   for (std::size_t i = 1; i < rays.size(); i += 23)
-    EXPECT_EQ(ray_order_key(rays, i, box_of(lo, hi)), kRayOrderMissKey) << i;
+    EXPECT_EQ(testing::ray_order_key_reference(rays, i, box_of(lo, hi)), kRayOrderMissKey) << i;
 }
 
 TEST(RayOrderKeys, FlatBoxGivesTheScalarKey) {
@@ -117,7 +118,7 @@ TEST(RayOrderKeys, KeyInterleavesTheSixCoordinates) {
     expected |= ((16u >> b) & 1u) << (6 * b + 1);  // direction y
     expected |= ((16u >> b) & 1u) << (6 * b + 0);  // direction z
   }
-  EXPECT_EQ(ray_order_key(rays, 0, box), expected);
+  EXPECT_EQ(testing::ray_order_key_reference(rays, 0, box), expected);
   for (int isa : {0, 1}) {
     std::uint32_t lanes = 0;
     ray_order_keys(rays, 0, 1, box, &lanes, isa);
