@@ -46,29 +46,50 @@ AI static V3 solid_point(const V3& w, const V3& c, const V3& b, real ry, real hy
 /// has two minima on the circle, as a line's distance, and from the axis point nearest to the rim's centre Newton
 /// found the far one on many contacts: close witness double (20000 pairs, 7c8cd99 + rr) cylinder-cone's rim-slant
 /// contacts took 8.1 mean iterations (74% of the row's), cone-cone's rim-slant / slant-rim 7.2 / 5.9,
-/// cylinder-cylinder's rim-side / side-rim 3.3 / 2.3. So (C, S) is the best of kEdgeRimSamples angles (rim_rim()'s
-/// shared products: with w = (0, 0, zr) - c and m = (cos, sin, 0), |v|^2 = |w|^2 + r^2 +- 2 r <w, m> and <v, b> =
-/// <w, b> +- r <m, b> for m and -m; a cone's constant ry <w, b> is left out).
+/// cylinder-cylinder's rim-side / side-rim 3.3 / 2.3. So (C, S) is the best of a few sampled angles. With w = (0,
+/// 0, zr) - c and m = (cos, sin, 0), phi(m) = K + D1 - B^2: K = |w|^2 + r^2 - <w, b>^2, D1 = 2 r <w - <w, b> b, m>,
+/// B = r <m, b>, and the opposite angle -m flips the signs of D1 and B only (a cone's constant ry <w, b> is left
+/// out). A cylinder's better of m and -m is then -|D1| - B^2: one compare and four selects per pair of angles
+/// instead of two and six, as the samples cost more than they saved on distant pairs, which took ~1.1 iterations
+/// already (distant witness double cylinder-cylinder +4.7% instructions, callgrind AVX2). The same choices as
+/// the old form's on the bench's pairs (the scalar reference's iterations identical); 8 angles instead of
+/// kEdgeRimSamples took close cylinder-cylinder 1.30 -> 1.40 mean iterations
+/// (bench/results/history/narrowphase-sessions.md, cone and cyl).
 AI static void lateral_start(real r, real zr, const V3& c, const V3& b, real ry, real hy, bool cone, real& C,
                              real& S) {
   const real zero = splat(T(0)), one = splat(T(1));
   const V3 w = {-c.x, -c.y, zr - c.z};
   const real tr = T(2) * r, kr = T(2) * hy;
-  const real twx = tr * w.x, twy = tr * w.y, rbx = r * b.x, rby = r * b.y;
-  const real wb = dot(w, b), base = norm2(w) + r * r;
+  const real wb = dot(w, b);
+  const real dx = tr * (w.x - wb * b.x), dy = tr * (w.y - wb * b.y), rbx = r * b.x, rby = r * b.y;
+  if (!cone) {  // maximise |D1| + B^2 over the sampled pairs of angles, then take the sign that makes D1 negative
+    real best = splat(-std::numeric_limits<T>::infinity()), Cb = one, Sb = zero, Db = zero;
+    for (int j = 0; j < kEdgeRimSamples / 2; ++j) {
+      const real cj = splat(T(kEdgeRimCos[j])), sj = splat(T(kEdgeRimSin[j]));
+      const real D1 = cj * dx + sj * dy, B = cj * rbx + sj * rby;
+      const real g = wmax(D1, -D1) + B * B;
+      const mask take = g > best;
+      best = select(take, g, best);
+      Cb = select(take, cj, Cb);
+      Sb = select(take, sj, Sb);
+      Db = select(take, D1, Db);
+    }
+    const mask flip = Db > zero;
+    C = select(flip, -Cb, Cb);
+    S = select(flip, -Sb, Sb);
+    return;
+  }
+  const real K = (norm2(w) + r * r) - wb * wb;
   real best = splat(std::numeric_limits<T>::infinity());
   C = one;
   S = zero;
   for (int j = 0; j < kEdgeRimSamples / 2; ++j) {
     const real cj = splat(T(kEdgeRimCos[j])), sj = splat(T(kEdgeRimSin[j]));
-    const real A = cj * twx + sj * twy, B = cj * rbx + sj * rby;
-    const real up = wb + B, dn = wb - B;
-    const real pp = (base + A) - up * up, pm = (base - A) - dn * dn;
-    real fp = pp, fm = pm;
-    if (cone) {
-      fp = kr * wsqrt<T>(select(pp > zero, pp, zero)) + ry * B;
-      fm = kr * wsqrt<T>(select(pm > zero, pm, zero)) - ry * B;
-    }
+    const real D1 = cj * dx + sj * dy, B = cj * rbx + sj * rby;
+    const real t0 = K - B * B;
+    const real pp = t0 + D1, pm = t0 - D1;
+    const real fp = kr * wsqrt<T>(select(pp > zero, pp, zero)) + ry * B;
+    const real fm = kr * wsqrt<T>(select(pm > zero, pm, zero)) - ry * B;
     mask take = fp < best;
     best = select(take, fp, best);
     C = select(take, cj, C);

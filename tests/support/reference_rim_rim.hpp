@@ -45,26 +45,38 @@ template <class T> Vec3<T> solid_point(const Vec3<T>& w, const Vec3<T>& c, const
   return add(add(c, scale(zq, b)), scale(f, e));
 }
 
-/// wide_gjk_rim_rim.inl's lateral_start(): rim_lateral()'s start angle (C, S), the best of kEdgeRimSamples angles.
+/// wide_gjk_rim_rim.inl's lateral_start(): rim_lateral()'s start angle (C, S), the best of a few sampled angles
+/// (kEdgeRimSamples; a cylinder's in the -|D1| - B^2 form).
 template <class T>
 void lateral_start(T r, T zr, const Vec3<T>& c, const Vec3<T>& b, T ry, T hy, bool cone, T& C, T& S) {
   const Vec3<T> w(-c.x(), -c.y(), zr - c.z());
   const T tr = T(2) * r, kr = T(2) * hy;
-  const T twx = tr * w.x(), twy = tr * w.y(), rbx = r * b.x(), rby = r * b.y();
-  const T wb = dot3(w, b), base = dot3(w, w) + r * r;
+  const T wb = dot3(w, b);
+  const T dx = tr * (w.x() - wb * b.x()), dy = tr * (w.y() - wb * b.y()), rbx = r * b.x(), rby = r * b.y();
+  if (!cone) {
+    T best = -std::numeric_limits<T>::infinity(), Cb = T(1), Sb = T(0), Db = T(0);
+    for (int j = 0; j < kEdgeRimSamples / 2; ++j) {
+      const T cj = T(kEdgeRimCos[j]), sj = T(kEdgeRimSin[j]);
+      const T D1 = cj * dx + sj * dy, B = cj * rbx + sj * rby;
+      const T g = (D1 < -D1 ? -D1 : D1) + B * B;  // wmax(D1, -D1)
+      if (g > best) best = g, Cb = cj, Sb = sj, Db = D1;
+    }
+    const bool flip = Db > T(0);
+    C = flip ? -Cb : Cb;
+    S = flip ? -Sb : Sb;
+    return;
+  }
+  const T K = (dot3(w, w) + r * r) - wb * wb;
   T best = std::numeric_limits<T>::infinity();
   C = T(1);
   S = T(0);
   for (int j = 0; j < kEdgeRimSamples / 2; ++j) {
     const T cj = T(kEdgeRimCos[j]), sj = T(kEdgeRimSin[j]);
-    const T A = cj * twx + sj * twy, B = cj * rbx + sj * rby;
-    const T up = wb + B, dn = wb - B;
-    const T pp = (base + A) - up * up, pm = (base - A) - dn * dn;
-    T fp = pp, fm = pm;
-    if (cone) {
-      fp = kr * std::sqrt(pp > T(0) ? pp : T(0)) + ry * B;
-      fm = kr * std::sqrt(pm > T(0) ? pm : T(0)) - ry * B;
-    }
+    const T D1 = cj * dx + sj * dy, B = cj * rbx + sj * rby;
+    const T t0 = K - B * B;
+    const T pp = t0 + D1, pm = t0 - D1;
+    const T fp = kr * std::sqrt(pp > T(0) ? pp : T(0)) + ry * B;
+    const T fm = kr * std::sqrt(pm > T(0) ? pm : T(0)) - ry * B;
     if (fp < best) best = fp, C = cj, S = sj;
     if (fm < best) best = fm, C = -cj, S = -sj;
   }
