@@ -424,11 +424,29 @@ template <class T> struct WideGjk {
     real lambda[3];
     mask use, via_i, via_j;
   };
-  AI static Face face(const V3& qi, const V3& qj, const V3& qk) {
+  /// The face's normal comes from the caller: n = (qi - qk) x (qj - qk), nn = |n|^2, t = <qk, n> / nn (the
+  /// origin's projection on the plane is t n). project() computes them for every face keeping s anyway (the
+  /// tetrahedron's visibility rule and its signed volumes), so the face does not compute them again.
+  struct Plane {
+    V3 n;
+    real nn, sn, t;
+  };
+  static Plane plane(const V3& qi, const V3& qj, const V3& qk) {
+    Plane h;
+    h.n = cross(sub(qi, qk), sub(qj, qk));
+    h.nn = norm2(h.n);
+    h.sn = dot(qk, h.n);
+    h.t = h.sn / h.nn;
+    return h;
+  }
+  AI static Plane pick(mask m, const Plane& a, const Plane& b) {
+    return {pick(m, a.n, b.n), select(m, a.nn, b.nn), select(m, a.sn, b.sn), select(m, a.t, b.t)};
+  }
+  AI static Face face(const V3& qi, const V3& qj, const V3& qk, const Plane& h) {
     const real zero = splat(T(0));
-    const V3 n = cross(sub(qj, qi), sub(qk, qi));
-    const real nn = norm2(n);
-    const V3 p0 = scale(dot(qi, n) / nn, n);
+    const V3& n = h.n;
+    const real nn = h.nn;
+    const V3 p0 = scale(h.t, n);
     const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
     const mask d1 = ay > ax;
     const mask d2 = az > select(d1, ay, ax);
@@ -475,10 +493,10 @@ template <class T> struct WideGjk {
 
   /// Face m of tetrahedron p[0..2], s that keeps s (vertex 3), per lane (m = 0: old vertices 1, 2; m = 1: 0, 2;
   /// m = 2: 0, 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
-  AI static Face face_keeping_3(const V3* p, const V3& s, mask m0, mask m2, mask& i, mask& j) {
+  AI static Face face_keeping_3(const V3* p, const V3& s, const Plane* h, mask m0, mask m2, mask& i, mask& j) {
     i = select(m0, splat_mask(1), splat_mask(0));
     j = select(m2, splat_mask(1), splat_mask(2));
-    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), s);
+    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), s, pick(m0, h[0], pick(m2, h[2], h[1])));
   }
 
   /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
@@ -514,22 +532,27 @@ template <class T> struct WideGjk {
     // face m omits vertex m), and the visible face whose plane is farthest from the origin (the reference's rule,
     // same arithmetic): where the origin's projection lies inside that face, it is the answer, in one face instead
     // of one round per visible face (on smooth shapes the origin sees all three new faces of a flat tent).
+    // The planes of the faces keeping s (face m omits old vertex m): n_m = (p_I - s) x (p_J - s). Face 2 (p0 p1 s)
+    // is also the triangle lanes' face; the tetrahedron lanes need all three. Their <s, n_m> are the signed
+    // volumes V[0], -V[1], V[2] (the triple product <s, (p_I - s) x (p_J - s)> = <s, p_I x p_J>), so three of the
+    // four determinants are not computed again, and the face() call takes its plane from here.
+    Plane h[3];
+    h[2] = plane(p[0], p[1], s);
+    h[0] = h[1] = h[2];
     real V[4] = {zero, zero, zero, zero}, total = zero;
     mask inside = splat_mask(0), have_first = splat_mask(0), first_0 = splat_mask(0), first_2 = splat_mask(0);
     mask cand[3] = {splat_mask(0), splat_mask(0), splat_mask(0)};
     if (any(four)) {
-      V[0] = det3(p[1], p[2], s), V[1] = -det3(p[0], p[2], s), V[2] = det3(p[0], p[1], s), V[3] = -det3(p[0], p[1], p[2]);
+      h[0] = plane(p[1], p[2], s), h[1] = plane(p[0], p[2], s);
+      V[0] = h[0].sn, V[1] = -h[1].sn, V[2] = h[2].sn, V[3] = -det3(p[0], p[1], p[2]);
       total = ((V[0] + V[1]) + V[2]) + V[3];
       inside = four & (total != zero);
       for (int m = 0; m < 4; ++m) inside &= ~opposite_sign(V[m], total);
       for (int m = 0; m < 3; ++m) cand[m] = four & ~inside & ((total == zero) | opposite_sign(V[m], total));
-      const int I[3] = {1, 0, 0}, J[3] = {2, 2, 1};
       real far = zero;
       mask choice = splat_mask(0);
       for (int m = 0; m < 3; ++m) {
-        const V3 n = cross(sub(p[I[m]], s), sub(p[J[m]], s));
-        const real nn = norm2(n), sn = dot(s, n);
-        const real q = select(nn > zero, sn * (sn / nn), splat(T(-1)));
+        const real q = select(h[m].nn > zero, h[m].sn * h[m].t, splat(T(-1)));
         const mask take = cand[m] & (~have_first | (q > far));
         far = select(take, q, far);
         choice = select(take, splat_mask(m), choice);
@@ -542,7 +565,9 @@ template <class T> struct WideGjk {
     const mask fi = select(first_0, splat_mask(1), splat_mask(0));
     const mask fj = select(three, splat_mask(1), select(first_2, splat_mask(1), splat_mask(2)));
     // Computed whatever the lanes (only segment lanes is rare): no branch, and no default value to write first.
-    const Face f = face(pick(first_0, p[1], p[0]), pick(three, p[1], pick(first_2, p[1], p[2])), s);
+    const mask first_1 = have_first & ~first_0 & ~first_2;
+    const Face f = face(pick(first_0, p[1], p[0]), pick(three, p[1], pick(first_2, p[1], p[2])), s,
+                        pick(first_0, h[0], pick(first_1, h[1], h[2])));
     const mask first_ok = have_first & f.use;
     // Edges to the new vertex (input indices k and 3), where some lane's answer may be one.
     const mask tri_edges = three & ~f.use, rest = four & ~inside & ~first_ok;
@@ -570,7 +595,7 @@ template <class T> struct WideGjk {
         if (!any(round)) break;
         // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
         mask i, j;
-        const Face g = face_keeping_3(p, s, taken[0], taken[2], i, j);
+        const Face g = face_keeping_3(p, s, h, taken[0], taken[2], i, j);
         const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
         const mask to_j = takes_j(g, ni, nj);
         const real n2 = select(g.use, norm2(g.x), select(to_j, nj, ni));

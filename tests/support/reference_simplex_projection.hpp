@@ -63,13 +63,15 @@ template <class T> bool opposite_sign(T a, T b) { return (a > T(0) && b < T(0)) 
 /// keep k. (Edge i-j and the old vertices belong to the previous simplex, whose closest point x GJK already has:
 /// they cannot bring |x| down, so GJK never needs them.) Edges are oriented old -> new and visited i-k, then j-k.
 template <class T> SimplexProjection<T> triangle(const Vec3<T>* p, int i, int j, int k) {
-  const Vec3<T> n = cross3<T>(p[j] - p[i], p[k] - p[i]);
+  // The normal from the edges at the newest vertex, (p_i - p_k) x (p_j - p_k): the tetrahedron's faces keeping
+  // vertex 3 use the same products for their visibility rule and signed volumes (wide_gjk.inl's Plane).
+  const Vec3<T> n = cross3<T>(p[i] - p[k], p[j] - p[k]);
   const T nn = norm2(n);
   const auto edges = [&] { return closer(segment(p, i, k), segment(p, j, k)); };
   if (nn == T(0)) return edges();  // collinear: the closest point lies on an edge
   // Origin projected on the triangle's plane, then 2D signed areas on the coordinate plane where the triangle's
   // projection is largest (drop the axis of the largest |n| component: best conditioned).
-  const Vec3<T> p0 = n * (dot3(p[i], n) / nn);
+  const Vec3<T> p0 = n * (dot3(p[k], n) / nn);
   int drop = 0;
   if (std::abs(n.y()) > std::abs(n[drop])) drop = 1;
   if (std::abs(n.z()) > std::abs(n[drop])) drop = 2;
@@ -106,8 +108,16 @@ template <class T> T det3(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) 
 /// is closer than GJK's current x: the result is "no candidate" (x infinite, count 0).
 template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   // V[m] = signed volume of the tetrahedron with vertex m replaced by the origin; their sum is the full volume.
-  const std::array<T, 4> V = {det3(p[1], p[2], p[3]), -det3(p[0], p[2], p[3]), det3(p[0], p[1], p[3]),
-                              -det3(p[0], p[1], p[2])};
+  // For m < 3 it is the triple product <p3, (p_I - p3) x (p_J - p3)> (= <p3, p_I x p_J>, up to the sign) with the
+  // normal n_m of face m, which the visibility rule below and triangle() compute in the same way.
+  const std::array<std::array<int, 2>, 3> old = {{{1, 2}, {0, 2}, {0, 1}}};
+  std::array<Vec3<T>, 3> n;
+  std::array<T, 3> sn;
+  for (int m = 0; m < 3; ++m) {
+    n[m] = cross3<T>(p[old[m][0]] - p[3], p[old[m][1]] - p[3]);
+    sn[m] = dot3(p[3], n[m]);
+  }
+  const std::array<T, 4> V = {sn[0], -sn[1], sn[2], -det3(p[0], p[1], p[2])};
   const T total = V[0] + V[1] + V[2] + V[3];
   bool inside = total != T(0);
   for (T vm : V) inside = inside && !opposite_sign(vm, total);
@@ -121,7 +131,6 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   }
   // Outside (or flat): faces m = 0, 1, 2 (face m omits vertex m) that the origin sees, i.e. whose opposite weight
   // has the wrong sign; a flat tetrahedron (total == 0) has no orientation, so all three are candidates.
-  const std::array<std::array<int, 2>, 3> old = {{{1, 2}, {0, 2}, {0, 1}}};
   const auto candidate = [&](int m) { return total == T(0) || opposite_sign(V[m], total); };
   // First the visible face whose plane is farthest from the origin (squared distance s (s / nn), the first of
   // equal ones): when the origin's projection on it lies inside it, it is the answer, since the plane of a face
@@ -131,8 +140,7 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
   T far = T(0);
   for (int m = 0; m < 3; ++m) {
     if (!candidate(m)) continue;
-    const Vec3<T> n = cross3<T>(p[old[m][0]] - p[3], p[old[m][1]] - p[3]);
-    const T nn = norm2(n), s = dot3(p[3], n);
+    const T nn = norm2(n[m]), s = sn[m];
     const T q = nn > T(0) ? s * (s / nn) : T(-1);
     if (first < 0 || q > far) first = m, far = q;
   }
