@@ -15,6 +15,7 @@
 #include <cstring>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -263,6 +264,38 @@ FeaturePlacement place_feature(Rng& rng, const Eigen::Vector3d& x, const Eigen::
   return f;
 }
 
+/// The pair (X, Y) placed by place_feature() as the lanes see it: A first in run()'s order (Y when swap), B's pose in
+/// A's frame; the shapes are kept in `keep` (the set-up's cores point into them). Empty when the set-up answers alone.
+std::optional<kernels::PairSetup<double>> placed_setup(std::deque<OwnedShapeView>& keep, const Shape& sx,
+                                                       const Shape& sy, const FeaturePlacement& f, bool swap,
+                                                       const QueryOptions& opt) {
+  kernels::RelativePose X;
+  X.R = swap ? f.Rx : Eigen::Matrix3d(f.Rx.transpose());
+  X.t = swap ? f.centre : Eigen::Vector3d(-(f.Rx.transpose() * f.centre));
+  keep.emplace_back(swap ? sy : sx);
+  const ShapeView& a = keep.back().view;
+  keep.emplace_back(swap ? sx : sy);
+  const ShapeView& b = keep.back().view;
+  const kernels::PairSetup<double> s =
+      kernels::setup_pair<double>(a, b, X, Eigen::Vector3d::Constant(std::nan("")), opt);
+  if (s.done) return std::nullopt;
+  return s;
+}
+
+/// The lanes of every instruction set this CPU runs against the scalar reference on `setups`, bit for bit; counts the
+/// comparisons in `compared`.
+void expect_lanes_equal_reference(const std::vector<kernels::PairSetup<double>>& setups, int& compared,
+                                  const std::string& label) {
+  std::vector<kernels::GjkResult<double>> want;
+  for (const auto& s : setups) want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
+  for (const InstructionSet isa : runnable_sets()) {
+    std::vector<kernels::GjkResult<double>> got(setups.size());
+    kernels::simd::gjk_lanes<double>(isa, setups.data(), setups.size(), got.data(), Solver::gjk);
+    for (std::size_t i = 0; i < setups.size(); ++i, ++compared)
+      ASSERT_EQ(compare(want[i], got[i]), "") << label << " pair " << i << " isa " << to_string(isa);
+  }
+}
+
 }  // namespace
 
 /// Box edge and vertex contacts with an ellipsoid, built with a known gap: the ellipsoid touches the plane through
@@ -489,33 +522,17 @@ TEST(WideGjk, ConeRimSlantAndSlantSlantContactsStartNearTheOptimum) {
             xf = Eigen::Vector3d(sx * rx, 0, hx - 2 * hx * sx);
             nx = Eigen::Vector3d(2 * hx, 0, rx).normalized();
           }
-          const auto [Rx, centre, gap, pose_x, pose_y] = place_feature(rng, x, m, xf, nx);
+          const FeaturePlacement f = place_feature(rng, x, m, xf, nx);
           const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx), sy = Shape::cone(ry, hy);
           SCOPED_TRACE("kind " + std::to_string(kind) + " xcone " + std::to_string(xcone) + " swap " +
-                       std::to_string(swap) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));
-          tally.run(sx, pose_x, sy, pose_y, swap, opt, gap);
-          // The lanes against the reference on the same pair (A first in run()'s order; B's pose in A's frame).
-          kernels::RelativePose X;
-          X.R = swap ? Rx : Eigen::Matrix3d(Rx.transpose());
-          X.t = swap ? centre : Eigen::Vector3d(-(Rx.transpose() * centre));
-          keep.emplace_back(swap ? sy : sx);
-          const ShapeView& a = keep.back().view;
-          keep.emplace_back(swap ? sx : sy);
-          const ShapeView& b = keep.back().view;
-          const kernels::PairSetup<double> s =
-              kernels::setup_pair<double>(a, b, X, Eigen::Vector3d::Constant(std::nan("")), opt);
-          if (!s.done) setups.push_back(s);
+                       std::to_string(swap) + " trial " + std::to_string(trial) + " gap " + std::to_string(f.gap));
+          tally.run(sx, f.pose_x, sy, f.pose_y, swap, opt, f.gap);
+          if (auto s = placed_setup(keep, sx, sy, f, swap, opt)) setups.push_back(*s);
         }
         ASSERT_EQ(setups.size(), std::size_t(40));
-        std::vector<kernels::GjkResult<double>> want;
-        for (const auto& s : setups) want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
-        for (const InstructionSet isa : runnable_sets()) {
-          std::vector<kernels::GjkResult<double>> got(setups.size());
-          kernels::simd::gjk_lanes<double>(isa, setups.data(), setups.size(), got.data(), Solver::gjk);
-          for (std::size_t i = 0; i < setups.size(); ++i, ++compared)
-            ASSERT_EQ(compare(want[i], got[i]), "") << "kind " << kind << " xcone " << xcone << " swap " << swap
-                                                    << " pair " << i << " isa " << to_string(isa);
-        }
+        expect_lanes_equal_reference(setups, compared, "kind " + std::to_string(kind) + " xcone " +
+                                                           std::to_string(xcone) + " swap " + std::to_string(swap));
+        if (::testing::Test::HasFatalFailure()) return;
       }
     }
   }
@@ -556,33 +573,18 @@ TEST(WideGjk, RimRimContactsStartNearTheOptimumInBothOrders) {
           const Eigen::Vector3d lat_x = xcone ? Eigen::Vector3d(2 * hx, 0, rx).normalized() : Eigen::Vector3d(1, 0, 0);
           const double mu = testing::uniform(rng, 0.1, 0.9);
           const Eigen::Vector3d xf(rx, 0, zx * hx), nx = ((1 - mu) * lat_x + mu * zx * ez).normalized();
-          const auto [Rx, centre, gap, pose_x, pose_y] = place_feature(rng, x, m, xf, nx);
+          const FeaturePlacement f = place_feature(rng, x, m, xf, nx);
           const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx);
           const Shape sy = ycone ? Shape::cone(ry, hy) : Shape::cylinder(ry, hy);
           SCOPED_TRACE("xcone " + std::to_string(xcone) + " ycone " + std::to_string(ycone) + " swap " +
-                       std::to_string(swap) + " trial " + std::to_string(trial) + " gap " + std::to_string(gap));
-          tally.run(sx, pose_x, sy, pose_y, swap, opt, gap);
-          kernels::RelativePose X;  // B's pose in A's frame, A first in run()'s order
-          X.R = swap ? Rx : Eigen::Matrix3d(Rx.transpose());
-          X.t = swap ? centre : Eigen::Vector3d(-(Rx.transpose() * centre));
-          keep.emplace_back(swap ? sy : sx);
-          const ShapeView& a = keep.back().view;
-          keep.emplace_back(swap ? sx : sy);
-          const ShapeView& b = keep.back().view;
-          const kernels::PairSetup<double> s =
-              kernels::setup_pair<double>(a, b, X, Eigen::Vector3d::Constant(std::nan("")), opt);
-          if (!s.done) setups.push_back(s);
+                       std::to_string(swap) + " trial " + std::to_string(trial) + " gap " + std::to_string(f.gap));
+          tally.run(sx, f.pose_x, sy, f.pose_y, swap, opt, f.gap);
+          if (auto s = placed_setup(keep, sx, sy, f, swap, opt)) setups.push_back(*s);
         }
         ASSERT_EQ(setups.size(), std::size_t(60));
-        std::vector<kernels::GjkResult<double>> want;
-        for (const auto& s : setups) want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
-        for (const InstructionSet isa : runnable_sets()) {
-          std::vector<kernels::GjkResult<double>> got(setups.size());
-          kernels::simd::gjk_lanes<double>(isa, setups.data(), setups.size(), got.data(), Solver::gjk);
-          for (std::size_t i = 0; i < setups.size(); ++i, ++compared)
-            ASSERT_EQ(compare(want[i], got[i]), "") << "xcone " << xcone << " ycone " << ycone << " swap " << swap
-                                                    << " pair " << i << " isa " << to_string(isa);
-        }
+        expect_lanes_equal_reference(setups, compared, "xcone " + std::to_string(xcone) + " ycone " +
+                                                           std::to_string(ycone) + " swap " + std::to_string(swap));
+        if (::testing::Test::HasFatalFailure()) return;
       }
     }
   }
