@@ -18,6 +18,8 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace batchcol {
@@ -241,6 +243,31 @@ std::pair<Eigen::Vector3d, Eigen::Quaterniond> ellipsoid_touching(Rng& rng, cons
   return {pb + Qm * m / std::sqrt(m.dot(Qm * m)), qe};
 }
 
+/// Sizes of X and Y (radius, half height: 3-30 cm) and the radial direction of Y's feature for the rim / slant start
+/// tests, drawn in this order: rx, hx, ry, hy, the angle.
+struct RimSizes {
+  double rx, hx, ry, hy;
+  Eigen::Vector3d radial;
+};
+RimSizes draw_rim_sizes(Rng& rng) {
+  RimSizes d;
+  d.rx = testing::uniform(rng, 0.03, 0.3);
+  d.hx = testing::uniform(rng, 0.03, 0.3);
+  d.ry = testing::uniform(rng, 0.03, 0.3);
+  d.hy = testing::uniform(rng, 0.03, 0.3);
+  const double th = testing::uniform(rng, 0, 6.283185307179586);
+  d.radial = Eigen::Vector3d(std::cos(th), std::sin(th), 0);
+  return d;
+}
+
+/// X's rim point at height zx * hx (X's frame) and an outward normal between X's lateral (a cone's slant) and cap
+/// normals there (one draw: the mix).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> x_rim_feature(Rng& rng, bool xcone, double rx, double hx, double zx) {
+  const Eigen::Vector3d lat_x = xcone ? Eigen::Vector3d(2 * hx, 0, rx).normalized() : Eigen::Vector3d(1, 0, 0);
+  const double mu = testing::uniform(rng, 0.1, 0.9);
+  return {Eigen::Vector3d(rx, 0, zx * hx), ((1 - mu) * lat_x + mu * zx * Eigen::Vector3d::UnitZ()).normalized()};
+}
+
 /// X placed against Y for the rim / slant start tests: X's feature xf (X's frame) with outward normal nx goes to Y's
 /// point x (Y's frame) moved out by a gap of 1e-5..1e-1 along Y's outward normal m, spun about nx; then both are
 /// posed by one random pose. The random draws in this order: spin, gap, rotation, translation.
@@ -421,7 +448,6 @@ TEST(WideGjk, BoxCylinderAndConeRimAndSideContactsStartInClosedForm) {
 /// start in most lanes, in either pair order.
 TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
   Rng rng(2029);
-  const double two_pi = 6.283185307179586;
   const QueryOptions opt = StartTally::options();
   StartTally tally;
   enum Kind { rim_rim, rim_cap, apex_side };
@@ -431,10 +457,8 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
       for (const bool ycone : {false, true}) {
         for (const bool swap : {false, true}) {
           for (int trial = 0; trial < 25; ++trial) {
-            const double rx = testing::uniform(rng, 0.03, 0.3), hx = testing::uniform(rng, 0.03, 0.3);
-            const double ry = testing::uniform(rng, 0.03, 0.3), hy = testing::uniform(rng, 0.03, 0.3);
-            const double th = testing::uniform(rng, 0, two_pi);
-            const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ(), radial(std::cos(th), std::sin(th), 0);
+            const auto [rx, hx, ry, hy, radial] = draw_rim_sizes(rng);
+            const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
             const Eigen::Vector3d lateral = ycone ? (2 * hy * radial + ry * ez).normalized() : radial;
             const double top = ycone || testing::uniform(rng, 0, 1) < 0.5 ? -1.0 : 1.0;
             Eigen::Vector3d x, m;
@@ -458,11 +482,7 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
               xf = Eigen::Vector3d(0, 0, hx);
               nx = Eigen::Vector3d(std::sin(beta), 0, std::cos(beta));
             } else {
-              const double zx = xcone ? -1.0 : 1.0;  // a cylinder's top rim, a cone's base
-              const Eigen::Vector3d lat_x = xcone ? Eigen::Vector3d(2 * hx, 0, rx).normalized() : Eigen::Vector3d(1, 0, 0);
-              const double mu = testing::uniform(rng, 0.1, 0.9);
-              xf = Eigen::Vector3d(rx, 0, zx * hx);
-              nx = ((1 - mu) * lat_x + mu * zx * ez).normalized();
+              std::tie(xf, nx) = x_rim_feature(rng, xcone, rx, hx, xcone ? -1.0 : 1.0);  // a cylinder's top, a cone's base
             }
             const auto [Rx, centre, gap, pose_x, pose_y] = place_feature(rng, x, m, xf, nx);
             const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx);
@@ -490,7 +510,6 @@ TEST(WideGjk, CylinderAndConeRimRimCapAndApexContactsStartInClosedForm) {
 /// lanes of every instruction set must give the reference's results bit for bit (these starts are the new code).
 TEST(WideGjk, ConeRimSlantAndSlantSlantContactsStartNearTheOptimum) {
   Rng rng(2030);
-  const double two_pi = 6.283185307179586;
   const QueryOptions opt = StartTally::options();
   StartTally tally;
   std::deque<OwnedShapeView> keep;  // the setups' cores point into it
@@ -502,21 +521,15 @@ TEST(WideGjk, ConeRimSlantAndSlantSlantContactsStartNearTheOptimum) {
       for (const bool swap : {false, true}) {
         std::vector<kernels::PairSetup<double>> setups;  // one type pair: a run of the lanes takes one
         for (int trial = 0; trial < 40; ++trial) {
-          const double rx = testing::uniform(rng, 0.03, 0.3), hx = testing::uniform(rng, 0.03, 0.3);
-          const double ry = testing::uniform(rng, 0.03, 0.3), hy = testing::uniform(rng, 0.03, 0.3);
-          const double th = testing::uniform(rng, 0, two_pi);
-          const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ(), radial(std::cos(th), std::sin(th), 0);
+          const auto [rx, hx, ry, hy, radial] = draw_rim_sizes(rng);
+          const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
           const double sg = testing::uniform(rng, 0.1, 0.9);
           const Eigen::Vector3d x(sg * ry * radial.x(), sg * ry * radial.y(), hy - 2 * hy * sg);
           const Eigen::Vector3d m = (2 * hy * radial + ry * ez).normalized();
           Eigen::Vector3d xf, nx;  // X's feature in its own frame and the outward normal there, -m in Y's frame
           if (kind == rim_slant) {
             const double zx = xcone || testing::uniform(rng, 0, 1) < 0.5 ? -1.0 : 1.0;  // a cone's base rim
-            const Eigen::Vector3d lat_x =
-                xcone ? Eigen::Vector3d(2 * hx, 0, rx).normalized() : Eigen::Vector3d(1, 0, 0);
-            const double mu = testing::uniform(rng, 0.1, 0.9);
-            xf = Eigen::Vector3d(rx, 0, zx * hx);
-            nx = ((1 - mu) * lat_x + mu * zx * ez).normalized();
+            std::tie(xf, nx) = x_rim_feature(rng, xcone, rx, hx, zx);
           } else {
             const double sx = testing::uniform(rng, 0.1, 0.9);
             xf = Eigen::Vector3d(sx * rx, 0, hx - 2 * hx * sx);
@@ -550,7 +563,6 @@ TEST(WideGjk, ConeRimSlantAndSlantSlantContactsStartNearTheOptimum) {
 /// 240, up to 42 iterations); 4: 444 (up to 37). The bound 9 / 10 (432) fails with 3 steps.
 TEST(WideGjk, RimRimContactsStartNearTheOptimumInBothOrders) {
   Rng rng(2031);
-  const double two_pi = 6.283185307179586;
   const QueryOptions opt = StartTally::options();
   StartTally tally;
   std::deque<OwnedShapeView> keep;  // the setups' cores point into it
@@ -560,19 +572,14 @@ TEST(WideGjk, RimRimContactsStartNearTheOptimumInBothOrders) {
       for (const bool swap : {false, true}) {
         std::vector<kernels::PairSetup<double>> setups;  // one type pair: a run of the lanes takes one
         for (int trial = 0; trial < 60; ++trial) {
-          const double rx = testing::uniform(rng, 0.03, 0.3), hx = testing::uniform(rng, 0.03, 0.3);
-          const double ry = testing::uniform(rng, 0.03, 0.3), hy = testing::uniform(rng, 0.03, 0.3);
-          const double th = testing::uniform(rng, 0, two_pi);
-          const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ(), radial(std::cos(th), std::sin(th), 0);
+          const auto [rx, hx, ry, hy, radial] = draw_rim_sizes(rng);
+          const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
           const Eigen::Vector3d lateral = ycone ? (2 * hy * radial + ry * ez).normalized() : radial;
           const double top = ycone || testing::uniform(rng, 0, 1) < 0.5 ? -1.0 : 1.0;
           const Eigen::Vector3d x = ry * radial + top * hy * ez;
           const double lambda = testing::uniform(rng, 0.1, 0.9);
           const Eigen::Vector3d m = ((1 - lambda) * lateral + lambda * top * ez).normalized();
-          const double zx = xcone ? -1.0 : 1.0;  // a cylinder's top rim, a cone's base
-          const Eigen::Vector3d lat_x = xcone ? Eigen::Vector3d(2 * hx, 0, rx).normalized() : Eigen::Vector3d(1, 0, 0);
-          const double mu = testing::uniform(rng, 0.1, 0.9);
-          const Eigen::Vector3d xf(rx, 0, zx * hx), nx = ((1 - mu) * lat_x + mu * zx * ez).normalized();
+          const auto [xf, nx] = x_rim_feature(rng, xcone, rx, hx, xcone ? -1.0 : 1.0);  // a cylinder's top, a cone's base
           const FeaturePlacement f = place_feature(rng, x, m, xf, nx);
           const Shape sx = xcone ? Shape::cone(rx, hx) : Shape::cylinder(rx, hx);
           const Shape sy = ycone ? Shape::cone(ry, hy) : Shape::cylinder(ry, hy);
