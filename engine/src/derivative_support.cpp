@@ -469,11 +469,8 @@ int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vect
     return 1;
   };
   constexpr std::size_t kKept = 16;
-  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && count >= 4 && count <= kKept) {
-    for (std::uint32_t mask = exposed_mask_avx2(vertices, count, u, tolerance); mask != 0; mask &= mask - 1)
-      if (exposed(std::size_t(__builtin_ctz(mask)))) return 2;
-    return feature();
-  }
+  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && count >= 4 && count <= kKept)
+    return feature_of_mask(vertices, exposed_mask_avx2(vertices, count, u, tolerance), edge);
   double kept[kKept];
   // Two vertices per SSE2 register (vector extensions, the scalar expression's operations and order: the same
   // bits): the 6 coordinates of vertices k, k + 1 are three unaligned pairs (x y, z x', y' z').
@@ -511,12 +508,10 @@ int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vect
     for (k = 0; k + 1 < count; k += 2)
       mask |= std::uint32_t(_mm_movemask_pd(_mm_cmpge_pd(_mm_loadu_pd(&kept[k]), f))) << k;
     if (k < count && kept[k] >= floor) mask |= std::uint32_t{1} << k;
-    for (; mask != 0; mask &= mask - 1)
-      if (exposed(std::size_t(__builtin_ctz(mask)))) return 2;
-  } else {
-    for (k = 0; k < count; ++k)
-      if ((k < kKept ? kept[k] : height(k)) >= floor && exposed(k)) return 2;
+    return feature_of_mask(vertices, mask, edge);
   }
+  for (k = 0; k < count; ++k)
+    if ((k < kKept ? kept[k] : height(k)) >= floor && exposed(k)) return 2;
   return feature();
 }
 

@@ -9,9 +9,11 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -140,10 +142,35 @@ TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
   EXPECT_EQ(mismatches, 0);
 }
 
-// exposed_feature_pair() (both hulls' height passes and walks in one AVX2 call on the wide sets) must find the
-// features and edges exposed_feature() finds side by side on the baseline: hulls of 4..16 vertices on a coarse
-// integer grid (so that directions along the axes and diagonals tie exactly: vertices, edges, faces, and three or
-// more collinear exposed vertices), and random directions.
+// The exposed feature by its definition, in plain loops: the vertices whose height <u, v> (the production's
+// expression and order) is >= max - tolerance, in index order; none or one: a vertex (0); a third off the line of the
+// first two (the same collinearity expression): a face (2); else an edge (1), second - first.
+int reference_feature(const std::vector<double>& v, const Eigen::Vector3d& u, double tolerance, Eigen::Vector3d& edge) {
+  const std::size_t n = v.size() / 3;
+  const auto vertex = [&](std::size_t k) { return Eigen::Vector3d(v[3 * k], v[3 * k + 1], v[3 * k + 2]); };
+  std::vector<double> h(n);
+  double top = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < n; ++k) {
+    h[k] = u.x() * v[3 * k] + u.y() * v[3 * k + 1] + u.z() * v[3 * k + 2];
+    top = std::max(top, h[k]);
+  }
+  std::vector<std::size_t> exposed;
+  for (std::size_t k = 0; k < n; ++k)
+    if (h[k] >= top - tolerance) exposed.push_back(k);
+  if (exposed.size() < 2) return 0;
+  const Eigen::Vector3d e1 = vertex(exposed[1]) - vertex(exposed[0]);
+  for (std::size_t m = 2; m < exposed.size(); ++m) {
+    const Eigen::Vector3d e2 = vertex(exposed[m]) - vertex(exposed[0]);
+    if (e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm()) return 2;
+  }
+  edge = e1;
+  return 1;
+}
+
+// exposed_feature_pair() (both hulls' height passes and walks in one AVX2 call on the wide sets, exposed_feature()
+// per side on the baseline) must find the features and edges of the plain reference above: hulls of 4..16 vertices
+// on a coarse integer grid (so that directions along the axes and diagonals tie exactly: vertices, edges, faces, and
+// three or more collinear exposed vertices), and random directions.
 TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
   std::mt19937_64 rng(20261128);
   std::uniform_int_distribution<int> grid(-2, 2), size(4, 16), pick(0, 3);
@@ -172,10 +199,12 @@ TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
     const double tolerance[2] = {1e-9, 1e-9};
     int want[2];
     Eigen::Vector3d want_edge[2];
-    want[0] = detail::exposed_feature(va.data(), va.size() / 3, u[0], tolerance[0], want_edge[0]);
-    want[1] = detail::exposed_feature(vb.data(), vb.size() / 3, u[1], tolerance[1], want_edge[1]);
+    want[0] = reference_feature(va, u[0], tolerance[0], want_edge[0]);
+    want[1] = reference_feature(vb, u[1], tolerance[1], want_edge[1]);
     ++features[want[0]], ++features[want[1]];
-    for (const auto isa : vector_isas_here()) {
+    std::vector<InstructionSet> isas = vector_isas_here();
+    isas.insert(isas.begin(), InstructionSet::scalar);
+    for (const auto isa : isas) {
       int got[2];
       Eigen::Vector3d edge[2];
       detail::exposed_feature_pair(view(va), view(vb), u, tolerance, got, edge, isa);
