@@ -267,9 +267,7 @@ void size_unfilled(RayResults& r, std::size_t n) {
 // The buffers (~130 bytes a ray) are the index's RayCastArena (ray_cast_arena.hpp), on huge pages when large: the
 // records and results are read at scattered places in the cast order and the scatter, one TLB entry per ray with
 // small pages, one per 2 MiB with huge ones; mapped once, not faulted in and cleared by the kernel for every cast.
-struct alignas(64) PackedRay {  // one cache line
-  double o[3], d[3], t_max;
-};
+using PackedRay = WideRayRecord;  // one cache line
 
 struct CastResult {
   Hit best;
@@ -298,7 +296,8 @@ class RayOrder {
           const std::size_t i = b + l;
           packed_[i] = {{rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]},
                         {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]},
-                        rays.t_max[i]};
+                        rays.t_max[i],
+                        0.0};
           words_[i] = std::uint64_t(keys[l]) << 32 | std::uint64_t(i);
         }
       }
@@ -384,10 +383,9 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
     detail::run_with_threads(options.threads, [&] {
       RayOrder order(rays, state_->wide.nodes()[0], isa, arena);
       const bool any = options.query == RayQuery::any;
-      const WideRaySetup setup = select_wide_ray_setup(isa);
+      const WideRecordSetup setup = select_wide_record_setup(isa);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
-        double rows[7][kWideRaySetupLanes];  // 8 records in cast order as structure of arrays
-        const WideRayInput group{{rows[0], rows[1], rows[2]}, {rows[3], rows[4], rows[5]}, rows[6]};
+        const WideRayRecord* group[kWideRaySetupLanes];  // the next 8 records in cast order
         WideRay wide[kWideRaySetupLanes];
         std::uint8_t status[kWideRaySetupLanes];
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -397,12 +395,8 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
             const std::size_t lane = (k - begin) % kWideRaySetupLanes;
             if (lane == 0) {  // the next 8 records' setup in lanes (as in input order below)
               const std::size_t m = std::min(kWideRaySetupLanes, end - k);
-              for (std::size_t l = 0; l < m; ++l) {
-                const PackedRay& q = order.ray(k + l);
-                for (int a = 0; a < 3; ++a) rows[a][l] = q.o[a], rows[3 + a][l] = q.d[a];
-                rows[6][l] = q.t_max;
-              }
-              setup(group, 0, m, wide, status);
+              for (std::size_t l = 0; l < m; ++l) group[l] = &order.ray(k + l);
+              setup(group, m, wide, status);
               caster.prepare(wide, m);
             }
             const PackedRay& p = order.ray(k);

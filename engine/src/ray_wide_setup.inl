@@ -26,14 +26,42 @@ inline U4 round_up_bits(D x) {
   return u + (below & (1u | (0u - (u >> 31))));
 }
 
-// Lanes [b, b + 4) of the group: the arrays below hold 8 lanes.
-struct SetupLanes {
-  float inv[3][8], near[3][8], far[3][8], ball_o[3][8], ball_d[3][8], margin[8];
-  std::uint32_t near_off[3][8], far_off[3][8];
-  std::int64_t supported[8], valid[8];
-};
+// The 22 four-byte fields of a WideRay before its pointer (o_near, o_far, inv, near_offset, far_offset, ball_o,
+// ball_d, ball_margin), in their order, as vectors of 4 lanes (rays); two more slots pad to whole blocks of 4.
+constexpr int kRayFields = 22, kFieldSlots = 24;
+static_assert(offsetof(WideRay, o_near) == 0 && offsetof(WideRay, o_far) == 12 && offsetof(WideRay, inv) == 24 &&
+                  offsetof(WideRay, near_offset) == 36 && offsetof(WideRay, far_offset) == 48 &&
+                  offsetof(WideRay, ball_o) == 60 && offsetof(WideRay, ball_d) == 72 &&
+                  offsetof(WideRay, ball_margin) == 4 * (kRayFields - 1) && offsetof(WideRay, balls) == 4 * kRayFields &&
+                  offsetof(WideRay, ball_stride) >= 4 * kFieldSlots,
+              "store_rays4() writes the fields as 6 blocks of 4, the last two slots over `balls` only");
 
-void setup4(const double (&in)[7][8], int b, SetupLanes& s) {
+// Writes rays [0, 4) of `f` into out[0..3]: each block of 4 fields is a 4 x 4 transposition (8 shuffles) and one
+// 16-byte store per ray, where copying lane by lane cost ~50 instructions a ray (callgrind, AVX2). The last block's
+// two padding slots land on the ray's `balls` pointer, which the caller writes afterwards. Only bits move: the
+// fields are those the lanes computed, on every instruction set.
+inline void store_rays4(const U4 (&f)[kFieldSlots], WideRay* out) {
+  const U4 lo = {0, 4, 1, 5}, hi = {2, 6, 3, 7}, first = {0, 1, 4, 5}, second = {2, 3, 6, 7};
+  for (int j = 0; j < kFieldSlots / 4; ++j) {
+    const U4 t0 = __builtin_shuffle(f[4 * j], f[4 * j + 1], lo), t1 = __builtin_shuffle(f[4 * j + 2], f[4 * j + 3], lo);
+    const U4 t2 = __builtin_shuffle(f[4 * j], f[4 * j + 1], hi), t3 = __builtin_shuffle(f[4 * j + 2], f[4 * j + 3], hi);
+    const U4 ray[4] = {__builtin_shuffle(t0, t1, first), __builtin_shuffle(t0, t1, second),
+                       __builtin_shuffle(t2, t3, first), __builtin_shuffle(t2, t3, second)};
+    for (int l = 0; l < 4; ++l) __builtin_memcpy(reinterpret_cast<char*>(out + l) + 16 * j, &ray[l], sizeof ray[l]);
+  }
+}
+
+// Four vectors (one per ray) of four fields each, transposed to four vectors (one per field) of four rays.
+inline void transpose4(const D (&v)[4], D (&out)[4]) {
+  const L even = {0, 4, 2, 6}, odd = {1, 5, 3, 7}, low = {0, 1, 4, 5}, high = {2, 3, 6, 7};
+  const D t0 = __builtin_shuffle(v[0], v[1], even), t1 = __builtin_shuffle(v[0], v[1], odd);
+  const D t2 = __builtin_shuffle(v[2], v[3], even), t3 = __builtin_shuffle(v[2], v[3], odd);
+  out[0] = __builtin_shuffle(t0, t2, low), out[1] = __builtin_shuffle(t1, t3, low);
+  out[2] = __builtin_shuffle(t0, t2, high), out[3] = __builtin_shuffle(t1, t3, high);
+}
+
+// Rays [b, b + 4) of the group into out[0..3] (fields before `balls`), their validity and float-range masks.
+void setup4(const double (&in)[7][8], int b, WideRay* out, std::int64_t (&supported_out)[8], std::int64_t (&valid_out)[8]) {
   D o[3], d[3], t_max;
   for (int k = 0; k < 3; ++k) __builtin_memcpy(&o[k], &in[k][b], sizeof(D)), __builtin_memcpy(&d[k], &in[3 + k][b], sizeof(D));
   __builtin_memcpy(&t_max, &in[6][b], sizeof(D));
@@ -49,8 +77,9 @@ void setup4(const double (&in)[7][8], int b, SetupLanes& s) {
     supported &= (ao <= splat_d(0x1p60)) & ((d[k] == splat_d(0.0)) | ((ad >= splat_d(0x1p-60)) & (ad <= splat_d(0x1p60))));
   }
   supported &= valid;
-  __builtin_memcpy(&s.supported[b], &supported, sizeof supported);
-  __builtin_memcpy(&s.valid[b], &valid, sizeof valid);
+  __builtin_memcpy(&supported_out[b], &supported, sizeof supported);
+  __builtin_memcpy(&valid_out[b], &valid, sizeof valid);
+  U4 f[kFieldSlots] = {};
   // make_wide_ray().
   constexpr std::uint32_t lo[3] = {offsetof(WideNode, lo_x), offsetof(WideNode, lo_y), offsetof(WideNode, lo_z)};
   constexpr std::uint32_t hi[3] = {offsetof(WideNode, hi_x), offsetof(WideNode, hi_y), offsetof(WideNode, hi_z)};
@@ -63,17 +92,30 @@ void setup4(const double (&in)[7][8], int b, SetupLanes& s) {
     const U4 o_near = (down & neg) | (up & ~neg), o_far = (up & neg) | (down & ~neg);
     const U4 near_offset = (hi[k] & neg) | (lo[k] & ~neg), far_offset = (lo[k] & neg) | (hi[k] & ~neg);
     const F4 ball_o = __builtin_convertvector(o[k], F4), ball_d = __builtin_convertvector(d[k] / len, F4);
-    __builtin_memcpy(&s.inv[k][b], &inv, sizeof inv);
-    __builtin_memcpy(&s.near[k][b], &o_near, sizeof o_near);
-    __builtin_memcpy(&s.far[k][b], &o_far, sizeof o_far);
-    __builtin_memcpy(&s.near_off[k][b], &near_offset, sizeof near_offset);
-    __builtin_memcpy(&s.far_off[k][b], &far_offset, sizeof far_offset);
-    __builtin_memcpy(&s.ball_o[k][b], &ball_o, sizeof ball_o);
-    __builtin_memcpy(&s.ball_d[k][b], &ball_d, sizeof ball_d);
+    f[k] = o_near, f[3 + k] = o_far, f[6 + k] = inv, f[9 + k] = near_offset, f[12 + k] = far_offset;
+    f[15 + k] = (U4)ball_o, f[18 + k] = (U4)ball_d;
     o_length += abs_d(o[k]);
   }
-  const U4 margin = round_up_bits(splat_d(double(kBallMargin)) * o_length);
-  __builtin_memcpy(&s.margin[b], &margin, sizeof margin);
+  f[21] = round_up_bits(splat_d(double(kBallMargin)) * o_length);
+  store_rays4(f, out);
+}
+
+// The rays of a group from its 7 rows of 8 lanes (a partial group's padding lanes are computed, not written out).
+void setup_rows(const double (&rows)[7][8], std::size_t n, WideRay* out, std::uint8_t* status) {
+  // A whole group is written in place; a partial one through a local group, of which the first n rays are copied.
+  WideRay local[8];
+  WideRay* const dst = n == 8 ? out : local;
+  std::int64_t supported[8], valid[8];
+  setup4(rows, 0, dst, supported, valid);
+  setup4(rows, 4, dst + 4, supported, valid);
+  for (std::size_t l = 0; l < n; ++l) {
+    status[l] = supported[l] ? kWideRaySupported : valid[l] ? kWideRayBinary : kWideRayInvalid;
+    WideRay& r = dst[l];
+    r.balls = nullptr;
+    r.ball_stride = 4;
+    r.prefetch = false;
+    if (dst != out) out[l] = r;
+  }
 }
 
 }  // namespace
@@ -96,19 +138,36 @@ void setup_rays(const WideRayInput& in, std::size_t begin, std::size_t n, WideRa
       rows[6][l] = in.t_max[begin + l];
     }
   }
-  SetupLanes s;
-  setup4(rows, 0, s);
-  setup4(rows, 4, s);
-  for (std::size_t l = 0; l < n; ++l) {
-    status[l] = s.supported[l] ? kWideRaySupported : s.valid[l] ? kWideRayBinary : kWideRayInvalid;
-    WideRay& r = out[l];
-    for (int k = 0; k < 3; ++k) {
-      r.inv[k] = s.inv[k][l], r.o_near[k] = s.near[k][l], r.o_far[k] = s.far[k][l];
-      r.near_offset[k] = s.near_off[k][l], r.far_offset[k] = s.far_off[k][l];
-      r.ball_o[k] = s.ball_o[k][l], r.ball_d[k] = s.ball_d[k][l];
-    }
-    r.ball_margin = s.margin[l];
-    r.balls = nullptr;
-    r.prefetch = false;
+  setup_rows(rows, n, out, status);
+}
+
+void setup_records(const WideRayRecord* const* records, std::size_t n, WideRay* out, std::uint8_t* status) {
+  // Each record is two vectors of 4 doubles, (o x, o y, o z, d x) and (d y, d z, t_max, pad); four records' first
+  // (second) vectors transposed 4 x 4 are rows 0-3 (4-6 and the pads) of 4 lanes: 16 loads, 16 shuffles and 14
+  // stores for 8 rays, where gathering them field by field cost ~27 instructions a ray (callgrind, AVX2). A partial
+  // group pads with the harmless ray of setup_rays(); only bits move, so the rows are those of setup_rays().
+  static const WideRayRecord pad{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 0.0, 0.0};
+  const WideRayRecord* r[8];
+  for (std::size_t l = 0; l < 8; ++l) r[l] = l < n ? records[l] : &pad;
+  const auto load = [](const double* p) {
+    D v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+  };
+  double rows[7][8];
+  for (int b = 0; b < 8; b += 4) {
+    const D first[4] = {load(r[b]->o), load(r[b + 1]->o), load(r[b + 2]->o), load(r[b + 3]->o)};
+    const D second[4] = {load(&r[b]->d[1]), load(&r[b + 1]->d[1]), load(&r[b + 2]->d[1]), load(&r[b + 3]->d[1])};
+    D row[4];
+    transpose4(first, row);
+    __builtin_memcpy(&rows[0][b], &row[0], sizeof(D));
+    __builtin_memcpy(&rows[1][b], &row[1], sizeof(D));
+    __builtin_memcpy(&rows[2][b], &row[2], sizeof(D));
+    __builtin_memcpy(&rows[3][b], &row[3], sizeof(D));
+    transpose4(second, row);
+    __builtin_memcpy(&rows[4][b], &row[0], sizeof(D));
+    __builtin_memcpy(&rows[5][b], &row[1], sizeof(D));
+    __builtin_memcpy(&rows[6][b], &row[2], sizeof(D));  // row[3]: the pads
   }
+  setup_rows(rows, n, out, status);
 }

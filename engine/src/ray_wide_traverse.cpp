@@ -143,6 +143,20 @@ WideRaySetup select_wide_ray_setup(int isa) {
 
 WideRaySetup select_wide_ray_setup() { return select_wide_ray_setup(2); }
 
+WideRecordSetup wide_record_setup_for(int isa) {
+  switch (isa) {
+    case 0: return &wide_baseline::setup_records;
+    case 1: return wide_traverse_for(1) ? &wide_avx2::setup_records : nullptr;
+    default: return nullptr;  // no AVX-512 build (wide_ray_setup_for())
+  }
+}
+
+WideRecordSetup select_wide_record_setup(int isa) {
+  for (isa = std::min(isa, 1); isa > 0; --isa)
+    if (WideRecordSetup f = wide_record_setup_for(isa)) return f;
+  return wide_record_setup_for(0);
+}
+
 WideTraverse select_wide_traverse(int isa) {
   for (; isa > 0; --isa)
     if (WideTraverse f = wide_traverse_for(isa)) return f;

@@ -79,6 +79,18 @@ WideRaySetup select_wide_ray_setup();
 WideRaySetup select_wide_ray_setup(int isa);  // at most `isa` (AVX-512 processors run the AVX2 setup)
 WideRaySetup wide_ray_setup_for(int isa);
 
+/// A ray as the ordered cast keeps it (one cache line): origin, direction, t_max; `pad` is read with the rest.
+struct alignas(64) WideRayRecord {
+  double o[3], d[3], t_max, pad;
+};
+/// The setup of n <= 8 records given by address (the ordered cast reads its records in cast order, scattered):
+/// the same status and WideRay bits as a WideRaySetup of the same rays.
+using WideRecordSetup = void (*)(const WideRayRecord* const* records, std::size_t n, WideRay* out,
+                                 std::uint8_t* status);
+/// As wide_ray_setup_for() / select_wide_ray_setup(isa).
+WideRecordSetup wide_record_setup_for(int isa);
+WideRecordSetup select_wide_record_setup(int isa);
+
 /// The float limit the traversal compares with for a double limit t: t (1 + 2^-20) rounded up to float.
 /// Inline: the scene cast calls it after every hit (a call cost ~30 instructions, 1.2% of a ray on 10k hulls).
 float wide_limit_round_up(double x);  // round_up(): the next float at or above x, for x < 0 and NaN

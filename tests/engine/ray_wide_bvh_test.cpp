@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -394,7 +395,8 @@ TEST(RayWideBvh, BranchFreeLimitGivesTheRoundUpBits) {
 // instruction set and for partial groups: random rays, and the cases where the rounding or the sign decides (origins
 // exactly representable in float or not, +-0, subnormal and huge components, the range limits 2^-60 / 2^60), and
 // invalid rays (NaN, inf, zero direction, negative or NaN t_max).
-TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
+// Random rays mixed with the special values of the setup tests below.
+RayBatch setup_test_rays() {
   Rng rng(19);
   RayBatch rays;
   const double special[] = {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1.0 + 0x1p-40, -(1.0 + 0x1p-40), 0x1p-60, -0x1p-60,
@@ -413,6 +415,11 @@ TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
     if (i % 97 == 0) d[0] = d[1] = d[2] = 0.0;
     rays.add(Eigen::Vector3d(o[0], o[1], o[2]), Eigen::Vector3d(d[0], d[1], d[2]), t);
   }
+  return rays;
+}
+
+TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
+  const RayBatch rays = setup_test_rays();
   const WideRayInput in{{rays.origin.x.data(), rays.origin.y.data(), rays.origin.z.data()},
                         {rays.direction.x.data(), rays.direction.y.data(), rays.direction.z.data()},
                         rays.t_max.data()};
@@ -455,6 +462,62 @@ TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
   EXPECT_GT(counts[kWideRayInvalid], 500u);
   EXPECT_GT(counts[kWideRayBinary], 500u);
   EXPECT_GT(counts[kWideRaySupported], 5000u);
+}
+
+// The ordered cast's setup from records at scattered addresses (WideRecordSetup) gives the status and every field of
+// the array setup (WideRaySetup, checked against the scalar setup above) bit for bit: the same rays, groups of 8 and
+// partial groups, records taken in a shuffled order, on every instruction set either has; the padding lanes of a
+// partial group are not written (the rays after it keep a marker).
+TEST(RayWideBvh, RecordSetupMatchesTheArraySetupBitwise) {
+  const RayBatch rays = setup_test_rays();
+  std::vector<WideRayRecord> records(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    records[i] = {{rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]},
+                  {rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]},
+                  rays.t_max[i],
+                  0.0};
+  std::vector<std::size_t> order(rays.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), Rng(5));
+  RayBatch shuffled;  // the rays in `order`, for the array setup
+  for (std::size_t i : order)
+    shuffled.add(Eigen::Vector3d(rays.origin.x[i], rays.origin.y[i], rays.origin.z[i]),
+                 Eigen::Vector3d(rays.direction.x[i], rays.direction.y[i], rays.direction.z[i]), rays.t_max[i]);
+  const WideRayInput sin{{shuffled.origin.x.data(), shuffled.origin.y.data(), shuffled.origin.z.data()},
+                         {shuffled.direction.x.data(), shuffled.direction.y.data(), shuffled.direction.z.data()},
+                         shuffled.t_max.data()};
+  int sets = 0;
+  for (int isa = 0; isa < 3; ++isa) {
+    const WideRecordSetup by_record = wide_record_setup_for(isa);
+    const WideRaySetup by_array = wide_ray_setup_for(isa);
+    ASSERT_EQ(by_record == nullptr, by_array == nullptr) << "isa " << isa;
+    if (by_record == nullptr) continue;
+    ++sets;
+    for (std::size_t group : {std::size_t(8), std::size_t(5), std::size_t(1)}) {
+      for (std::size_t b = 0; b < rays.size(); b += group) {
+        const std::size_t n = std::min(group, rays.size() - b);
+        const WideRayRecord* addresses[kWideRaySetupLanes];
+        for (std::size_t l = 0; l < n; ++l) addresses[l] = &records[order[b + l]];
+        WideRay got[kWideRaySetupLanes], want[kWideRaySetupLanes];
+        std::uint8_t got_status[kWideRaySetupLanes], want_status[kWideRaySetupLanes];
+        for (std::size_t l = 0; l < kWideRaySetupLanes; ++l) got[l].ball_stride = 77, got_status[l] = 9;
+        by_record(addresses, n, got, got_status);
+        by_array(sin, b, n, want, want_status);
+        for (std::size_t l = 0; l < n; ++l) {
+          ASSERT_EQ(got_status[l], want_status[l]) << "isa " << isa << " ray " << order[b + l];
+          // The 22 four-byte fields before `balls`: lanes compute them for every ray, valid or not.
+          ASSERT_EQ(std::memcmp(&got[l], &want[l], offsetof(WideRay, balls)), 0) << "isa " << isa << " ray " << order[b + l];
+          EXPECT_EQ(got[l].balls, nullptr);
+          EXPECT_FALSE(got[l].prefetch);
+        }
+        for (std::size_t l = n; l < kWideRaySetupLanes; ++l) {
+          EXPECT_EQ(got[l].ball_stride, 77u) << "padding lane written, isa " << isa;
+          EXPECT_EQ(got_status[l], 9) << "padding lane written, isa " << isa;
+        }
+      }
+    }
+  }
+  EXPECT_GE(sets, 1);
 }
 
 }  // namespace
