@@ -26,23 +26,20 @@ inline U4 round_up_bits(D x) {
   return u + (below & (1u | (0u - (u >> 31))));
 }
 
-// The 22 four-byte fields of a WideRay before its pointer (o_near, o_far, inv, near_offset, far_offset, ball_o,
-// ball_d, ball_margin), in their order, as vectors of 4 lanes (rays); two more slots pad to whole blocks of 4.
-constexpr int kRayFields = 22, kFieldSlots = 24;
+// The first 16 four-byte fields of a WideRay (o_near, o_far, inv, ball_o, ball_d, ball_margin), in their order, as
+// vectors of 4 lanes (rays).
+constexpr int kRayFields = 16;
 static_assert(offsetof(WideRay, o_near) == 0 && offsetof(WideRay, o_far) == 12 && offsetof(WideRay, inv) == 24 &&
-                  offsetof(WideRay, near_offset) == 36 && offsetof(WideRay, far_offset) == 48 &&
-                  offsetof(WideRay, ball_o) == 60 && offsetof(WideRay, ball_d) == 72 &&
-                  offsetof(WideRay, ball_margin) == 4 * (kRayFields - 1) && offsetof(WideRay, balls) == 4 * kRayFields &&
-                  offsetof(WideRay, ball_stride) >= 4 * kFieldSlots,
-              "store_rays4() writes the fields as 6 blocks of 4, the last two slots over `balls` only");
+                  offsetof(WideRay, ball_o) == 36 && offsetof(WideRay, ball_d) == 48 &&
+                  offsetof(WideRay, ball_margin) == 4 * (kRayFields - 1) && offsetof(WideRay, octant) == 4 * kRayFields,
+              "store_rays4() writes the fields before `octant` as 4 blocks of 4");
 
 // Writes rays [0, 4) of `f` into out[0..3]: each block of 4 fields is a 4 x 4 transposition (8 shuffles) and one
-// 16-byte store per ray, where copying lane by lane cost ~50 instructions a ray (callgrind, AVX2). The last block's
-// two padding slots land on the ray's `balls` pointer, which the caller writes afterwards. Only bits move: the
-// fields are those the lanes computed, on every instruction set.
-inline void store_rays4(const U4 (&f)[kFieldSlots], WideRay* out) {
+// 16-byte store per ray, where copying lane by lane cost ~50 instructions a ray (callgrind, AVX2). Only bits move:
+// the fields are those the lanes computed, on every instruction set.
+inline void store_rays4(const U4 (&f)[kRayFields], WideRay* out) {
   const U4 lo = {0, 4, 1, 5}, hi = {2, 6, 3, 7}, first = {0, 1, 4, 5}, second = {2, 3, 6, 7};
-  for (int j = 0; j < kFieldSlots / 4; ++j) {
+  for (int j = 0; j < kRayFields / 4; ++j) {
     const U4 t0 = __builtin_shuffle(f[4 * j], f[4 * j + 1], lo), t1 = __builtin_shuffle(f[4 * j + 2], f[4 * j + 3], lo);
     const U4 t2 = __builtin_shuffle(f[4 * j], f[4 * j + 1], hi), t3 = __builtin_shuffle(f[4 * j + 2], f[4 * j + 3], hi);
     const U4 ray[4] = {__builtin_shuffle(t0, t1, first), __builtin_shuffle(t0, t1, second),
@@ -60,8 +57,10 @@ inline void transpose4(const D (&v)[4], D (&out)[4]) {
   out[2] = __builtin_shuffle(t0, t2, high), out[3] = __builtin_shuffle(t1, t3, high);
 }
 
-// Rays [b, b + 4) of the group into out[0..3] (fields before `balls`), their validity and float-range masks.
-void setup4(const double (&in)[7][8], int b, WideRay* out, std::int64_t (&supported_out)[8], std::int64_t (&valid_out)[8]) {
+// Rays [b, b + 4) of the group into out[0..3] (the fields before `octant`), their octants, validity and float-range
+// masks.
+void setup4(const double (&in)[7][8], int b, WideRay* out, std::uint32_t (&octant_out)[8],
+            std::int64_t (&supported_out)[8], std::int64_t (&valid_out)[8]) {
   D o[3], d[3], t_max;
   for (int k = 0; k < 3; ++k) __builtin_memcpy(&o[k], &in[k][b], sizeof(D)), __builtin_memcpy(&d[k], &in[3 + k][b], sizeof(D));
   __builtin_memcpy(&t_max, &in[6][b], sizeof(D));
@@ -79,10 +78,8 @@ void setup4(const double (&in)[7][8], int b, WideRay* out, std::int64_t (&suppor
   supported &= valid;
   __builtin_memcpy(&supported_out[b], &supported, sizeof supported);
   __builtin_memcpy(&valid_out[b], &valid, sizeof valid);
-  U4 f[kFieldSlots] = {};
+  U4 f[kRayFields], octant = {0, 0, 0, 0};
   // make_wide_ray().
-  constexpr std::uint32_t lo[3] = {offsetof(WideNode, lo_x), offsetof(WideNode, lo_y), offsetof(WideNode, lo_z)};
-  constexpr std::uint32_t hi[3] = {offsetof(WideNode, hi_x), offsetof(WideNode, hi_y), offsetof(WideNode, hi_z)};
   const D len = BATCHCOL_SETUP_SQRT(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   D o_length = splat_d(0.0);
   for (int k = 0; k < 3; ++k) {
@@ -90,14 +87,14 @@ void setup4(const double (&in)[7][8], int b, WideRay* out, std::int64_t (&suppor
     const U4 inv = (U4)__builtin_convertvector(splat_d(1.0) / d[k], F4);
     const U4 up = round_up_bits(o[k]), down = round_up_bits(-o[k]) ^ 0x80000000u;  // round_down(x) = -round_up(-x)
     const U4 o_near = (down & neg) | (up & ~neg), o_far = (up & neg) | (down & ~neg);
-    const U4 near_offset = (hi[k] & neg) | (lo[k] & ~neg), far_offset = (lo[k] & neg) | (hi[k] & ~neg);
     const F4 ball_o = __builtin_convertvector(o[k], F4), ball_d = __builtin_convertvector(d[k] / len, F4);
-    f[k] = o_near, f[3 + k] = o_far, f[6 + k] = inv, f[9 + k] = near_offset, f[12 + k] = far_offset;
-    f[15 + k] = (U4)ball_o, f[18 + k] = (U4)ball_d;
+    f[k] = o_near, f[3 + k] = o_far, f[6 + k] = inv, f[9 + k] = (U4)ball_o, f[12 + k] = (U4)ball_d;
+    octant |= neg & (1u << k);
     o_length += abs_d(o[k]);
   }
-  f[21] = round_up_bits(splat_d(double(kBallMargin)) * o_length);
+  f[15] = round_up_bits(splat_d(double(kBallMargin)) * o_length);
   store_rays4(f, out);
+  __builtin_memcpy(&octant_out[b], &octant, sizeof octant);
 }
 
 // The rays of a group from its 7 rows of 8 lanes (a partial group's padding lanes are computed, not written out).
@@ -105,12 +102,14 @@ void setup_rows(const double (&rows)[7][8], std::size_t n, WideRay* out, std::ui
   // A whole group is written in place; a partial one through a local group, of which the first n rays are copied.
   WideRay local[8];
   WideRay* const dst = n == 8 ? out : local;
+  std::uint32_t octant[8];
   std::int64_t supported[8], valid[8];
-  setup4(rows, 0, dst, supported, valid);
-  setup4(rows, 4, dst + 4, supported, valid);
+  setup4(rows, 0, dst, octant, supported, valid);
+  setup4(rows, 4, dst + 4, octant, supported, valid);
   for (std::size_t l = 0; l < n; ++l) {
     status[l] = supported[l] ? kWideRaySupported : valid[l] ? kWideRayBinary : kWideRayInvalid;
     WideRay& r = dst[l];
+    r.octant = octant[l];
     r.balls = nullptr;
     r.ball_stride = 4;
     r.prefetch = false;

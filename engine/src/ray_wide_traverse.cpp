@@ -81,14 +81,12 @@ bool wide_ray_supported(const double o[3], const double d[3]) {
 }
 
 WideRay make_wide_ray(const double o[3], const double d[3]) {
-  constexpr std::uint32_t lo[3] = {offsetof(WideNode, lo_x), offsetof(WideNode, lo_y), offsetof(WideNode, lo_z)};
-  constexpr std::uint32_t hi[3] = {offsetof(WideNode, hi_x), offsetof(WideNode, hi_y), offsetof(WideNode, hi_z)};
   WideRay r;
+  r.octant = 0;
   for (int k = 0; k < 3; ++k) {
     const bool negative = std::signbit(d[k]);  // -0 counts as negative: 1 / -0 = -inf pairs with the hi plane
     r.inv[k] = static_cast<float>(1.0 / d[k]);
-    r.near_offset[k] = negative ? hi[k] : lo[k];
-    r.far_offset[k] = negative ? lo[k] : hi[k];
+    r.octant |= negative ? 1u << k : 0u;
     r.o_near[k] = negative ? round_down(o[k]) : round_up(o[k]);
     r.o_far[k] = negative ? round_up(o[k]) : round_down(o[k]);
   }

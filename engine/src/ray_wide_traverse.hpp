@@ -42,9 +42,11 @@ constexpr float kBallMargin = 0x1p-16f;  // 32 times the error bound above
 
 struct WideRay {
   float o_near[3], o_far[3], inv[3];
-  std::uint32_t near_offset[3], far_offset[3];  // byte offsets of the near / far plane arrays inside WideNode
   float ball_o[3], ball_d[3];  // origin and unit direction rounded to float
   float ball_margin;           // kBallMargin * |o|_1, rounded up
+  // Bit k: the direction's component k is negative (-0 included), so the ray enters a slab of axis k through its hi
+  // plane: which loop of the traversal runs (one per octant, the near / far planes fixed offsets in it).
+  std::uint32_t octant;
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
   std::uint32_t ball_stride = 4;  // floats from one leaf's ball to the next (the balls sit in the leaf records)
   bool prefetch = false;  // request a pushed child's lines early (worth it when the nodes do not fit the L2)

@@ -166,11 +166,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
 }  // namespace
 
 void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisit visit, void* context) {
-  // The octant is read back from the near planes make_wide_ray() chose (hi: a negative component).
-  const int octant = (r.near_offset[0] == offsetof(WideNode, hi_x) ? 1 : 0) |
-                     (r.near_offset[1] == offsetof(WideNode, hi_y) ? 2 : 0) |
-                     (r.near_offset[2] == offsetof(WideNode, hi_z) ? 4 : 0);
-  switch (octant) {
+  switch (r.octant) {
     case 0: return traverse_octant<0>(nodes, r, limit, visit, context);
     case 1: return traverse_octant<1>(nodes, r, limit, visit, context);
     case 2: return traverse_octant<2>(nodes, r, limit, visit, context);

@@ -365,6 +365,33 @@ TEST(RayWideBvh, RaysOutsideFloatRangeAreRefused) {
   EXPECT_EQ(wide_limit(INFINITY), INFINITY);
 }
 
+// The octant that picks the traversal loop: bit k set for a negative direction component k, -0 included (1 / -0 =
+// -inf pairs with the hi plane), in make_wide_ray() and in the SIMD setup.
+TEST(RayWideBvh, OctantIsTheDirectionsSignBits) {
+  const double o[3] = {0.5, -0.25, 3.0}, values[] = {1.0, -1.0, 0.0, -0.0, 0x1p-60, -0x1p60};
+  for (double x : values)
+    for (double y : values)
+      for (double z : values) {
+        const double d[3] = {x, y, z};
+        const std::uint32_t want =
+            (std::signbit(x) ? 1u : 0u) | (std::signbit(y) ? 2u : 0u) | (std::signbit(z) ? 4u : 0u);
+        EXPECT_EQ(make_wide_ray(o, d).octant, want) << x << " " << y << " " << z;
+        for (int isa = 0; isa < 3; ++isa) {
+          const WideRaySetup setup = wide_ray_setup_for(isa);
+          if (setup == nullptr) continue;
+          const double t_max = 1.0;
+          const WideRayInput in{{&o[0], &o[1], &o[2]}, {&d[0], &d[1], &d[2]}, &t_max};
+          WideRay out[kWideRaySetupLanes];
+          std::uint8_t status[kWideRaySetupLanes];
+          setup(in, 0, 1, out, status);
+          ASSERT_EQ(status[0], std::abs(x) + std::abs(y) + std::abs(z) > 0.0 ? kWideRaySupported : kWideRayInvalid);
+          if (status[0] == kWideRaySupported) {
+            EXPECT_EQ(out[0].octant, want) << "isa " << isa;
+          }
+        }
+      }
+}
+
 // wide_limit()'s branch-free rounding for limits >= 0 (the bit pattern plus one) gives round_up()'s bits: at float
 // values and just beside them (where the conversion is exact or rounds either way), at 0, subnormals, the float
 // range's top (FLT_MAX -> +inf) and on random magnitudes; negative and NaN limits take round_up() itself.
@@ -447,8 +474,7 @@ TEST(RayWideBvh, SimdSetupMatchesTheScalarSetupBitwise) {
           EXPECT_EQ(std::memcmp(w.o_near, v.o_near, sizeof w.o_near), 0) << "isa " << isa << " ray " << i;
           EXPECT_EQ(std::memcmp(w.o_far, v.o_far, sizeof w.o_far), 0) << "isa " << isa << " ray " << i;
           EXPECT_EQ(std::memcmp(w.inv, v.inv, sizeof w.inv), 0) << "isa " << isa << " ray " << i;
-          EXPECT_EQ(std::memcmp(w.near_offset, v.near_offset, sizeof w.near_offset), 0) << "isa " << isa;
-          EXPECT_EQ(std::memcmp(w.far_offset, v.far_offset, sizeof w.far_offset), 0) << "isa " << isa;
+          EXPECT_EQ(w.octant, v.octant) << "isa " << isa << " ray " << i;
           EXPECT_EQ(std::memcmp(w.ball_o, v.ball_o, sizeof w.ball_o), 0) << "isa " << isa << " ray " << i;
           EXPECT_EQ(std::memcmp(w.ball_d, v.ball_d, sizeof w.ball_d), 0) << "isa " << isa << " ray " << i;
           EXPECT_EQ(std::memcmp(&w.ball_margin, &v.ball_margin, sizeof w.ball_margin), 0) << "isa " << isa;
@@ -505,8 +531,9 @@ TEST(RayWideBvh, RecordSetupMatchesTheArraySetupBitwise) {
         by_array(sin, b, n, want, want_status);
         for (std::size_t l = 0; l < n; ++l) {
           ASSERT_EQ(got_status[l], want_status[l]) << "isa " << isa << " ray " << order[b + l];
-          // The 22 four-byte fields before `balls`: lanes compute them for every ray, valid or not.
-          ASSERT_EQ(std::memcmp(&got[l], &want[l], offsetof(WideRay, balls)), 0) << "isa " << isa << " ray " << order[b + l];
+          // The 17 four-byte fields before `balls`: lanes compute them for every ray, valid or not.
+          ASSERT_EQ(std::memcmp(&got[l], &want[l], offsetof(WideRay, octant) + sizeof(std::uint32_t)), 0)
+              << "isa " << isa << " ray " << order[b + l];
           EXPECT_EQ(got[l].balls, nullptr);
           EXPECT_FALSE(got[l].prefetch);
         }
