@@ -99,6 +99,46 @@ __attribute__((noinline)) void scan_hull_avx2(const double* v, std::uint32_t cou
     _mm256_storeu_pd(index + j0, found);
   }
 }
+
+// q_j = v_index[j] - s0 for the n samples of a hull without inflation, a masked load, subtraction and store of three
+// coordinates each (the scalar copy was ~19 instructions a sample with its index conversions and bound tests).
+__attribute__((noinline)) void hull_differences_avx2(const double* v, const double* index, std::size_t n,
+                                                     const double* s0, double* q) {
+  const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
+  const __m256d base = _mm256_maskload_pd(s0, three);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double* p = v + 3 * static_cast<std::size_t>(index[j]);
+    _mm256_maskstore_pd(q + 3 * j, three, _mm256_sub_pd(_mm256_maskload_pd(p, three), base));
+  }
+}
+// The sample sums of smoothed_support_estimate() with row r of s_rc = sum_j +-(S_r - s0_r) z_c in one AVX2 register
+// (lane 3 unused): the same products and the same order of additions per entry as its SSE2 form, half the
+// instructions (one broadcast, product and sum per row and sample instead of a pair, a scalar and their moves).
+// Then, as the SSE2 path's tail, H = sum / scale and S = 0.5 (H + H^T) (written to S: symmetric, so either order), the
+// rows divided in registers and H^T by a register transpose instead of nine scalar divisions and Eigen's expression.
+__attribute__((noinline)) void sample_sums_avx2(const double* q, const double* const* z, std::size_t draws,
+                                                std::size_t n, double scale, double* S) {
+  __m256d s[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+  for (std::size_t k = 0; k < draws; ++k) {
+    const __m256d zk = _mm256_setr_pd(z[0][k], z[1][k], z[2][k], 0.0);
+    const double* qj = q + 6 * k;
+    for (int r = 0; r < 3; ++r) s[r] = _mm256_add_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qj + r), zk));
+    if (2 * k + 1 < n)
+      for (int r = 0; r < 3; ++r) s[r] = _mm256_sub_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qj + 3 + r), zk));
+  }
+  const __m256d by = _mm256_set1_pd(scale), half = _mm256_set1_pd(0.5), zero = _mm256_setzero_pd();
+  const __m256d h0 = _mm256_div_pd(s[0], by), h1 = _mm256_div_pd(s[1], by), h2 = _mm256_div_pd(s[2], by);
+  const __m256d t0 = _mm256_unpacklo_pd(h0, h1), t1 = _mm256_unpackhi_pd(h0, h1);    // h00 h10 h02 h12, h01 h11 ..
+  const __m256d t2 = _mm256_unpacklo_pd(h2, zero), t3 = _mm256_unpackhi_pd(h2, zero);  // h20 0 h22 0, h21 0 ..
+  const __m256d c0 = _mm256_permute2f128_pd(t0, t2, 0x20), c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
+  const __m256d c2 = _mm256_permute2f128_pd(t0, t2, 0x31);  // columns 0, 1, 2 of H (lane 3: 0)
+  double rows[3][4];
+  _mm256_storeu_pd(rows[0], _mm256_mul_pd(half, _mm256_add_pd(h0, c0)));
+  _mm256_storeu_pd(rows[1], _mm256_mul_pd(half, _mm256_add_pd(h1, c1)));
+  _mm256_storeu_pd(rows[2], _mm256_mul_pd(half, _mm256_add_pd(h2, c2)));
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) S[3 * r + c] = rows[r][c];
+}
 #pragma GCC pop_options
 
 }  // namespace
@@ -124,10 +164,25 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
                         buffer.data() + 2 * n4};  // u + e z_j by coordinate, padded with zeros to 4
   double* const q = buffer.data() + 3 * n4;       // S(u + e z_j) - s0, 3 per sample, then a scan's n4 indices
   // Sample 2k adds e z_k, its antithetic copy 2k+1 subtracts it: u + e (-z) and u - e z are the same bits.
+  // Two draws per SSE2 register (the same products and sums; the scalar loop, ~24 instructions per two draws and
+  // coordinate, was ~70 per side at M = 4, callgrind): {u + e z_k, u + e z_k+1} and {u - e z_k, u - e z_k+1}
+  // interleaved to the samples' order.
+  const V2 ev = V2{} + e;
+#pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
     const double uc = u[c];
+    const V2 uv = V2{} + uc;
     double* dc = d[c];
-    for (std::size_t k = 0; k < draws; ++k) {  // an odd M's unused copy lands in the padding (n4 > n)
+    std::size_t k = 0;
+    for (; k + 2 <= draws; k += 2) {  // an odd M's unused copy lands in the padding (n4 > n)
+      V2 zk;
+      std::memcpy(&zk, z[c] + k, sizeof zk);
+      const V2 ez = ev * zk, plus = uv + ez, minus = uv - ez;
+      const V2 first = __builtin_shufflevector(plus, minus, 0, 2), second = __builtin_shufflevector(plus, minus, 1, 3);
+      std::memcpy(dc + 2 * k, &first, sizeof first);
+      std::memcpy(dc + 2 * k + 2, &second, sizeof second);
+    }
+    if (k < draws) {
       const double ez = e * z[c][k];
       dc[2 * k] = uc + ez;
       dc[2 * k + 1] = uc - ez;
@@ -140,9 +195,15 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     // then the sample points.
     const double* v = view.hull->vertices;
     double* const index_of = q + 3 * n;  // the first maximum's vertex of each direction (n4 of them)
-    if (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) scan_hull_avx2(v, view.hull->vertex_count, d, n4, index_of);
+    std::size_t j_done = 0;  // directions whose sample differences are written
+    const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;
+    if (wide) scan_hull_avx2(v, view.hull->vertex_count, d, n4, index_of);
     else scan_hull_sse2(v, view.hull->vertex_count, d, n4, index_of);
-    for (std::size_t j0 = 0; j0 < n4; j0 += 4) {
+    if (wide && core.radius == 0.0) {
+      hull_differences_avx2(v, index_of, n, s0.data(), q);
+      j_done = n4;
+    }
+    for (std::size_t j0 = j_done; j0 < n4; j0 += 4) {
       const double* const index = index_of + j0;
       const std::size_t lanes = std::min<std::size_t>(4, n - j0);
       if (core.radius == 0.0) {
@@ -168,7 +229,8 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
     for (std::size_t j = 0; j < n; j += 2) {
       V2 dx, dy, dz;
-      std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy), std::memcpy(&dz, d[2] + j, sizeof dz);
+      std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy);
+      std::memcpy(&dz, d[2] + j, sizeof dz);
       const V2 ax = rx * dx, ay = ry * dy, az = rz * dz;
       const V2 m = _mm_sqrt_pd((ax * ax + ay * ay) + az * az);
       const M2 zero = m == 0.0;
@@ -182,27 +244,34 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
       for (int r = 0; r < 3; ++r) q[3 * j + r] = p[r] - s0[r];
     }
   }
-  // Each entry s_rc still adds (S_r - s0_r) z_c sample after sample, row r's three entries in one SSE2 pair and a
-  // scalar (q (-z) added is q z subtracted, exactly).
-  using V2 = double __attribute__((vector_size(16)));
-  V2 s01[3] = {}, s2v = {};
-  double s22 = 0.0;
-  const auto add = [&](const double* qj, const V2 z01, double z2v, bool minus) {
-    for (int r = 0; r < 3; ++r) {
-      const V2 t = qj[r] * z01;
-      s01[r] = minus ? s01[r] - t : s01[r] + t;
+  // Each entry s_rc still adds (S_r - s0_r) z_c sample after sample (q (-z) added is q z subtracted, exactly).
+  double sum[3][4];
+  if (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) {
+    Eigen::Matrix3d S;
+    sample_sums_avx2(q, z, draws, n, static_cast<double>(samples) * e, S.data());
+    return S;
+  } else {
+    // Row r's three entries in one SSE2 pair and a scalar.
+    V2 s01[3] = {}, s2v = {};
+    double s22 = 0.0;
+    const auto add = [&](const double* qj, const V2 z01, double z2v, bool minus) {
+      for (int r = 0; r < 3; ++r) {
+        const V2 t = qj[r] * z01;
+        s01[r] = minus ? s01[r] - t : s01[r] + t;
+      }
+      const V2 q01 = {qj[0], qj[1]}, t2 = q01 * z2v;
+      const double t22 = qj[2] * z2v;
+      s2v = minus ? s2v - t2 : s2v + t2;
+      s22 = minus ? s22 - t22 : s22 + t22;
+    };
+    for (std::size_t k = 0; k < draws; ++k) {
+      const V2 z01 = {z[0][k], z[1][k]};
+      add(q + 6 * k, z01, z[2][k], false);
+      if (2 * k + 1 < n) add(q + 6 * k + 3, z01, z[2][k], true);
     }
-    const V2 q01 = {qj[0], qj[1]}, t2 = q01 * z2v;
-    const double t22 = qj[2] * z2v;
-    s2v = minus ? s2v - t2 : s2v + t2;
-    s22 = minus ? s22 - t22 : s22 + t22;
-  };
-  for (std::size_t k = 0; k < draws; ++k) {
-    const V2 z01 = {z[0][k], z[1][k]};
-    add(q + 6 * k, z01, z[2][k], false);
-    if (2 * k + 1 < n) add(q + 6 * k + 3, z01, z[2][k], true);
+    for (int r = 0; r < 3; ++r) sum[r][0] = s01[r][0], sum[r][1] = s01[r][1];
+    sum[0][2] = s2v[0], sum[1][2] = s2v[1], sum[2][2] = s22;
   }
-  const double sum[3][3] = {{s01[0][0], s01[0][1], s2v[0]}, {s01[1][0], s01[1][1], s2v[1]}, {s01[2][0], s01[2][1], s22}};
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
