@@ -111,6 +111,34 @@ __attribute__((noinline)) void hull_differences_avx2(const double* v, const doub
     _mm256_maskstore_pd(q + 3 * j, three, _mm256_sub_pd(_mm256_maskload_pd(p, three), base));
   }
 }
+// The ellipsoid branch of smoothed_support_estimate() (kernels::support()'s formula in its order, zero where
+// |r .* d| = 0) four directions per AVX2 register, and q_j = S(d_j) - s0 transposed to three coordinates a sample by
+// register shuffles and masked stores: the same bits, half the SSE2 form's instructions per sample.
+__attribute__((noinline)) void ellipsoid_differences_avx2(const double* radii, const double* const* d, std::size_t n,
+                                                          const double* s0, double* q) {
+  const __m256d rx = _mm256_set1_pd(radii[0]), ry = _mm256_set1_pd(radii[1]), rz = _mm256_set1_pd(radii[2]);
+  const __m256d bx = _mm256_set1_pd(s0[0]), by = _mm256_set1_pd(s0[1]), bz = _mm256_set1_pd(s0[2]);
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
+  for (std::size_t j = 0; j < n; j += 4) {  // the directions are padded with zeros to a multiple of 4
+    const __m256d ax = _mm256_mul_pd(rx, _mm256_loadu_pd(d[0] + j));
+    const __m256d ay = _mm256_mul_pd(ry, _mm256_loadu_pd(d[1] + j));
+    const __m256d az = _mm256_mul_pd(rz, _mm256_loadu_pd(d[2] + j));
+    const __m256d m = _mm256_sqrt_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, ax), _mm256_mul_pd(ay, ay)), _mm256_mul_pd(az, az)));
+    const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
+    const auto point = [&](__m256d r, __m256d a, __m256d base) {
+      return _mm256_sub_pd(_mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r, a), m), zero, at_zero), base);
+    };
+    const __m256d X = point(rx, ax, bx), Y = point(ry, ay, by), Z = point(rz, az, bz);
+    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y);  // x0 y0 x2 y2, x1 y1 x3 y3
+    const __m256d t2 = _mm256_unpacklo_pd(Z, zero), t3 = _mm256_unpackhi_pd(Z, zero);
+    const __m256d rows[4] = {_mm256_permute2f128_pd(t0, t2, 0x20), _mm256_permute2f128_pd(t1, t3, 0x20),
+                             _mm256_permute2f128_pd(t0, t2, 0x31), _mm256_permute2f128_pd(t1, t3, 0x31)};
+    for (std::size_t l = 0; l < 4 && j + l < n; ++l) _mm256_maskstore_pd(q + 3 * (j + l), three, rows[l]);
+  }
+}
+
 // The sample sums of smoothed_support_estimate() with row r of s_rc = sum_j +-(S_r - s0_r) z_c in one AVX2 register
 // (lane 3 unused): the same products and the same order of additions per entry as its SSE2 form, half the
 // instructions (one broadcast, product and sum per row and sample instead of a pair, a scalar and their moves).
@@ -226,17 +254,21 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     // kernels::support()'s ellipsoid, two directions per SSE2 register with its operations in its order (rd = r .* d,
     // m = sqrt((rd_x^2 + rd_y^2) + rd_z^2), (r .* rd) / m, zero where m == 0): the same bits without a call per
     // sample (~47 instructions each, callgrind). The directions are padded with zeros to n4.
-    const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
-    for (std::size_t j = 0; j < n; j += 2) {
-      V2 dx, dy, dz;
-      std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy);
-      std::memcpy(&dz, d[2] + j, sizeof dz);
-      const V2 ax = rx * dx, ay = ry * dy, az = rz * dz;
-      const V2 m = _mm_sqrt_pd((ax * ax + ay * ay) + az * az);
-      const M2 zero = m == 0.0;
-      const V2 p[3] = {zero ? V2{} : (rx * ax) / m, zero ? V2{} : (ry * ay) / m, zero ? V2{} : (rz * az) / m};
-      for (std::size_t l = 0; l < 2 && j + l < n; ++l)
-        for (int r = 0; r < 3; ++r) q[3 * (j + l) + r] = p[r][l] - s0[r];
+    if (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) {
+      ellipsoid_differences_avx2(core.size.data(), d, n, s0.data(), q);
+    } else {
+      const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
+      for (std::size_t j = 0; j < n; j += 2) {
+        V2 dx, dy, dz;
+        std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy);
+        std::memcpy(&dz, d[2] + j, sizeof dz);
+        const V2 ax = rx * dx, ay = ry * dy, az = rz * dz;
+        const V2 m = _mm_sqrt_pd((ax * ax + ay * ay) + az * az);
+        const M2 zero = m == 0.0;
+        const V2 p[3] = {zero ? V2{} : (rx * ax) / m, zero ? V2{} : (ry * ay) / m, zero ? V2{} : (rz * az) / m};
+        for (std::size_t l = 0; l < 2 && j + l < n; ++l)
+          for (int r = 0; r < 3; ++r) q[3 * (j + l) + r] = p[r][l] - s0[r];
+      }
     }
   } else {
     for (std::size_t j = 0; j < n; ++j) {
