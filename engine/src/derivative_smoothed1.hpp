@@ -1,7 +1,8 @@
-// smoothed1's last per-pair steps, the PSD projection of each shape's symmetrised support-Jacobian estimate and its
-// rotation to the world frame (H = R P R^T), for a store block's smooth pairs together in SIMD lanes instead of pair
-// by pair: the eigenvalues' Jacobi sweeps are a chain of divisions and square roots, ~1100 instructions per pair in
-// scalar / two-lane code with the projection and the two 3x3 products (callgrind AVX2, convex8 M = 4).
+// smoothed1's support-Jacobian estimate (smoothed_support_estimate(), derivative_smoothed1_estimate.cpp) and its last
+// per-pair steps, the PSD projection of each shape's estimate and its rotation to the world frame (H = R P R^T), for a
+// store block's smooth pairs together in SIMD lanes instead of pair by pair (derivative_smoothed1.cpp): the
+// eigenvalues' Jacobi sweeps are a chain of divisions and square roots, ~1100 instructions per pair in scalar /
+// two-lane code with the projection and the two 3x3 products (callgrind AVX2, convex8 M = 4).
 #pragma once
 
 #include "batchcol/shapes.hpp"

@@ -302,8 +302,10 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     double* const z_b[4] = {noise.data() + 4 * draws, noise.data() + 5 * draws, noise.data() + 6 * draws,
                             noise.data() + 7 * draws};
     kernels::simd::draw_gaussians4_streams(isa, splitmix64(splitmix64(o.seed) ^ i), 1, 2, 0, draws, z_a, z_b);
-    Eigen::Matrix3d S_a = smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
-    Eigen::Matrix3d S_b = smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b, isa);
+    Eigen::Matrix3d S_a =
+        smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
+    Eigen::Matrix3d S_b =
+        smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b, isa);
     // Separated pairs (every smooth_pair(): smoothed1 has no flats): the projections and rotations for the block's
     // pairs together at the flush, with these bits.
     if (smooth_pair(g)) {
