@@ -292,6 +292,23 @@ void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* 
   side(b, curved_b, g.H_b);
 }
 
+void SmoothLanes::add_given(std::size_t col, const PairGeometry& g) {
+  const std::size_t l = count++;
+  column[l] = col;
+  sd[l] = g.distance;
+  for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+  if (!given && l > 0) {  // the lanes before have curved sides without H0 (add()'s zeroing)
+    for (int e = 0; e < 9; ++e)
+      for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
+  }
+  given = true;
+  for (Side* s : {&a, &b}) {
+    for (int k = 0; k < 4; ++k) s->q[k][l] = 0.0;
+    for (int i = 0; i < 3; ++i) s->radii2[i][l] = 0.0;
+    s->round[l] = 0.0;
+  }
+}
+
 namespace {
 
 // Polytopes without inflation (H_a = H_b = 0) separated, with up to two independent flats (vertex-vertex,

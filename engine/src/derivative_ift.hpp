@@ -29,6 +29,7 @@
 #include "batchcol/types.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross() in distance_gradients()
 
 #include <cstddef>
 
@@ -129,6 +130,9 @@ struct SmoothLanes {
   /// The next lane takes pair g, for output column `column`; a null side uses g.H_a / g.H_b.
   void add(std::size_t column, const PairGeometry& g, const CurvedSide* curved_a = nullptr,
            const CurvedSide* curved_b = nullptr);
+  /// The next lane takes pair g with H0 of both sides left to the caller (written before solve(): smoothed1's
+  /// Smoothed1Lanes), for output column `column`: add(column, g) without g.H_a, g.H_b.
+  void add_given(std::size_t column, const PairGeometry& g);
   /// Writes the 120 entries of every lane l < count to out[e][column[l]] (write_jacobians()'s order; out[e] points
   /// to column 0 of entry e: a block buffer's row or the output array itself). Whole registers are stored when
   /// the columns are 0, 1, 2, ... (a block of smooth pairs only), single lanes otherwise.

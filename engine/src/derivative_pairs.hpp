@@ -3,6 +3,7 @@
 
 #include "batchcol/derivatives.hpp"
 #include "derivative_ift.hpp"
+#include "derivative_smoothed1.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -67,6 +68,15 @@ class StoreBlock {
     slot(i);
     smooth_.add(count_ - 1, g, curved_a, curved_b);
   }
+  /// Queues smoothed1 pair i (smooth_pair(g); g's H_a, H_b are not read) for the block's SmoothLanes, its world
+  /// curvatures R psd_projection(S) R^T computed at the flush for the block's pairs together (Smoothed1Lanes).
+  void add_smoothed1(std::size_t i, const PairGeometry& g, const Eigen::Matrix3d& S_a, const Eigen::Matrix3d& S_b,
+                     const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+    slot(i);
+    const std::size_t l = smooth_.count;
+    smooth_.add_given(count_ - 1, g);
+    smoothed1_.set(l, S_a, S_b, R_a, R_b);
+  }
   /// Queues pair i (polytope_pair(g)) for the block's PolytopeLanes; returns null, or pair i's slot to be written by
   /// the caller when its flats are dependent (no lane taken).
   double* add_polytope(std::size_t i, const PairGeometry& g) {
@@ -92,6 +102,7 @@ class StoreBlock {
   bool have_rows_ = false;
   SmoothLanes smooth_{};  // value-initialised: an unused register half is computed (not written) on initialised numbers
   PolytopeLanes polytope_{};
+  Smoothed1Lanes smoothed1_{};  // smoothed1: the pending curvatures of smooth_'s lanes
   std::size_t first_ = 0, count_ = 0;
 };
 

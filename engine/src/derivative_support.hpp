@@ -135,15 +135,12 @@ Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H);
 /// sweeps share SSE2 registers.
 void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B);
 
-/// The smoothed support-map Jacobian at unit local direction u before its projection (psd_projection()):
-/// 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k}
-/// (the baseline S(u) cancels within a pair), symmetrised. The Hessian of the smoothed convex support function is
-/// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
-/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
-/// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
-/// caller draws it: kernels::simd::draw_gaussians4_streams() for both sides of a pair). `view`: the shape's plain
-/// record (ShapeTableAccess::view()).
-Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
-                                          const double* const* z);
+/// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
+/// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.
+inline void add_swept_radius(Eigen::Vector3d& p, double radius, const Eigen::Vector3d& d) {
+  if (!(radius > 0.0)) return;
+  const double n = d.norm();
+  if (n > 0.0) p += radius * d / n;
+}
 
 }  // namespace batchcol::detail

@@ -81,6 +81,7 @@ void StoreBlock::flush() {
   if (!have_rows_) entry_rows(d, 0, rows_), have_rows_ = true;
   double* const* const rows = rows_;
   const std::size_t at = first_;
+  if (smoothed1_.pending != 0) smoothed1_.finish(smooth_, isa), smoothed1_.clear();
   if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
     smooth_.solve(rows, normal_b_only, isa, at);
   } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
@@ -301,8 +302,17 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     double* const z_b[4] = {noise.data() + 4 * draws, noise.data() + 5 * draws, noise.data() + 6 * draws,
                             noise.data() + 7 * draws};
     kernels::simd::draw_gaussians4_streams(isa, splitmix64(splitmix64(o.seed) ^ i), 1, 2, 0, draws, z_a, z_b);
-    Eigen::Matrix3d S_a = smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a);
-    Eigen::Matrix3d S_b = smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b);
+    Eigen::Matrix3d S_a =
+        smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
+    Eigen::Matrix3d S_b =
+        smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b, isa);
+    // Separated pairs (every smooth_pair(): smoothed1 has no flats): the projections and rotations for the block's
+    // pairs together at the flush, with these bits.
+    if (smooth_pair(g)) {
+      out.add_smoothed1(i, g, S_a, S_b, R_a, R_b);
+      d.status[i] = status;
+      return;
+    }
     psd_projection_pair(S_a, S_b);
     g.H_a = R_a * S_a * R_a.transpose();
     g.H_b = R_b * S_b * R_b.transpose();
