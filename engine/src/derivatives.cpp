@@ -158,34 +158,18 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   g.normal = results.normal[i];
   if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite()) return false;
   const auto& hulls = ShapeTableAccess::hulls(shapes);
-  // n in each hull's frame (b's reversed), both sides in one SSE2 register with the bits of the per-side Eigen
-  // expressions (q.normalized(), sign * (unit.conjugate() * n)).
-  Eigen::Quaterniond unit_a, unit_b;
-  Eigen::Vector3d u[2];
-  hull_pair_directions(batch.rotation_a[i], batch.rotation_b[i], g.normal, unit_a, unit_b, u[0], u[1]);
-  // Both sides' features in one call (exposed_feature_pair()); `side` is forced inline because GCC otherwise kept it
-  // out of line once the features moved out of it (~58 instructions per hull pair, callgrind AVX2).
-  int features[2];
-  Eigen::Vector3d edges[2];
+  // Both sides' flats in one call (hull_pair_flats(): n in each hull's frame, b's reversed, with the bits of the
+  // per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the features n exposes; an edge's
+  // direction in the world orthogonal to n). A face's flats are only needed by the general path below
+  // (PolytopeLanes uses n).
+  int flats[2];
+  Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};
-  exposed_feature_pair(hulls[a], hulls[b], u, tolerance, features, edges, out.isa);
-  const auto side = [&](int s, const Eigen::Quaterniond& unit, Eigen::Matrix<double, 3, 2>& flat)
-                        __attribute__((always_inline)) {
-    const int feature = features[s];
-    if (feature == 1) {
-      Eigen::Vector3d e = unit * edges[s];
-      const double length = e.norm();
-      e -= g.normal.dot(e) * g.normal;
-      if (e.norm() > 1e-6 * length) {  // add_flat()'s test
-        flat.col(0) = e.normalized();
-        return 1;
-      }
-      return 0;
-    }
-    return feature;  // a face's flats are only needed by the general path below (PolytopeLanes uses n)
-  };
-  g.flats_a = side(0, unit_a, g.flat_a);
-  g.flats_b = side(1, unit_b, g.flat_b);
+  hull_pair_flats(batch.rotation_a[i], batch.rotation_b[i], g.normal, hulls[a], hulls[b], tolerance, flats, flat,
+                  out.isa);
+  g.flats_a = flats[0], g.flats_b = flats[1];
+  if (flats[0] == 1) g.flat_a.col(0) = flat[0];
+  if (flats[1] == 1) g.flat_b.col(0) = flat[1];
   const DerivativeStatus status =
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
