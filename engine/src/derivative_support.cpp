@@ -431,12 +431,13 @@ __attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices
 }  // namespace
 // hull_pair_directions(), feature_of_mask() and edge_flat() are inlined here (baseline code into an AVX2 function,
 // no FMA enabled), so their SSE2 operations take the VEX three-operand forms with the bits of the baseline code.
-void hull_pair_flats_avx2(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
+void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
                           const HullView& a, const HullView& b, const double* tolerance, int* flats,
                           Eigen::Vector3d* flat) {
   Eigen::Quaterniond unit[2];
   Eigen::Vector3d u[2], edge[2];
-  hull_pair_directions(q_a, q_b, n, unit[0], unit[1], u[0], u[1]);
+  hull_pair_directions(Lanes2{ra.x[i], rb.x[i]}, Lanes2{ra.y[i], rb.y[i]}, Lanes2{ra.z[i], rb.z[i]},
+                       Lanes2{ra.w[i], rb.w[i]}, n, unit[0], unit[1], u[0], u[1]);
   const std::uint32_t mask_a = exposed_mask_avx2_body(a.vertices, a.vertex_count, u[0], tolerance[0]);
   const std::uint32_t mask_b = exposed_mask_avx2_body(b.vertices, b.vertex_count, u[1], tolerance[1]);
   flats[0] = feature_of_mask(a.vertices, mask_a, edge[0]);

@@ -3,6 +3,7 @@
 // the slide "Randomized smoothing - 1st order"). Used by the implicit-function derivatives (derivative_ift.hpp).
 #pragma once
 
+#include "batchcol/pose.hpp"
 #include "batchcol/shapes.hpp"
 #include "batchcol/types.hpp"
 
@@ -71,12 +72,15 @@ SupportJacobian exposed_support_jacobian(const Shape& s, const Eigen::Vector3d& 
 /// (y^2 + w^2)); conjugate() negates x, y, z; q * v is _transformVector(): uv = q.vec() x v, uv += uv,
 /// (v + w uv) + q.vec() x uv; the sign is a product by +-1 (exact). Tested bitwise against Eigen
 /// (tests/engine/derivatives_lanes_test.cpp).
-inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
-                                 Eigen::Quaterniond& unit_a, Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
-                                 Eigen::Vector3d& u_b) {
-  using V = double __attribute__((vector_size(16)));
+/// The coefficients (x, y, z, w) come as SSE2 lanes (a in lane 0, b in lane 1) in the first form, as quaternions in
+/// the second.
+using Lanes2 = double __attribute__((vector_size(16)));
+inline __attribute__((always_inline)) void hull_pair_directions(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2 w,
+                                                                const Eigen::Vector3d& n, Eigen::Quaterniond& unit_a,
+                                                                Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
+                                                                Eigen::Vector3d& u_b) {
+  using V = Lanes2;
   using M = long long __attribute__((vector_size(16)));
-  V x = {q_a.x(), q_b.x()}, y = {q_a.y(), q_b.y()}, z = {q_a.z(), q_b.z()}, w = {q_a.w(), q_b.w()};
   const V s = (x * x + z * z) + (y * y + w * w);
   const V root = _mm_sqrt_pd(s);
   const M positive = s > 0.0;
@@ -95,6 +99,12 @@ inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Qua
   const V r2 = sign * ((n2 + w * uv2) + (cx * uv1 - cy * uv0));
   u_a = {r0[0], r1[0], r2[0]};
   u_b = {r0[1], r1[1], r2[1]};
+}
+inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
+                                 Eigen::Quaterniond& unit_a, Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
+                                 Eigen::Vector3d& u_b) {
+  hull_pair_directions(Lanes2{q_a.x(), q_b.x()}, Lanes2{q_a.y(), q_b.y()}, Lanes2{q_a.z(), q_b.z()},
+                       Lanes2{q_a.w(), q_b.w()}, n, unit_a, unit_b, u_a, u_b);
 }
 
 /// hull_pair()'s flat of an exposed edge (a local vector): e = unit * edge (Eigen 3.4's q * v, _transformVector():
@@ -126,21 +136,23 @@ inline __attribute__((always_inline)) bool edge_flat(const Eigen::Quaterniond& u
 /// operations in the same order: the same bits), where the baseline SSE2 code of the directions and edges needed a
 /// register copy for most of its two-operand operations: callgrind AVX2, convex8 analytic, 2331.7 -> 2303.3
 /// instructions per pair (the features alone: 116 + 81 in four calls, 156 in one).
-void hull_pair_flats_avx2(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
+/// The rotations are pair i's of ra (a) and rb (b), read straight into the lanes (building the two quaternions in
+/// memory for the call cost ~15 instructions per pair, callgrind AVX2).
+void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
                           const HullView& a, const HullView& b, const double* tolerance, int* flats,
                           Eigen::Vector3d* flat);
 
-inline __attribute__((always_inline)) void hull_pair_flats(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b,
+inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
                                                            const Eigen::Vector3d& n, const HullView& a,
                                                            const HullView& b, const double tolerance[2], int flats[2],
                                                            Eigen::Vector3d flat[2], InstructionSet isa) {
   constexpr std::uint32_t kKept = 16;
   if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count >= 4 &&
       a.vertex_count <= kKept && b.vertex_count >= 4 && b.vertex_count <= kKept)
-    return hull_pair_flats_avx2(q_a, q_b, n, a, b, tolerance, flats, flat);
+    return hull_pair_flats_avx2(ra, rb, i, n, a, b, tolerance, flats, flat);
   Eigen::Quaterniond unit[2];
   Eigen::Vector3d u[2], edge[2];
-  hull_pair_directions(q_a, q_b, n, unit[0], unit[1], u[0], u[1]);
+  hull_pair_directions(ra[i], rb[i], n, unit[0], unit[1], u[0], u[1]);
   flats[0] = exposed_feature(a.vertices, a.vertex_count, u[0], tolerance[0], edge[0], isa);
   flats[1] = exposed_feature(b.vertices, b.vertex_count, u[1], tolerance[1], edge[1], isa);
   for (int s = 0; s < 2; ++s)

@@ -165,7 +165,7 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   int flats[2];
   Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};
-  hull_pair_flats(batch.rotation_a[i], batch.rotation_b[i], g.normal, hulls[a], hulls[b], tolerance, flats, flat,
+  hull_pair_flats(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b], tolerance, flats, flat,
                   out.isa);
   g.flats_a = flats[0], g.flats_b = flats[1];
   if (flats[0] == 1) g.flat_a.col(0) = flat[0];

@@ -261,7 +261,9 @@ TEST(DerivativesLanes, HullPairFlatsFindEachSidesFeature) {
     for (const auto isa : isas) {
       int got[2];
       Eigen::Vector3d flat[2];
-      detail::hull_pair_flats(q[0], q[1], n, view(va), view(vb), tolerance, got, flat, isa);
+      QuatArray ra, rb;
+      ra.push_back(q[0]), rb.push_back(q[1]);
+      detail::hull_pair_flats(ra, rb, 0, n, view(va), view(vb), tolerance, got, flat, isa);
       for (int s = 0; s < 2; ++s) {
         const bool ok = got[s] == want[s] &&
                         (want[s] != 1 || std::memcmp(flat[s].data(), want_flat[s].data(), 3 * sizeof(double)) == 0);
