@@ -57,8 +57,8 @@ class StoreBlock {
   ~StoreBlock() { flush(); }
   /// The slot of pair i (entry e at slot[e * kStride]); every entry must be written before the next call.
   double* slot(std::size_t i) {
-    if (count_ == kStride || (count_ > 0 && i != first_ + count_)) flush();
-    if (count_ == 0) first_ = i;
+    // (An empty block flushes as a no-op and then starts at i.)
+    if (count_ == kStride || i != first_ + count_) flush(), first_ = i;
     return &buf_[0][count_++];
   }
   void add(std::size_t i, const PairJacobians& J);
