@@ -147,8 +147,9 @@ inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, 
                                                            const HullView& b, const double tolerance[2], int flats[2],
                                                            Eigen::Vector3d flat[2], InstructionSet isa) {
   constexpr std::uint32_t kKept = 16;
-  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count >= 4 &&
-      a.vertex_count <= kKept && b.vertex_count >= 4 && b.vertex_count <= kKept)
+  // 4 <= vertex_count <= kKept, each as one unsigned comparison
+  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count - 4 <= kKept - 4 &&
+      b.vertex_count - 4 <= kKept - 4)
     return hull_pair_flats_avx2(ra, rb, i, n, a, b, tolerance, flats, flat);
   Eigen::Quaterniond unit[2];
   Eigen::Vector3d u[2], edge[2];

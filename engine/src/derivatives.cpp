@@ -144,8 +144,10 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
                StoreBlock& out, PairGeometry& g) {
   if (results.status[i] != Status::converged) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
-  if (a >= shapes.size() || b >= shapes.size()) return false;
+  // The per-shape arrays grow with the table (ShapeTable::add()): types.size() is shapes.size() without its
+  // division by sizeof(Shape).
   const auto& types = ShapeTableAccess::types(shapes);
+  if (a >= types.size() || b >= types.size()) return false;
   const auto& inflations = ShapeTableAccess::inflations(shapes);
   if (types[a] != ShapeType::convex || types[b] != ShapeType::convex || inflations[a] != 0.0 ||
       inflations[b] != 0.0)
@@ -153,7 +155,8 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   const auto& radii = ShapeTableAccess::bounding_radii(shapes);
   g.distance = results.distance[i];
   g.scale = radii[a] + radii[b];
-  if (!(g.distance > 1e-9 * g.scale) || !std::isfinite(g.distance)) return false;  // touching, penetrating: general
+  // Touching, penetrating (and NaN): the general path; past the first test only +inf is not finite.
+  if (!(g.distance > 1e-9 * g.scale) || !(g.distance < std::numeric_limits<double>::infinity())) return false;
   g.witness_a = results.witness_a[i];
   g.witness_b = results.witness_b[i];
   g.normal = results.normal[i];
