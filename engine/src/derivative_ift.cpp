@@ -67,10 +67,13 @@ using V = double __attribute__((vector_size(16)));
 
 // A whole block (kLanes pairs to columns 0 .. kLanes - 1): the wide sets' one-register path, and run_lanes()'s
 // fixed-trip-count case.
+// (Early exits: the and-accumulating loop ran all `count` iterations, 7.5 instructions per analytic hull pair,
+// callgrind AVX2.)
 template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
-  bool in_order = count == kLanes;
-  for (std::size_t l = 0; l < count; ++l) in_order = in_order && column[l] == l;
-  return in_order;
+  if (count != kLanes) return false;
+  for (std::size_t l = 0; l < kLanes; ++l)
+    if (column[l] != l) return false;
+  return true;
 }
 
 // Runs body(l, both, put) for every register of two lanes l, l + 1 < count (both: the second lane is used), put(e,
@@ -130,6 +133,10 @@ inline __attribute__((always_inline)) V select_positive(const V& z, const V& a, 
 #pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
 namespace lanes_avx512 {
 namespace {
+// The wide blocks' output store, p[at .. at + 8) = v: one register.
+inline __attribute__((always_inline)) void store_lanes(double* p, std::size_t at, const V8& v) {
+  __builtin_memcpy(p + at, &v, sizeof v);
+}
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   // The masked form: _mm512_sqrt_pd()'s undefined source trips GCC 12's -Wuninitialized.
   return (V8)_mm512_mask_sqrt_pd((__m512d)x, 0xFF, (__m512d)x);
@@ -146,6 +153,14 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 #pragma GCC target("avx2")
 namespace lanes_avx2 {
 namespace {
+// Two halves stored at p + at and p + at + 4: for the 64-byte memcpy GCC added `at` to each of the 120 row pointers
+// (an add per entry, 117 a block, ~15 per pair) before its two stores; these take the indexed address form. With
+// polytope_lanes()' columns, the PolytopeLanes block went 1666 -> 1371 instructions (callgrind AVX2: 208 -> 171 a
+// hull pair), the smooth ellipsoid block 1705 -> 1567.
+inline __attribute__((always_inline)) void store_lanes(double* p, std::size_t at, const V8& v) {
+  _mm256_storeu_pd(p + at, __m256d{v[0], v[1], v[2], v[3]});
+  _mm256_storeu_pd(p + at + 4, __m256d{v[4], v[5], v[6], v[7]});
+}
 inline __attribute__((always_inline)) V8 sqrt_lanes(const V8& x) {
   const __m256d lo = _mm256_sqrt_pd(__m256d{x[0], x[1], x[2], x[3]});
   const __m256d hi = _mm256_sqrt_pd(__m256d{x[4], x[5], x[6], x[7]});
@@ -193,61 +208,6 @@ void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa, std::size_
   });
 }
 
-
-// PolytopeLanes: polytope_jacobians()'s closed forms with their case-dependent parts in P, G and W (see the header):
-//   no flats: P = G = W = 0 (y = F / sd, both points rigid);   a has none: G = 0, W = I (dx_b = P F);
-//   b has none: G = P [n]x, W = 0;   edge A of a, edge B of b: G = B' (A x n)^T / (A . B'), W = B A'^T / (B . A')
-//   (A' = n x A, B' = n x B).
-bool PolytopeLanes::add(std::size_t col, const PairGeometry& g) {
-  const int ka = g.flats_a, kb = g.flats_b, k = ka + kb;
-  const Eigen::Vector3d& nv = g.normal;
-  const std::size_t l = count;
-  // Each case stores the lane's 27 entries of P, G, W once, each an expression of its (i, j) that folds after
-  // unrolling (zeros as stores of 0). Zeroing the 27 entries first and storing the case's over them cost ~170
-  // instructions per hull pair (callgrind); building them in local arrays and copying those ~150.
-  const auto put = [&](const auto& pf, const auto& gf, const auto& wf) __attribute__((always_inline)) {
-#pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 3
-      for (int j = 0; j < 3; ++j) P[3 * i + j][l] = pf(i, j), G[3 * i + j][l] = gf(i, j), W[3 * i + j][l] = wf(i, j);
-  };
-  const auto zero = [](int, int) { return 0.0; };
-  const auto identity = [](int i, int j) { return i == j ? 1.0 : 0.0; };
-  const auto tangent = [&](int i, int j) { return (i == j ? 1.0 : 0.0) - nv(i) * nv(j); };  // I - n n^T
-  if (k == 1) {  // one edge (flats are unit and orthogonal to n): P = c c^T; G = P [n]x = c (c x n)^T for a's edge
-    const Eigen::Vector3d c = ka > 0 ? g.flat_a.col(0) : g.flat_b.col(0);
-    const auto edge = [&](int i, int j) { return c(i) * c(j); };
-    if (ka > 0) {
-      const Eigen::Vector3d cn = c.cross(nv);
-      put(edge, [&](int i, int j) { return c(i) * cn(j); }, zero);
-    } else {
-      put(edge, zero, identity);
-    }
-  } else if (k == 2) {  // two independent flats orthogonal to n span its tangent plane: P = I - n n^T
-    if (ka == 1) {  // edge A against edge B; independent when A . (n x B) = +-|A x B| is not ~0 (polytope_jacobians'
-                    // test: what is left of one unit flat after removing the other)
-      const Eigen::Vector3d A = g.flat_a.col(0), B = g.flat_b.col(0);
-      const Eigen::Vector3d B_perp = nv.cross(B), A_perp = nv.cross(A), An = A.cross(nv);
-      const double s = A.dot(B_perp);
-      if (!(std::abs(s) > 1e-6)) return false;
-      const double t = B.dot(A_perp);
-      put(tangent, [&](int i, int j) { return B_perp(i) * (An(j) / s); },
-          [&](int i, int j) { return B(i) * (A_perp(j) / t); });
-    } else if (ka == 2) {  // a's face against b's vertex: G = P [n]x = [n]x (n^T [n]x = 0)
-      const double cross[9] = {0.0, -nv.z(), nv.y(), nv.z(), 0.0, -nv.x(), -nv.y(), nv.x(), 0.0};
-      put(tangent, [&](int i, int j) { return cross[3 * i + j]; }, zero);
-    } else {  // a's vertex against b's face
-      put(tangent, zero, identity);
-    }
-  } else {  // no flats: both points rigid
-    put(zero, zero, zero);
-  }
-  ++count;
-  column[l] = col;
-  sd[l] = g.distance;
-  for (int i = 0; i < 3; ++i) n[i][l] = nv(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
-  return true;
-}
 
 void PolytopeLanes::solve(double* const* out, InstructionSet isa, std::size_t at) const {
   if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))

@@ -167,8 +167,8 @@ struct PolytopeLanes {
   void clear() { count = 0; }
   /// The next lane takes pair g (g.H_a = g.H_b = 0, separated beyond the singularity threshold, flats_a + flats_b
   /// <= 2), for output column `column`. Returns false, taking no lane, when two flats are dependent (parallel
-  /// edges): the general path decides.
-  bool add(std::size_t column, const PairGeometry& g);
+  /// edges): the general path decides. Defined in derivative_polytope_add.hpp, inlined into its caller.
+  inline bool add(std::size_t column, const PairGeometry& g);
   /// As SmoothLanes::solve().
   void solve(double* const* out, InstructionSet isa = InstructionSet::scalar, std::size_t at = 0) const;
 };

@@ -6,8 +6,8 @@
 // writes the same bits. Everything here has internal linkage and is inlined: no AVX code can be shared with
 // baseline code through a weak symbol.
 //
-// The includer declares sqrt_lanes(V) (its set's vector square root) and select_positive(z, a, b) (z > 0 ? a : b
-// lane by lane) before the include.
+// The includer declares sqrt_lanes(V) (its set's vector square root), select_positive(z, a, b) (z > 0 ? a : b
+// lane by lane) and, for the 8-lane sets, store_lanes(p, at, v) (p[at .. at + 8) = v) before the include.
 //
 // No include guard.
 
@@ -28,25 +28,29 @@ inline __attribute__((always_inline)) void load3(const double (&rows)[3][N], std
 // Writes the 120 entries of a register of lanes through put(e, value): the distance gradients by the envelope
 // theorem from n, x_a, x_b, and for each entry (i, j) of the 3x6 derivatives with respect to the twist of a, given
 // by entry(i, j, wa, wb, dn) (dx_a/dxi_a, dx_b/dxi_a, dn/dxi_a), those and the twist of b's by the rigid-motion
-// identity (write_from_twist_a()'s order and formulas).
+// identity (write_from_twist_a()'s order and formulas). n(i), xa(i), xb(i) return coordinate i (a register, or a
+// load where the caller wants its operands read from memory at each use); the entries go column by column (j outer),
+// so that a caller can compute its operands one column at a time (polytope_lanes()).
 // kNormalB: only normal_wrt_b (the 18 entries from store_at::normal_b), the smoothed0 samples' first-order start
 // (dn/dxi_b); the other entries are neither computed nor written.
-template <bool kNormalB = false, class V, class Put, class Entry>
-inline __attribute__((always_inline)) void put_outputs(const Put& put, const V (&n)[3], const V (&xa)[3], const V (&xb)[3], const Entry& entry) {
+template <bool kNormalB = false, class Put, class Vec, class Entry>
+inline __attribute__((always_inline)) void put_outputs(const Put& put, const Vec& n, const Vec& xa, const Vec& xb,
+                                                       const Entry& entry) {
+  using V = decltype(n(0));
   // put() for the entries kNormalB keeps: after unrolling, e is a constant and the test folds away.
   const auto keep = [&](int e, const V& v) {
     if (!kNormalB || e >= store_at::normal_b) put(e, v);
   };
-  keep(0, -n[0]), keep(1, -n[1]), keep(2, -n[2]);
-  keep(3, n[1] * xa[2] - n[2] * xa[1]), keep(4, n[2] * xa[0] - n[0] * xa[2]), keep(5, n[0] * xa[1] - n[1] * xa[0]);
-  keep(6, n[0]), keep(7, n[1]), keep(8, n[2]);
-  keep(9, xb[1] * n[2] - xb[2] * n[1]), keep(10, xb[2] * n[0] - xb[0] * n[2]), keep(11, xb[0] * n[1] - xb[1] * n[0]);
+  keep(0, -n(0)), keep(1, -n(1)), keep(2, -n(2));
+  keep(3, n(1) * xa(2) - n(2) * xa(1)), keep(4, n(2) * xa(0) - n(0) * xa(2)), keep(5, n(0) * xa(1) - n(1) * xa(0));
+  keep(6, n(0)), keep(7, n(1)), keep(8, n(2));
+  keep(9, xb(1) * n(2) - xb(2) * n(1)), keep(10, xb(2) * n(0) - xb(0) * n(2)), keep(11, xb(0) * n(1) - xb(1) * n(0));
   // Unrolled: with (i, j) constants the case tests vanish and the operands stay in registers; rolled, GCC kept
   // this a loop over stack arrays with the tests inside (~2.8x the instructions of the PolytopeLanes solve).
-#pragma GCC unroll 3
-  for (int i = 0; i < 3; ++i)
 #pragma GCC unroll 6
-    for (int j = 0; j < 6; ++j) {
+  for (int j = 0; j < 6; ++j)
+#pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i) {
       const int e = 6 * i + j;
       V wa, wb, dn;
       entry(i, j, wa, wb, dn);
@@ -65,11 +69,11 @@ inline __attribute__((always_inline)) void put_outputs(const Put& put, const V (
         const int k = j - 3, other = 3 - i - k;
         // -[x]x(i, k) = eps(i, k, other) x_other
         if ((i + 1) % 3 == k) {
-          keep(store_at::witness_a_b + e, xa[other] - wa), keep(store_at::witness_b_b + e, xb[other] - wb);
-          keep(store_at::normal_b + e, n[other] - dn);
+          keep(store_at::witness_a_b + e, xa(other) - wa), keep(store_at::witness_b_b + e, xb(other) - wb);
+          keep(store_at::normal_b + e, n(other) - dn);
         } else {
-          keep(store_at::witness_a_b + e, -xa[other] - wa), keep(store_at::witness_b_b + e, -xb[other] - wb);
-          keep(store_at::normal_b + e, -n[other] - dn);
+          keep(store_at::witness_a_b + e, -xa(other) - wa), keep(store_at::witness_b_b + e, -xb(other) - wb);
+          keep(store_at::normal_b + e, -n(other) - dn);
         }
       }
     }
@@ -157,7 +161,8 @@ inline __attribute__((always_inline)) void smooth_lanes(const SmoothLanes& s, st
       }
     V nY[6];
     for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
-    put_outputs<kNormalB>(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
+    const auto row = [](const V (&v)[3]) { return [&v](int i) __attribute__((always_inline)) { return v[i]; }; };
+    put_outputs<kNormalB>(put, row(n), row(xa), row(xb), [&](int i, int j, V& wa, V& wb, V& dn) {
       wb = Hb[i][0] * Y[0][j] + Hb[i][1] * Y[1][j] + Hb[i][2] * Y[2][j];
       wa = wb + d * Y[i][j];
       dn = n[i] * nY[j] - Y[i][j];
@@ -169,38 +174,46 @@ inline __attribute__((always_inline)) void smooth_lanes(const SmoothLanes& s, st
 template <class V, class Put>
 inline __attribute__((always_inline)) void polytope_lanes(const PolytopeLanes& lanes, std::size_t l, const Put& put) {
   {
-    const V d = load<V>(&lanes.sd[l]);
-    V n[3], xa[3], xb[3];
-    load3(lanes.n, l, n), load3(lanes.xa, l, xa), load3(lanes.xb, l, xb);
-    const V inv = 1.0 / d;
-    // Y = y and R = F - sd y = [P, -[x_a]x + (I - P) [x_a]x - sd G]; row i of M [x]x is (row i of M) x x.
-    V Y[3][6], R[3][6];
-    for (int i = 0; i < 3; ++i) {
-      V Ip[3], Gi[3];
-      for (int j = 0; j < 3; ++j) {
-        const V p = load<V>(&lanes.P[3 * i + j][l]);
-        Ip[j] = (i == j ? 1.0 : 0.0) - p;
-        Gi[j] = load<V>(&lanes.G[3 * i + j][l]);
-        Y[i][j] = Ip[j] * inv;
-        R[i][j] = p;
-      }
-      const V c[3] = {Ip[1] * xa[2] - Ip[2] * xa[1], Ip[2] * xa[0] - Ip[0] * xa[2], Ip[0] * xa[1] - Ip[1] * xa[0]};
-      for (int j = 0; j < 3; ++j) {
-        Y[i][3 + j] = Gi[j] - c[j] * inv;
-        R[i][3 + j] = c[j] - d * Gi[j];
-      }
-    }
-    // -[x_a]x: x_2 at (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
-    R[0][4] += xa[2], R[0][5] -= xa[1], R[1][3] -= xa[2], R[1][5] += xa[0], R[2][3] += xa[1], R[2][4] -= xa[0];
-    V Wr[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) Wr[i][j] = load<V>(&lanes.W[3 * i + j][l]);
-    V nY[6];
-    for (int j = 0; j < 6; ++j) nY[j] = n[0] * Y[0][j] + n[1] * Y[1][j] + n[2] * Y[2][j];
+    const V inv = 1.0 / load<V>(&lanes.sd[l]);
+    const auto d = [&] { return load<V>(&lanes.sd[l]); };
+    const auto row = [l](const double (&rows)[3][PolytopeLanes::kLanes]) {
+      return [&rows, l](int i) __attribute__((always_inline)) { return load<V>(&rows[i][l]); };
+    };
+    const auto n = row(lanes.n), xa = row(lanes.xa), xb = row(lanes.xb);
+    const auto Wr = [&](int i, int j) __attribute__((always_inline)) { return load<V>(&lanes.W[3 * i + j][l]); };
+    const auto P = [&](int i, int j) __attribute__((always_inline)) { return load<V>(&lanes.P[3 * i + j][l]); };
+    const auto Ip = [&](int i, int j) __attribute__((always_inline)) { return (i == j ? 1.0 : 0.0) - P(i, j); };
+    // Column j of Y = y and R = F - sd y = [P, -[x_a]x + (I - P) [x_a]x - sd G] (row i of M [x]x is (row i of M) x
+    // x), computed when put_outputs() reaches the column (its first row), with every lane array (n, x_a, x_b, sd,
+    // P, G, W) read from memory where it is used: all of Y and R (36 registers of 8 lanes), n, x_a and x_b held
+    // through the 120 stores were ~250 spills and reloads a block in AVX2 (16 registers, two per 8 lanes); now only
+    // a column's Y, R and n . Y are held. The same operations on the same operands as a whole-matrix pass: the same
+    // bits. Each Ip entry is recomputed where used (one subtraction with a memory operand) rather than held.
+    V Y[3], R[3], nY;
     put_outputs(put, n, xa, xb, [&](int i, int j, V& wa, V& wb, V& dn) {
-      wb = Wr[i][0] * R[0][j] + Wr[i][1] * R[1][j] + Wr[i][2] * R[2][j];
-      wa = wb + d * Y[i][j];
-      dn = n[i] * nY[j] - Y[i][j];
+      if (i == 0) {
+        for (int k = 0; k < 3; ++k) {
+          if (j < 3) {
+            Y[k] = Ip(k, j) * inv;
+            R[k] = P(k, j);
+          } else {
+            const int c0 = j - 3, c1 = (c0 + 1) % 3, c2 = (c0 + 2) % 3;
+            const V c = Ip(k, c1) * xa(c2) - Ip(k, c2) * xa(c1);
+            const V g = load<V>(&lanes.G[3 * k + c0][l]);
+            Y[k] = g - c * inv;
+            R[k] = c - d() * g;
+            // -[x_a]x: x_2 at (0, 1), -x_1 at (0, 2), -x_2 at (1, 0), x_0 at (1, 2), x_1 at (2, 0), -x_0 at (2, 1).
+            if (k != c0) {
+              if ((k + 1) % 3 == c0) R[k] += xa(3 - k - c0);
+              else R[k] -= xa(3 - k - c0);
+            }
+          }
+        }
+        nY = n(0) * Y[0] + n(1) * Y[1] + n(2) * Y[2];
+      }
+      wb = Wr(i, 0) * R[0] + Wr(i, 1) * R[1] + Wr(i, 2) * R[2];
+      wa = wb + d() * Y[i];
+      dn = n(i) * nY - Y[i];
     });
   }
 }
@@ -211,12 +224,12 @@ template <class V, bool kNormalB, bool kCurved, bool kGiven>
 void smooth_block(const SmoothLanes& s, double* const* out, std::size_t at) {
   static_assert(sizeof(V) == SmoothLanes::kLanes * sizeof(double));
   smooth_lanes<kNormalB, kCurved, kGiven, V>(
-      s, 0, [out, at](int e, const V& v) { __builtin_memcpy(out[e] + at, &v, sizeof v); });
+      s, 0, [out, at](int e, const V& v) { store_lanes(out[e], at, v); });
 }
 
 template <class V> void polytope_block(const PolytopeLanes& lanes, double* const* out, std::size_t at) {
   static_assert(sizeof(V) == PolytopeLanes::kLanes * sizeof(double));
-  polytope_lanes<V>(lanes, 0, [out, at](int e, const V& v) { __builtin_memcpy(out[e] + at, &v, sizeof v); });
+  polytope_lanes<V>(lanes, 0, [out, at](int e, const V& v) { store_lanes(out[e], at, v); });
 }
 
 }  // namespace

@@ -422,16 +422,21 @@ __attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices
   return exposed_mask_avx2_body(vertices, count, u, tolerance);
 }
 }  // namespace
-// Both hulls of a pair in one call, masks and walks (exposed_feature_pair()): one call and return instead of four,
-// and GCC interleaves the two sides' independent height passes. The walk (feature_of_mask(), SSE2 code inlined
-// here) computes in the same operations and order under VEX encoding (no FMA: only AVX2 is enabled), so its face
-// test and edge have the bits of exposed_feature()'s.
-void exposed_features_avx2(const HullView& a, const HullView& b, const Eigen::Vector3d* u, const double* tolerance,
-                           int* feature, Eigen::Vector3d* edge) {
+// hull_pair_directions(), feature_of_mask() and edge_flat() are inlined here (baseline code into an AVX2 function,
+// no FMA enabled), so their SSE2 operations take the VEX three-operand forms with the bits of the baseline code.
+void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
+                          const HullView& a, const HullView& b, const double* tolerance, int* flats,
+                          Eigen::Vector3d* flat) {
+  Eigen::Quaterniond unit[2];
+  Eigen::Vector3d u[2], edge[2];
+  hull_pair_directions(Lanes2{ra.x[i], rb.x[i]}, Lanes2{ra.y[i], rb.y[i]}, Lanes2{ra.z[i], rb.z[i]},
+                       Lanes2{ra.w[i], rb.w[i]}, n, unit[0], unit[1], u[0], u[1]);
   const std::uint32_t mask_a = exposed_mask_avx2_body(a.vertices, a.vertex_count, u[0], tolerance[0]);
   const std::uint32_t mask_b = exposed_mask_avx2_body(b.vertices, b.vertex_count, u[1], tolerance[1]);
-  feature[0] = feature_of_mask(a.vertices, mask_a, edge[0]);
-  feature[1] = feature_of_mask(b.vertices, mask_b, edge[1]);
+  flats[0] = feature_of_mask(a.vertices, mask_a, edge[0]);
+  flats[1] = feature_of_mask(b.vertices, mask_b, edge[1]);
+  for (int s = 0; s < 2; ++s)
+    if (flats[s] == 1 && !edge_flat(unit[s], edge[s], n, flat[s])) flats[s] = 0;
 }
 #pragma GCC pop_options
 

@@ -3,6 +3,7 @@
 // the slide "Randomized smoothing - 1st order"). Used by the implicit-function derivatives (derivative_ift.hpp).
 #pragma once
 
+#include "batchcol/pose.hpp"
 #include "batchcol/shapes.hpp"
 #include "batchcol/types.hpp"
 
@@ -58,25 +59,6 @@ constexpr double kExposedFeature = 1e-9;
 int exposed_feature(const double* vertices, std::size_t count, const Eigen::Vector3d& u, double tolerance,
                     Eigen::Vector3d& edge, InstructionSet isa = InstructionSet::scalar);
 
-/// exposed_feature() of both hulls of a pair (a, b; local directions u, tolerances; feature[0] and edge[0] for a,
-/// [1] for b) on AVX2 / AVX-512 for hulls of 4..16 vertices: both height passes and walks in one call of AVX2 code,
-/// the same features and edges (callgrind AVX2, convex8 analytic: 116 + 81 instructions per pair for the masks and
-/// the walks in four calls, 156 in this one).
-void exposed_features_avx2(const HullView& a, const HullView& b, const Eigen::Vector3d* u, const double* tolerance,
-                           int* feature, Eigen::Vector3d* edge);
-
-/// exposed_feature() of both hulls of a pair, through exposed_features_avx2() where it applies.
-inline void exposed_feature_pair(const HullView& a, const HullView& b, const Eigen::Vector3d u[2],
-                                 const double tolerance[2], int feature[2], Eigen::Vector3d edge[2],
-                                 InstructionSet isa) {
-  constexpr std::uint32_t kKept = 16;
-  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count >= 4 &&
-      a.vertex_count <= kKept && b.vertex_count >= 4 && b.vertex_count <= kKept)
-    return exposed_features_avx2(a, b, u, tolerance, feature, edge);
-  feature[0] = exposed_feature(a.vertices, a.vertex_count, u[0], tolerance[0], edge[0], isa);
-  feature[1] = exposed_feature(b.vertices, b.vertex_count, u[1], tolerance[1], edge[1], isa);
-}
-
 /// support_jacobian() of a hull without inflation (s.type == convex, s.inflation == 0) against a polytope, from
 /// the vertices n exposes (kExposedFeature) instead of the face planes through the witness: a scan of the
 /// vertices (2 dot products each) instead of every face's plane test.
@@ -90,12 +72,15 @@ SupportJacobian exposed_support_jacobian(const Shape& s, const Eigen::Vector3d& 
 /// (y^2 + w^2)); conjugate() negates x, y, z; q * v is _transformVector(): uv = q.vec() x v, uv += uv,
 /// (v + w uv) + q.vec() x uv; the sign is a product by +-1 (exact). Tested bitwise against Eigen
 /// (tests/engine/derivatives_lanes_test.cpp).
-inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
-                                 Eigen::Quaterniond& unit_a, Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
-                                 Eigen::Vector3d& u_b) {
-  using V = double __attribute__((vector_size(16)));
+/// The coefficients (x, y, z, w) come as SSE2 lanes (a in lane 0, b in lane 1) in the first form, as quaternions in
+/// the second.
+using Lanes2 = double __attribute__((vector_size(16)));
+inline __attribute__((always_inline)) void hull_pair_directions(Lanes2 x, Lanes2 y, Lanes2 z, Lanes2 w,
+                                                                const Eigen::Vector3d& n, Eigen::Quaterniond& unit_a,
+                                                                Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
+                                                                Eigen::Vector3d& u_b) {
+  using V = Lanes2;
   using M = long long __attribute__((vector_size(16)));
-  V x = {q_a.x(), q_b.x()}, y = {q_a.y(), q_b.y()}, z = {q_a.z(), q_b.z()}, w = {q_a.w(), q_b.w()};
   const V s = (x * x + z * z) + (y * y + w * w);
   const V root = _mm_sqrt_pd(s);
   const M positive = s > 0.0;
@@ -114,6 +99,65 @@ inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Qua
   const V r2 = sign * ((n2 + w * uv2) + (cx * uv1 - cy * uv0));
   u_a = {r0[0], r1[0], r2[0]};
   u_b = {r0[1], r1[1], r2[1]};
+}
+inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Quaterniond& q_b, const Eigen::Vector3d& n,
+                                 Eigen::Quaterniond& unit_a, Eigen::Quaterniond& unit_b, Eigen::Vector3d& u_a,
+                                 Eigen::Vector3d& u_b) {
+  hull_pair_directions(Lanes2{q_a.x(), q_b.x()}, Lanes2{q_a.y(), q_b.y()}, Lanes2{q_a.z(), q_b.z()},
+                       Lanes2{q_a.w(), q_b.w()}, n, unit_a, unit_b, u_a, u_b);
+}
+
+/// hull_pair()'s flat of an exposed edge (a local vector): e = unit * edge (Eigen 3.4's q * v, _transformVector():
+/// uv = q.vec() x v, uv += uv, (v + w uv) + q.vec() x uv), the part of e orthogonal to n, e - (n . e) n, and, where
+/// that part's norm is > 1e-6 of e's (add_flat()'s test), flat = its normalized(); returns whether it was. The
+/// rotation and the projection are written out with Eigen's operations in its order (the same bits, tested against
+/// Eigen in tests/engine/derivatives_lanes_test.cpp): GCC called both out of line from hull_pair(), 27.5 + 11.1
+/// instructions per convex8 pair plus the calls' spills (callgrind AVX2).
+inline __attribute__((always_inline)) bool edge_flat(const Eigen::Quaterniond& unit, const Eigen::Vector3d& edge, const Eigen::Vector3d& n,
+                      Eigen::Vector3d& flat) {
+  const double x = unit.x(), y = unit.y(), z = unit.z(), w = unit.w();
+  double uv0 = y * edge.z() - z * edge.y(), uv1 = z * edge.x() - x * edge.z(), uv2 = x * edge.y() - y * edge.x();
+  uv0 += uv0, uv1 += uv1, uv2 += uv2;
+  Eigen::Vector3d e((edge.x() + w * uv0) + (y * uv2 - z * uv1), (edge.y() + w * uv1) + (z * uv0 - x * uv2),
+                    (edge.z() + w * uv2) + (x * uv1 - y * uv0));
+  const double length = e.norm();
+  const double along = n.dot(e);
+  e.x() -= along * n.x(), e.y() -= along * n.y(), e.z() -= along * n.z();
+  if (!(e.norm() > 1e-6 * length)) return false;
+  flat = e.normalized();
+  return true;
+}
+
+/// hull_pair()'s flats of both sides (a, b: [0], [1]): the local directions (hull_pair_directions()), each side's
+/// exposed feature (exposed_feature(), tolerance[s]) and, for an edge, edge_flat(): flats[s] = 0 (a vertex, or an
+/// edge along n), 1 (an edge; flat[s] its unit direction in the world) or 2 (a face). AVX2 / AVX-512 for hulls of
+/// 4..16 vertices: all of it in one call of AVX2 code (both sides' height passes four vertices per register and
+/// mask walks, interleaved by GCC; the SSE2 arithmetic of the directions, walks and edges under VEX encoding, the same
+/// operations in the same order: the same bits), where the baseline SSE2 code of the directions and edges needed a
+/// register copy for most of its two-operand operations: callgrind AVX2, convex8 analytic, 2331.7 -> 2303.3
+/// instructions per pair (the features alone: 116 + 81 in four calls, 156 in one).
+/// The rotations are pair i's of ra (a) and rb (b), read straight into the lanes (building the two quaternions in
+/// memory for the call cost ~15 instructions per pair, callgrind AVX2).
+void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
+                          const HullView& a, const HullView& b, const double* tolerance, int* flats,
+                          Eigen::Vector3d* flat);
+
+inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
+                                                           const Eigen::Vector3d& n, const HullView& a,
+                                                           const HullView& b, const double tolerance[2], int flats[2],
+                                                           Eigen::Vector3d flat[2], InstructionSet isa) {
+  constexpr std::uint32_t kKept = 16;
+  // 4 <= vertex_count <= kKept, each as one unsigned comparison
+  if ((isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count - 4 <= kKept - 4 &&
+      b.vertex_count - 4 <= kKept - 4)
+    return hull_pair_flats_avx2(ra, rb, i, n, a, b, tolerance, flats, flat);
+  Eigen::Quaterniond unit[2];
+  Eigen::Vector3d u[2], edge[2];
+  hull_pair_directions(ra[i], rb[i], n, unit[0], unit[1], u[0], u[1]);
+  flats[0] = exposed_feature(a.vertices, a.vertex_count, u[0], tolerance[0], edge[0], isa);
+  flats[1] = exposed_feature(b.vertices, b.vertex_count, u[1], tolerance[1], edge[1], isa);
+  for (int s = 0; s < 2; ++s)
+    if (flats[s] == 1 && !edge_flat(unit[s], edge[s], n, flat[s])) flats[s] = 0;
 }
 
 /// support_jacobian() of a sphere or an ellipsoid (returns false for the other types, leaving H alone) at the unit

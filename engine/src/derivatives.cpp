@@ -139,54 +139,42 @@ namespace {
 // differentiate_pair()'s general setup: no rotation matrices (the quaternions turn n into each local frame and an
 // edge back), the features from the vertices n exposes (exposed_feature()), straight into PolytopeLanes. The same
 // features, statuses and formulas as the general path; false (nothing written) for any other pair.
+// `g`: the caller's, reused from pair to pair (every field this pair reads is written first): a PairGeometry per
+// pair zeroed its two flat matrices, 5 instructions per pair (callgrind AVX2).
 bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
-               StoreBlock& out) {
+               StoreBlock& out, PairGeometry& g) {
   if (results.status[i] != Status::converged) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
-  if (a >= shapes.size() || b >= shapes.size()) return false;
+  // The per-shape arrays grow with the table (ShapeTable::add()): types.size() is shapes.size() without its
+  // division by sizeof(Shape).
   const auto& types = ShapeTableAccess::types(shapes);
+  if (a >= types.size() || b >= types.size()) return false;
   const auto& inflations = ShapeTableAccess::inflations(shapes);
   if (types[a] != ShapeType::convex || types[b] != ShapeType::convex || inflations[a] != 0.0 ||
       inflations[b] != 0.0)
     return false;
   const auto& radii = ShapeTableAccess::bounding_radii(shapes);
-  PairGeometry g;
   g.distance = results.distance[i];
   g.scale = radii[a] + radii[b];
-  if (!(g.distance > 1e-9 * g.scale) || !std::isfinite(g.distance)) return false;  // touching, penetrating: general
+  // Touching, penetrating (and NaN): the general path; past the first test only +inf is not finite.
+  if (!(g.distance > 1e-9 * g.scale) || !(g.distance < std::numeric_limits<double>::infinity())) return false;
   g.witness_a = results.witness_a[i];
   g.witness_b = results.witness_b[i];
   g.normal = results.normal[i];
   if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite()) return false;
   const auto& hulls = ShapeTableAccess::hulls(shapes);
-  // n in each hull's frame (b's reversed), both sides in one SSE2 register with the bits of the per-side Eigen
-  // expressions (q.normalized(), sign * (unit.conjugate() * n)).
-  Eigen::Quaterniond unit_a, unit_b;
-  Eigen::Vector3d u[2];
-  hull_pair_directions(batch.rotation_a[i], batch.rotation_b[i], g.normal, unit_a, unit_b, u[0], u[1]);
-  // Both sides' features in one call (exposed_feature_pair()); `side` is forced inline because GCC otherwise kept it
-  // out of line once the features moved out of it (~58 instructions per hull pair, callgrind AVX2).
-  int features[2];
-  Eigen::Vector3d edges[2];
+  // Both sides' flats in one call (hull_pair_flats(): n in each hull's frame, b's reversed, with the bits of the
+  // per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the features n exposes; an edge's
+  // direction in the world orthogonal to n). A face's flats are only needed by the general path below
+  // (PolytopeLanes uses n).
+  int flats[2];
+  Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};
-  exposed_feature_pair(hulls[a], hulls[b], u, tolerance, features, edges, out.isa);
-  const auto side = [&](int s, const Eigen::Quaterniond& unit, Eigen::Matrix<double, 3, 2>& flat)
-                        __attribute__((always_inline)) {
-    const int feature = features[s];
-    if (feature == 1) {
-      Eigen::Vector3d e = unit * edges[s];
-      const double length = e.norm();
-      e -= g.normal.dot(e) * g.normal;
-      if (e.norm() > 1e-6 * length) {  // add_flat()'s test
-        flat.col(0) = e.normalized();
-        return 1;
-      }
-      return 0;
-    }
-    return feature;  // a face's flats are only needed by the general path below (PolytopeLanes uses n)
-  };
-  g.flats_a = side(0, unit_a, g.flat_a);
-  g.flats_b = side(1, unit_b, g.flat_b);
+  hull_pair_flats(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b], tolerance, flats, flat,
+                  out.isa);
+  g.flats_a = flats[0], g.flats_b = flats[1];
+  if (flats[0] == 1) g.flat_a.col(0) = flat[0];
+  if (flats[1] == 1) g.flat_b.col(0) = flat[1];
   const DerivativeStatus status =
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
@@ -219,8 +207,9 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
 
 // One pair, analytic or smoothed1. The support directions are n for a and -n for b, taken to each local frame.
 void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
-                        const DerivativeOptions& o, InstructionSet isa, std::size_t i, StoreBlock& out) {
-  if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out)) return;
+                        const DerivativeOptions& o, InstructionSet isa, std::size_t i, StoreBlock& out,
+                        PairGeometry& hull_geometry) {
+  if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out, hull_geometry)) return;
   DerivativeResults& d = out.d;
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;  // the analytic path sets them only where it uses them (see side())
@@ -405,7 +394,9 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
     detail::StoreBlock out(derivatives);
     out.normal_b_only = normal_b_only;
     out.isa = isa;
-    for (std::size_t i = begin; i < end; ++i) differentiate_pair(shapes, batch, results, options, isa, i, out);
+    detail::PairGeometry hull_geometry;
+    for (std::size_t i = begin; i < end; ++i)
+      differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry);
   });
 }
 

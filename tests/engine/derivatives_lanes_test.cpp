@@ -142,6 +142,39 @@ TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
   EXPECT_EQ(mismatches, 0);
 }
 
+// edge_flat() (the rotation and projection written out) must give the bits of the Eigen expressions it replaced in
+// hull_pair(): e = unit * edge, e -= n.dot(e) * n, a flat where e.norm() > 1e-6 * length, e.normalized(); on unit
+// quaternions, edges of any length (some along n, so that no flat is left) and normals with signed zeros.
+TEST(DerivativesLanes, EdgeFlatGivesEigensBits) {
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_int_distribution<int> pick(0, 9);
+  int mismatches = 0, flats = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const Eigen::Quaterniond unit =
+        Eigen::Quaterniond(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng)).normalized();
+    Eigen::Vector3d n(coefficient(rng), coefficient(rng), coefficient(rng));
+    if (pick(rng) == 0) n[pick(rng) % 3] = pick(rng) % 2 ? 0.0 : -0.0;
+    n.normalize();
+    Eigen::Vector3d edge = Eigen::Vector3d(coefficient(rng), coefficient(rng), coefficient(rng)) * std::pow(10.0, exponent(rng));
+    if (pick(rng) == 0) edge = (unit.conjugate() * n) * std::pow(10.0, exponent(rng));  // along n: no flat
+    Eigen::Vector3d e = unit * edge;
+    const double length = e.norm();
+    e -= n.dot(e) * n;
+    const bool expected = e.norm() > 1e-6 * length;
+    Eigen::Vector3d flat = Eigen::Vector3d::Constant(7.0), expected_flat = flat;
+    if (expected) expected_flat = e.normalized(), ++flats;
+    const bool got = detail::edge_flat(unit, edge, n, flat);
+    if ((got != expected || std::memcmp(flat.data(), expected_flat.data(), sizeof(double) * 3) != 0) &&
+        ++mismatches <= 3)
+      ADD_FAILURE() << "trial " << trial << ": " << got << " " << flat.transpose() << " vs " << expected << " "
+                    << expected_flat.transpose();
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(flats, 150000);
+  EXPECT_LT(flats, 199000);
+}
+
 // The exposed feature by its definition, in plain loops: the vertices whose height <u, v> (the production's
 // expression and order) is >= max - tolerance, in index order; none or one: a vertex (0); a third off the line of the
 // first two (the same collinearity expression): a face (2); else an edge (1), second - first.
@@ -167,11 +200,14 @@ int reference_feature(const std::vector<double>& v, const Eigen::Vector3d& u, do
   return 1;
 }
 
-// exposed_feature_pair() (both hulls' height passes and walks in one AVX2 call on the wide sets, exposed_feature()
-// per side on the baseline) must find the features and edges of the plain reference above: hulls of 4..16 vertices
-// on a coarse integer grid (so that directions along the axes and diagonals tie exactly: vertices, edges, faces, and
-// three or more collinear exposed vertices), and random directions.
-TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
+// hull_pair_flats() (both hulls' directions, height passes, walks and edge flats in one AVX2 call on the wide sets,
+// the SSE2 code per side on the baseline) must find the flats of the plain reference above and of the Eigen
+// expressions of hull_pair()'s edge (e = unit * edge, e -= n.dot(e) * n, a flat where e.norm() > 1e-6 * length,
+// e.normalized()), bit for bit: hulls of 4..16 vertices on a coarse integer grid (so that directions along the axes
+// and diagonals tie exactly: vertices, edges, faces, and three or more collinear exposed vertices) seen through the
+// identity or a half turn about an axis (exact quaternions: the local directions stay on the grid), and random
+// normals and rotations.
+TEST(DerivativesLanes, HullPairFlatsFindEachSidesFeature) {
   std::mt19937_64 rng(20261128);
   std::uniform_int_distribution<int> grid(-2, 2), size(4, 16), pick(0, 3);
   std::uniform_real_distribution<double> coefficient(-1.0, 1.0);
@@ -180,48 +216,70 @@ TEST(DerivativesLanes, ExposedFeaturePairFindsEachSidesFeature) {
     for (double& c : v) c = 0.5 * grid(rng);
     return v;
   };
-  const auto direction = [&] {
-    Eigen::Vector3d u = pick(rng) == 0 ? Eigen::Vector3d(coefficient(rng), coefficient(rng), coefficient(rng))
-                                       : Eigen::Vector3d(grid(rng), grid(rng), grid(rng));
-    if (u.isZero()) u = Eigen::Vector3d::UnitZ();
-    return u.normalized();
-  };
   const auto view = [](const std::vector<double>& v) {
     HullView h;
     h.vertices = v.data();
     h.vertex_count = std::uint32_t(v.size() / 3);
     return h;
   };
-  int mismatches = 0, features[3] = {0, 0, 0};
+  int mismatches = 0, features[3] = {0, 0, 0}, flats_seen[3] = {0, 0, 0};
   for (int trial = 0; trial < 20000; ++trial) {
     const std::vector<double> va = hull(), vb = hull();
-    const Eigen::Vector3d u[2] = {direction(), direction()};
+    const bool random = pick(rng) == 0;
+    Eigen::Vector3d n = random ? Eigen::Vector3d(coefficient(rng), coefficient(rng), coefficient(rng))
+                               : Eigen::Vector3d(grid(rng), grid(rng), grid(rng));
+    if (n.isZero()) n = Eigen::Vector3d::UnitZ();
+    n.normalize();
+    const auto rotation = [&] {
+      if (random) return Eigen::Quaterniond(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
+      Eigen::Quaterniond q(0.0, 0.0, 0.0, 0.0);
+      q.coeffs()[pick(rng)] = 1.0;  // the identity (w) or a half turn about x, y or z
+      return q;
+    };
+    const Eigen::Quaterniond q[2] = {rotation(), rotation()};
     const double tolerance[2] = {1e-9, 1e-9};
+    const std::vector<double>* vertices[2] = {&va, &vb};
     int want[2];
-    Eigen::Vector3d want_edge[2];
-    want[0] = reference_feature(va, u[0], tolerance[0], want_edge[0]);
-    want[1] = reference_feature(vb, u[1], tolerance[1], want_edge[1]);
-    ++features[want[0]], ++features[want[1]];
+    Eigen::Vector3d want_flat[2];
+    for (int s = 0; s < 2; ++s) {
+      const Eigen::Quaterniond unit = q[s].normalized();
+      const Eigen::Vector3d u = (s == 0 ? 1.0 : -1.0) * (unit.conjugate() * n);
+      Eigen::Vector3d edge;
+      want[s] = reference_feature(*vertices[s], u, tolerance[s], edge);
+      ++features[want[s]];
+      if (want[s] == 1) {
+        Eigen::Vector3d e = unit * edge;
+        const double length = e.norm();
+        e -= n.dot(e) * n;
+        if (e.norm() > 1e-6 * length) want_flat[s] = e.normalized();
+        else want[s] = 0;
+      }
+      ++flats_seen[want[s]];
+    }
     std::vector<InstructionSet> isas = vector_isas_here();
     isas.insert(isas.begin(), InstructionSet::scalar);
     for (const auto isa : isas) {
       int got[2];
-      Eigen::Vector3d edge[2];
-      detail::exposed_feature_pair(view(va), view(vb), u, tolerance, got, edge, isa);
+      Eigen::Vector3d flat[2];
+      QuatArray ra, rb;
+      ra.push_back(q[0]), rb.push_back(q[1]);
+      detail::hull_pair_flats(ra, rb, 0, n, view(va), view(vb), tolerance, got, flat, isa);
       for (int s = 0; s < 2; ++s) {
         const bool ok = got[s] == want[s] &&
-                        (want[s] != 1 || std::memcmp(edge[s].data(), want_edge[s].data(), 3 * sizeof(double)) == 0);
+                        (want[s] != 1 || std::memcmp(flat[s].data(), want_flat[s].data(), 3 * sizeof(double)) == 0);
         if (!ok && ++mismatches <= 3)
-          ADD_FAILURE() << "trial " << trial << " side " << s << " " << to_string(isa) << ": feature " << got[s]
+          ADD_FAILURE() << "trial " << trial << " side " << s << " " << to_string(isa) << ": flats " << got[s]
                         << " vs " << want[s];
       }
     }
   }
   EXPECT_EQ(mismatches, 0);
   // The grid ties vertices along the axes and diagonals: each kind of feature must be common, so that the test is
-  // one of edges and faces too (this seed: 30693 vertices, 7289 edges, 2018 faces of 40000 sides).
-  std::printf("sides: %d vertices, %d edges, %d faces\n", features[0], features[1], features[2]);
+  // one of edges and faces too.
+  std::printf("sides: %d vertices, %d edges, %d faces; flats 0 / 1 / 2: %d / %d / %d\n", features[0], features[1],
+              features[2], flats_seen[0], flats_seen[1], flats_seen[2]);
   for (int f = 0; f < 3; ++f) EXPECT_GT(features[f], 1000) << "feature " << f;
+  EXPECT_GT(flats_seen[1], 1000);
 }
 
 }  // namespace
