@@ -237,7 +237,7 @@ void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* 
     }
     if (!given) {  // the lanes so far (this lane's other side included) have curved sides without H0
       // Every lane (those after l are written when added): fixed-size vector stores, where zeroing lanes 0..l
-      // became 18 memset calls (~27 instructions per smoothed1 pair, callgrind).
+      // became 18 memset calls (~27 instructions per pair with a given H, callgrind).
       for (int e = 0; e < 9; ++e)
         for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
       given = true;

@@ -97,7 +97,7 @@ class StoreBlock {
  private:
   // Not zeroed (a 7.7 KB fill per task range, 3.75 instructions per pair at 256 pairs a range, callgrind AVX2): every
   // slot handed out has all its entries written before the flush reads them, except the rows normal_b_only skips,
-  // which analytic_normal_b()'s caller never reads (a whole block leaves those rows of the arrays unwritten too).
+  // which the flush then does not copy (analytic_normal_b()'s caller reads only normal_wrt_b's rows).
   alignas(64) double buf_[kEntries][kStride];
   // entry_rows(d, 0): the output arrays' rows of pair 0, computed at the first flush (d is sized by then and not
   // resized during the block's life); a block of pairs from first_ is at rows_[e] + first_. With the 120 pointers

@@ -18,7 +18,7 @@ namespace batchcol::detail {
 /// The pending smoothed1 pairs of a block, by their SmoothLanes lane: each side's estimate S (symmetric, entries
 /// 00, 11, 22, 01, 02, 12) and local-to-world rotation R (row-major). finish() writes
 ///   H = R psd_projection(S) R^T
-/// into the lane's SmoothLanes H0 with the bits of psd_projection_pair() followed by the assignment
+/// into the lane's SmoothLanes H0 with the bits of psd_projection() of each side followed by the assignment
 /// H = R * S * R.transpose() of Eigen matrices (the per-pair path's, which the pairs off this path still take): every
 /// lane does those functions' IEEE operations in their order (the eigenvalue sweeps until its own convergence test
 /// fails, the projectors' and the products' sums in Eigen's order), so the bits do not depend on the set or on the
@@ -45,7 +45,8 @@ struct Smoothed1Lanes {
 /// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
 /// caller draws it: kernels::simd::draw_gaussians4_streams() for both sides of a pair). `view`: the shape's plain
 /// record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four directions per AVX2
-/// register, with the same bits.
+/// register and take the ellipsoid sample differences, the hull differences and the sample sums in AVX2 registers,
+/// with the same bits as the baseline set.
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa = InstructionSet::scalar);
 

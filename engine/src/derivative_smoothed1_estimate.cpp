@@ -1,6 +1,7 @@
 // smoothed1's support-Jacobian estimate (smoothed_support_estimate(), derivative_smoothed1.hpp): the supports of the
-// perturbed directions and their sums. Moved here from derivative_support.cpp (unchanged but for the hull scan's AVX2
-// form) so that the smoothed1 path has its own file.
+// perturbed directions and their sums. Moved here from derivative_support.cpp so that the smoothed1 path has its own
+// file; since then AVX2 forms (the same bits) of the small-hull scan, the ellipsoid and hull sample differences and
+// the sample sums, and the directions two draws per SSE2 register.
 #include "derivative_smoothed1.hpp"
 
 #include "derivative_support.hpp"

@@ -1,6 +1,6 @@
 // Smoothed1Lanes::finish()'s arithmetic (derivative_smoothed1.cpp) for any width of GCC/Clang vector extension V with
 // its compare mask type M: included once for the baseline set (V = two lanes, SSE2) and once under AVX2's `#pragma
-// GCC target` (four lanes). Each lane does psd_projection_pair()'s and Eigen's H = R * S * R.transpose()'s elementwise
+// GCC target` (four lanes). Each lane does psd_projection()'s and Eigen's H = R * S * R.transpose()'s elementwise
 // IEEE operations in their order (-ffp-contract=off: nothing fused), so every set gives the per-pair path's bits.
 // The includer declares sqrt_lanes(V), any_lane(M) and blend_lanes(M m, V a, V b) (m ? a : b) before the include.
 // No include guard.

@@ -109,61 +109,8 @@ Eigen::Vector3d symmetric_eigenvalues(const Eigen::Matrix3d& A) {
   return {a00, a11, a22};
 }
 
-// Two symmetric matrices' Jacobi sweeps in one SSE2 register (lane 0, lane 1), for smoothed1's two shapes of a
-// pair (psd_projection_pair()): each lane does symmetric_eigenvalues()'s operations in its order (elementwise IEEE
-// operations; both sides of a test computed and one kept), and a lane whose sweep test has failed keeps its values,
-// so each lane ends with the scalar function's bits at about the instructions of one matrix.
+// Two doubles in an SSE2 register: project() computes columns 0 and 1 of each row together.
 using V2 = double __attribute__((vector_size(16)));
-using M2 = long long __attribute__((vector_size(16)));  // a V2 compare's lanes: all ones or zero
-
-inline V2 abs2(V2 x) { return (V2)((M2)x & 0x7FFFFFFFFFFFFFFFll); }
-inline V2 max2(V2 a, V2 b) { return a < b ? b : a; }  // std::max(a, b)
-
-/// jacobi_rotate() in the lanes where `go` is set (and a_pq != 0, its early return). The common case, both lanes
-/// rotating and no |theta| above 1e150, skips the selects (~20 of the ~60 instructions of a rotation in SSE2).
-inline void jacobi_rotate2(M2 go, V2& app, V2& aqq, V2& apq, V2& arp, V2& arq) {
-  go &= apq != 0.0;
-  const V2 theta = (aqq - app) / (2.0 * apq), at = abs2(theta);
-  const M2 large = at > 1e150;
-  V2 magnitude = 1.0 / (at + _mm_sqrt_pd(at * at + 1.0));
-  if (__builtin_expect(large[0] | large[1], 0)) magnitude = large ? 0.5 / at : magnitude;
-  const M2 sign = M2{} + (-0x7FFFFFFFFFFFFFFFll - 1);  // the sign bit
-  const V2 t = (V2)((M2)magnitude | ((M2)theta & sign));  // copysign(magnitude, theta)
-  const V2 c = 1.0 / _mm_sqrt_pd(t * t + 1.0), s = t * c;
-  const V2 rp = arp, rq = arq;
-  if (__builtin_expect(go[0] & go[1], 1)) {
-    app -= t * apq;
-    aqq += t * apq;
-    apq = V2{};
-    arp = c * rp - s * rq;
-    arq = s * rp + c * rq;
-    return;
-  }
-  app = go ? app - t * apq : app;
-  aqq = go ? aqq + t * apq : aqq;
-  apq = go ? V2{} : apq;
-  arp = go ? c * rp - s * rq : rp;
-  arq = go ? s * rp + c * rq : rq;
-}
-
-/// symmetric_eigenvalues() of A (lane 0) and B (lane 1).
-void symmetric_eigenvalues2(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B, Eigen::Vector3d& la,
-                            Eigen::Vector3d& lb) {
-  const auto pair = [&](int r, int c) { return V2{A(r, c), B(r, c)}; };
-  V2 a00 = pair(0, 0), a11 = pair(1, 1), a22 = pair(2, 2), a01 = pair(0, 1), a02 = pair(0, 2), a12 = pair(1, 2);
-  for (int sweep = 0; sweep < 32; ++sweep) {
-    const V2 off = max2(max2(abs2(a01), abs2(a02)), abs2(a12));
-    const V2 diagonal = max2(max2(abs2(a00), abs2(a11)), abs2(a22));
-    const M2 go = off > 1e-18 * diagonal;
-    if (!(go[0] | go[1])) break;
-    jacobi_rotate2(go, a00, a11, a01, a02, a12);  // (p, q, r) = (0, 1, 2)
-    jacobi_rotate2(go, a00, a22, a02, a01, a12);  // (0, 2, 1)
-    jacobi_rotate2(go, a11, a22, a12, a01, a02);  // (1, 2, 0)
-  }
-  la = {a00[0], a11[0], a22[0]};
-  lb = {a00[1], a11[1], a22[1]};
-}
-
 
 }  // namespace
 
@@ -236,19 +183,6 @@ Eigen::Matrix3d project(const Eigen::Matrix3d& H, Eigen::Vector3d l) {
 
 Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H) {
   return needs_eigenvalues(H) ? project(H, symmetric_eigenvalues(H)) : H;
-}
-
-void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B) {
-  const bool a = needs_eigenvalues(A), b = needs_eigenvalues(B);
-  if (a && b) {
-    Eigen::Vector3d la, lb;
-    symmetric_eigenvalues2(A, B, la, lb);
-    A = project(A, la);
-    B = project(B, lb);
-    return;
-  }
-  if (a) A = project(A, symmetric_eigenvalues(A));
-  if (b) B = project(B, symmetric_eigenvalues(B));
 }
 
 SupportJacobian support_jacobian(const Shape& s, const Eigen::Vector3d& u, const Eigen::Vector3d& witness) {

@@ -1,6 +1,6 @@
 // The Jacobian of a shape's support map (the Hessian of its support function sigma(u) = max_{x in A} <x, u>) in the
-// shape's local frame, exact where it exists, and its randomized-smoothing estimate (Montaut et al. 2023, sec. IV;
-// the slide "Randomized smoothing - 1st order"). Used by the implicit-function derivatives (derivative_ift.hpp).
+// shape's local frame, exact where it exists (its randomized-smoothing estimate, Montaut et al. 2023, sec. IV, is in
+// derivative_smoothed1.hpp). Used by the implicit-function derivatives (derivative_ift.hpp).
 #pragma once
 
 #include "batchcol/pose.hpp"
@@ -173,11 +173,6 @@ Eigen::Vector3d full_support(const Shape& shape, const Eigen::Vector3d& u);
 /// 0. Computed from the eigenvalues alone (Jacobi rotations, then spectral projectors as polynomials in H), within
 /// rounding of the eigendecomposition's V max(L, 0) V^T.
 Eigen::Matrix3d psd_projection(const Eigen::Matrix3d& H);
-
-/// Both psd_projection()s of a pair's two shapes (smoothed1), in place, with the same bits: where both need
-/// eigenvalues (almost always at small M: a 4-sample estimate has rank <= 2 before symmetrisation) their Jacobi
-/// sweeps share SSE2 registers.
-void psd_projection_pair(Eigen::Matrix3d& A, Eigen::Matrix3d& B);
 
 /// Adds a swept radius (the inflation of a core) to the core's support point p at direction d (not necessarily unit):
 /// radius d / |d|; the norm (a square root) only when there is a radius, nothing at d = 0.

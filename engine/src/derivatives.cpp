@@ -93,10 +93,12 @@ void StoreBlock::flush() {
       if (smooth_.count > 0) smooth_.solve(buffer_rows, normal_b_only);
       if (polytope_.count > 0) polytope_.solve(buffer_rows);
     }
+    // normal_b_only: only normal_wrt_b's rows are written (and read by the caller); the others are not copied.
+    const int first = normal_b_only ? store_at::normal_b : 0, end = normal_b_only ? store_at::normal_b + 18 : kEntries;
     if (count_ == kStride) {  // a full block: fixed-size copies the compiler inlines as vector moves
-      for (int k = 0; k < kEntries; ++k) std::memcpy(rows[k] + at, buf_[k], sizeof buf_[k]);
+      for (int k = first; k < end; ++k) std::memcpy(rows[k] + at, buf_[k], sizeof buf_[k]);
     } else {
-      for (int k = 0; k < kEntries; ++k) std::copy_n(buf_[k], count_, rows[k] + at);
+      for (int k = first; k < end; ++k) std::copy_n(buf_[k], count_, rows[k] + at);
     }
   }
   smooth_.clear();
@@ -302,7 +304,8 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
       d.status[i] = status;
       return;
     }
-    psd_projection_pair(S_a, S_b);
+    S_a = psd_projection(S_a);  // touching / overlapping pairs only (rare): the scalar projection
+    S_b = psd_projection(S_b);
     g.H_a = R_a * S_a * R_a.transpose();
     g.H_b = R_b * S_b * R_b.transpose();
   }

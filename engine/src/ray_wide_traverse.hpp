@@ -46,7 +46,7 @@ struct WideRay {
   float ball_margin;           // kBallMargin * |o|_1, rounded up
   // Bit k: the direction's component k is negative (-0 included), so the ray enters a slab of axis k through its hi
   // plane: which loop of the traversal runs (one per octant, the near / far planes fixed offsets in it).
-  std::uint32_t octant;
+  std::uint32_t octant = 0;
   const float* balls = nullptr;  // per leaf (Morton rank): x, y, z, radius; nullptr: every leaf is visited
   std::uint32_t ball_stride = 4;  // floats from one leaf's ball to the next (the balls sit in the leaf records)
   bool prefetch = false;  // request a pushed child's lines early (worth it when the nodes do not fit the L2)

@@ -111,14 +111,20 @@ TEST(DerivativesPolytope, WholeBlocksGiveTheSameBitsOnEveryInstructionSet) {
   const PairBatch hulls = random_separated_pairs(rng, shapes, {ShapeType::convex}, 1200);
   const PairBatch ellipsoids = random_separated_pairs(rng, shapes, {ShapeType::ellipsoid}, 1200);
   const PairBatch mixed = random_separated_pairs(rng, shapes, bounded_shape_types(), 600);
-  DerivativeOptions analytic, smoothed1;
-  smoothed1.method = DerivativeMethod::smoothed1;
-  smoothed1.samples = 4;
-  smoothed1.seed = 3;
+  // smoothed1 at M = 4 (whole AVX2 registers of samples), odd M = 3 and 5 (the masked tails of the AVX2 sample
+  // differences and sums) and M = 16 (the small-hull scan's multi-register path); a quarter of the a-sides are
+  // inflated (the scan followed by the swept radius).
+  DerivativeOptions analytic, smoothed1[4];
+  const int samples[4] = {4, 3, 5, 16};
+  for (int k = 0; k < 4; ++k) {
+    smoothed1[k].method = DerivativeMethod::smoothed1;
+    smoothed1[k].samples = samples[k];
+    smoothed1[k].seed = 3;
+  }
   if (vector_isas_here().empty()) GTEST_SKIP() << "no AVX2 or AVX-512 on this CPU: nothing to compare with scalar";
   int compared = 0;
   for (const PairBatch* batch : {&hulls, &ellipsoids, &mixed})
-    for (const DerivativeOptions* o : {&analytic, &smoothed1}) {
+    for (const DerivativeOptions* o : {&analytic, &smoothed1[0], &smoothed1[1], &smoothed1[2], &smoothed1[3]}) {
       PairResults r;
       QueryOptions q;
       q.isa = InstructionSet::scalar;
@@ -134,7 +140,8 @@ TEST(DerivativesPolytope, WholeBlocksGiveTheSameBitsOnEveryInstructionSet) {
         q.isa = isa;
         DerivativeResults d;
         differentiate(shapes, *batch, q, *o, r, d);
-        const std::string label = std::string(to_string(isa)) + (o == &analytic ? " analytic" : " smoothed1");
+        const std::string label = std::string(to_string(isa)) +
+                                  (o == &analytic ? " analytic" : " smoothed1 M = " + std::to_string(o->samples));
         expect_same_derivatives(reference, d, label);
       }
     }

@@ -115,46 +115,6 @@ TEST(DerivativesPsdProjection, SameBitsAsTheEigenExpressions) {
   EXPECT_GT(projected, 25000);  // most random symmetric matrices have a negative eigenvalue
 }
 
-// psd_projection_pair() (smoothed1's two shapes, their Jacobi sweeps in one SSE2 register) gives each matrix the bits
-// of psd_projection(): lanes that take different numbers of sweeps, one lane positive definite or not finite, rank
-// <= 2 estimates (sums of two outer products, symmetrised, as at M = 4), zero off-diagonal entries.
-TEST(DerivativesPsdProjection, PairGivesTheBitsOfEachAlone) {
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const auto random = [&](int kind) {
-    Eigen::Matrix3d H;
-    if (kind == 0) {  // rank <= 2 before symmetrisation
-      const Eigen::Vector3d a = Eigen::Vector3d::Random(), b = Eigen::Vector3d::Random();
-      const Eigen::Vector3d c(unit(rng), unit(rng), unit(rng)), d(unit(rng), unit(rng), unit(rng));
-      H = a * c.transpose() + b * d.transpose();
-    } else if (kind == 1) {  // positive definite
-      const Eigen::Matrix3d A = Eigen::Matrix3d::Random();
-      H = A * A.transpose() + 0.1 * Eigen::Matrix3d::Identity();
-    } else if (kind == 2) {  // diagonal (off-diagonal zeros: no rotation) or with one zero pair
-      H = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).asDiagonal();
-      if (rng() % 2) H(0, 1) = H(1, 0) = unit(rng);
-    } else if (kind == 3) {  // not finite
-      H = Eigen::Matrix3d::Random();
-      H(rng() % 3, rng() % 3) = rng() % 2 ? std::nan("") : INFINITY;
-    } else {  // spread eigenvalues (more sweeps in one lane)
-      H = Eigen::Matrix3d::Random();
-      H.row(rng() % 3) *= 1e8;
-    }
-    return (0.5 * (H + H.transpose())).eval();
-  };
-  int rotated = 0;
-  for (int trial = 0; trial < 20000; ++trial) {
-    const Eigen::Matrix3d A = random(trial % 5 == 4 ? 0 : int(rng() % 5)), B = random(int(rng() % 5));
-    Eigen::Matrix3d pa = A, pb = B;
-    detail::psd_projection_pair(pa, pb);
-    const Eigen::Matrix3d ea = detail::psd_projection(A), eb = detail::psd_projection(B);
-    ASSERT_EQ(std::memcmp(pa.data(), ea.data(), sizeof pa), 0) << "A =\n" << A << "\nB =\n" << B;
-    ASSERT_EQ(std::memcmp(pb.data(), eb.data(), sizeof pb), 0) << "A =\n" << A << "\nB =\n" << B;
-    rotated += pa != A && pb != B;
-  }
-  EXPECT_GT(rotated, 5000);  // both lanes projected (the shared sweeps) in a good part of the trials
-}
-
 TEST(DerivativesPsdProjection, KeepsNanAndSpecialCases) {
   EXPECT_EQ(detail::psd_projection(Eigen::Matrix3d::Zero()), Eigen::Matrix3d::Zero());
   EXPECT_EQ(detail::psd_projection(-Eigen::Matrix3d::Identity()), Eigen::Matrix3d::Zero());
