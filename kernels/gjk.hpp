@@ -218,6 +218,18 @@ constexpr int kRoundEllipsoidSideSteps = 3;
 constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
   return rim_start_pair(a, b) || box_ellipsoid_pair(a, b) || box_round_pair(a, b) || round_ellipsoid_pair(a, b);
 }
+/// A sphere against a convex hull, either order: every double lane (distance, witness and boolean) starts from the
+/// sphere centre's nearest point on the hull's most separating face (kernels/simd/wide_gjk_point_hull.inl) where the
+/// hull has at most kPointHullMaxFaces faces. Not float: the face loop (gathers of double hull data, two per value
+/// in 8 float lanes) costs more than the iterations it saves (close boolean float sphere-convex8 779 -> 947
+/// instructions per pair computed by start(), 975 computed W slots at a time at the chunk's set-up; callgrind
+/// AVX2), where double gains (witness 1387 -> 1027, boolean 983 -> 866; at the set-up 1059 and 899).
+constexpr bool point_hull_pair(ShapeType a, ShapeType b) {
+  return (a == ShapeType::sphere && b == ShapeType::convex) || (a == ShapeType::convex && b == ShapeType::sphere);
+}
+/// The face loop reads one plane per face and lane: bounded to hulls of up to 10 vertices (2 V - 4 triangles), which
+/// is what was measured (convex8, 12 faces); larger hulls keep GJK's first support point.
+constexpr std::uint32_t kPointHullMaxFaces = 16;
 /// Newton steps on the edge angle and on the vertex's Lagrange multiplier (box_ellipsoid_point()).
 constexpr int kBoxEdgeNewtonSteps = 3;
 constexpr int kBoxVertexNewtonSteps = 3;
