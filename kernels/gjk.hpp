@@ -218,12 +218,13 @@ constexpr int kRoundEllipsoidSideSteps = 3;
 constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
   return rim_start_pair(a, b) || box_ellipsoid_pair(a, b) || box_round_pair(a, b) || round_ellipsoid_pair(a, b);
 }
-/// A sphere against a convex hull, either order: every double lane (distance, witness and boolean) starts from the
-/// sphere centre's nearest point on the hull's most separating face (kernels/simd/wide_gjk_point_hull.inl) where the
-/// hull has at most kPointHullMaxFaces faces. Not float: the face loop (gathers of double hull data, two per value
-/// in 8 float lanes) costs more than the iterations it saves (close boolean float sphere-convex8 779 -> 947
-/// instructions per pair computed by start(), 975 computed W slots at a time at the chunk's set-up; callgrind
-/// AVX2), where double gains (witness 1387 -> 1027, boolean 983 -> 866; at the set-up 1059 and 899).
+/// A sphere against a convex hull, either order: double distance and witness lanes start from the sphere centre's
+/// nearest point on the hull's most separating face (kernels/simd/wide_gjk_point_hull.inl) where the hull has at
+/// most kPointHullMaxFaces faces. Its face loop reads the lanes' hull data by gathers, slow on this Xeon (the Gather
+/// Data Sampling microcode): close sphere-convex8 witness double 1387 -> 1025 instructions per pair (callgrind
+/// AVX2) and 73.0 -> 70.1 ns per pair (bench, 2 threads); boolean double 983 -> 868 instructions but 54.4 -> 61.1 ns,
+/// so boolean lanes keep the first support point. Not float: 779 -> 947 instructions (boolean, computed by start()),
+/// 975 computed W slots at a time at the chunk's set-up.
 constexpr bool point_hull_pair(ShapeType a, ShapeType b) {
   return (a == ShapeType::sphere && b == ShapeType::convex) || (a == ShapeType::convex && b == ShapeType::sphere);
 }

@@ -677,12 +677,12 @@ template <class T> struct WideGjk {
   /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
   AI static void start(Lanes& L, bool side, bool dirs = false) {
     if (L.fresh == 0) return;
-    // Sphere-hull runs in double: the candidate replaces the first support point wherever it is finite, so that
-    // point is computed only when some fresh lane has no candidate (wide_gjk_point_hull.inl). Never a run with
-    // `dirs` (certified boolean runs exclude hulls).
-    if (std::is_same_v<T, double> && point_hull_pair(L.A.type, L.B.type)) {
+    // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
+    // wherever it is finite, so that point is computed only when some fresh lane has no candidate
+    // (wide_gjk_point_hull.inl).
+    if (std::is_same_v<T, double> && side && point_hull_pair(L.A.type, L.B.type)) {
       const std::uint32_t fresh = L.fresh;
-      const std::uint32_t rest = fresh & ~lane_bits(point_hull_start(L, fresh));
+      const std::uint32_t rest = fresh & ~lane_bits(point_hull_start(L, fresh & ~lane_bits(L.boolean_only)));
       L.fresh = 0;
       if (rest == 0) return;
       V3 sw, sa, sb;

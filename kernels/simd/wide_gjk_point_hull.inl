@@ -1,4 +1,5 @@
-// WideGjk's start point for a sphere against a small hull (kernels/gjk.hpp's point_hull_pair()), either order.
+// WideGjk's start point for a sphere against a small hull (kernels/gjk.hpp's point_hull_pair()), either order, in
+// double distance and witness lanes (gjk.hpp says why not boolean and float).
 // Included inside WideGjk<T> (kernels/simd/wide_gjk.inl); tests/support/reference_point_hull.hpp is its scalar
 // transcription, with the same operations in the same order.
 //

@@ -1,10 +1,10 @@
 // Sphere-hull pairs start from the sphere centre's nearest point on the hull's most separating face
-// (kernels/simd/wide_gjk_point_hull.inl): the lanes give the reference's bits (tests/support/reference_point_hull.hpp
-// through reference_gjk.hpp) on every instruction set, in both orders and precisions (float lanes take none), at
-// the boolean and witness levels, with hulls that take the candidate (8 and 10 vertices: 12 and 16 faces) mixed in
-// one run with hulls that do not (12 and 24 vertices); and the candidate is the exact answer on most pairs: the
-// first plain step certifies it (one iteration), with the distance of a brute-force nearest point over every
-// triangle.
+// (kernels/simd/wide_gjk_point_hull.inl; double distance / witness lanes): the lanes give the reference's bits
+// (tests/support/reference_point_hull.hpp through reference_gjk.hpp) on every instruction set, in both orders and
+// precisions, at the boolean and witness levels (boolean and float lanes take no candidate: bits only), with hulls
+// that take it (8 and 10 vertices: 12 and 16 faces) mixed in one run with hulls that do not (12 and 24 vertices);
+// and the candidate is the exact answer on most pairs: the first plain step certifies it (one iteration), with the
+// distance of a brute-force nearest point over every triangle.
 #include "kernels/narrowphase.hpp"
 #include "kernels/simd/wide_gjk.hpp"
 #include "shape_table_access.hpp"  // engine/src: OwnedShapeView
@@ -139,7 +139,7 @@ template <class T> void check(double exact_within, int percent_one_step) {
           ++compared;
         }
       }
-      if (level != QueryLevel::witness || percent_one_step < 0) continue;
+      if (level != QueryLevel::witness || percent_one_step < 0) continue;  // boolean lanes: bits only
       for (std::size_t i = 0; i < want.size(); ++i) {
         if (!p.takes[i] || p.core_distance[i] < 0) continue;
         ++candidates;
