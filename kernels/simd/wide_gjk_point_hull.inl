@@ -15,98 +15,12 @@
 // Hulls of at most kPointHullMaxFaces faces only (the face loop costs one plane per face per lane); larger hulls,
 // and lanes where the candidate is not finite, keep the first support point.
 
-/// Lane addresses as 64-bit integers whatever T (float lanes: W of them in a wider vector, split into native
-/// registers by the compiler). Never returned by value: float lanes' are wider than a register (AVX2: 64 bytes),
-/// whose return GCC warns changes the ABI (-Wpsabi); out-parameters instead.
-/// (Element types spelled as dependent types: GCC 12 drops vector_size from a typedef whose element type is not
-/// dependent when only its size is, leaving a scalar in the W = 1 build.)
-using I64 = std::conditional_t<sizeof(T) == 0, T, std::int64_t>;
-using F64 = std::conditional_t<sizeof(T) == 0, T, double>;
-typedef I64 Addr __attribute__((vector_size(8 * W)));
-typedef F64 Doubles __attribute__((vector_size(8 * W)));
-
-/// The doubles at the lanes' addresses, as T (T(v): the hull's own conversion in hull_point()). One hardware gather
-/// per native register of 64-bit lanes.
-AI static real gather_t(const Addr& addr) {
-  Doubles r{};
-#if BATCHCOL_SIMD_BYTES == 32
-  for (int k = 0; k < W; k += 4) {
-    __m256i a;
-    std::memcpy(&a, reinterpret_cast<const char*>(&addr) + 8 * k, sizeof a);
-    const __m256d g = _mm256_i64gather_pd(static_cast<const double*>(nullptr), a, 1);
-    std::memcpy(reinterpret_cast<char*>(&r) + 8 * k, &g, sizeof g);
-  }
-#elif BATCHCOL_SIMD_BYTES == 64
-  for (int k = 0; k < W; k += 8) {
-    __m512i a;
-    std::memcpy(&a, reinterpret_cast<const char*>(&addr) + 8 * k, sizeof a);
-    const __m512d g = _mm512_i64gather_pd(a, static_cast<const double*>(nullptr), 1);
-    std::memcpy(reinterpret_cast<char*>(&r) + 8 * k, &g, sizeof g);
-  }
-#else
-  for (int l = 0; l < W; ++l) r[l] = *reinterpret_cast<const double*>(static_cast<std::uintptr_t>(addr[l]));
-#endif
-  if constexpr (std::is_same_v<T, double>) return r;
-  else return __builtin_convertvector(r, real);
-}
-/// The 64-bit words at the lanes' addresses, into r.
-AI static void gather_words(const Addr& addr, Addr& r) {
-#if BATCHCOL_SIMD_BYTES == 32
-  for (int k = 0; k < W; k += 4) {
-    __m256i a;
-    std::memcpy(&a, reinterpret_cast<const char*>(&addr) + 8 * k, sizeof a);
-    const __m256i g = _mm256_i64gather_epi64(static_cast<const long long*>(nullptr), a, 1);
-    std::memcpy(reinterpret_cast<char*>(&r) + 8 * k, &g, sizeof g);
-  }
-#elif BATCHCOL_SIMD_BYTES == 64
-  for (int k = 0; k < W; k += 8) {
-    __m512i a;
-    std::memcpy(&a, reinterpret_cast<const char*>(&addr) + 8 * k, sizeof a);
-    const __m512i g = _mm512_i64gather_epi64(a, static_cast<const long long*>(nullptr), 1);
-    std::memcpy(reinterpret_cast<char*>(&r) + 8 * k, &g, sizeof g);
-  }
-#else
-  for (int l = 0; l < W; ++l) {
-    std::int64_t v;
-    std::memcpy(&v, reinterpret_cast<const void*>(static_cast<std::uintptr_t>(addr[l])), sizeof v);
-    r[l] = v;
-  }
-#endif
-}
-/// A point of every lane's hull: the lanes' hull rows as an Addr per array (faces, normals, vertices) and the
-/// last face index, for lanes whose hull takes a candidate; the others read a one-face dummy hull.
-struct HullAddr {
-  Addr faces, normals, vertices, last;
-};
-static void hull_addresses(const HullView* const* hull, std::uint32_t lanes, HullAddr& h) {
-  static constexpr std::uint32_t dummy_face[3] = {0, 0, 0};
-  static constexpr double dummy_xyz[3] = {0, 0, 0};
-  // Through arrays: element writes into the vectors made GCC warn (maybe-uninitialized) in the W = 1 build.
-  std::int64_t faces[W], normals[W], vertices[W], last[W];
-  for (int l = 0; l < W; ++l) {
-    const HullView* v = (lanes >> l & 1u) ? hull[l] : nullptr;
-    faces[l] = std::int64_t(reinterpret_cast<std::uintptr_t>(v ? v->faces : dummy_face));
-    normals[l] = std::int64_t(reinterpret_cast<std::uintptr_t>(v ? v->face_normals : dummy_xyz));
-    vertices[l] = std::int64_t(reinterpret_cast<std::uintptr_t>(v ? v->vertices : dummy_xyz));
-    last[l] = v ? std::int64_t(v->face_count) - 1 : 0;
-  }
-  std::memcpy(&h.faces, faces, sizeof faces);
-  std::memcpy(&h.normals, normals, sizeof normals);
-  std::memcpy(&h.vertices, vertices, sizeof vertices);
-  std::memcpy(&h.last, last, sizeof last);
-}
 /// Whether a lane's hull takes a candidate: a small hull (linear-scan supports) with at most kPointHullMaxFaces
 /// faces, and its faces and normals present.
 static bool point_hull_takes(const HullView& h) {
   return h.vertex_count < kHillClimbMinVertices && h.face_count >= 1 && h.face_count <= kPointHullMaxFaces &&
          h.faces != nullptr && h.face_normals != nullptr;
 }
-/// Vertex `index` (64-bit lanes) of each lane's hull, as T.
-AI static V3 hull_vertex(const HullAddr& h, const Addr& index) {
-  const Addr p = h.vertices + index * std::int64_t(3 * sizeof(double));
-  return {gather_t(p), gather_t(p + std::int64_t(sizeof(double))), gather_t(p + std::int64_t(2 * sizeof(double)))};
-}
-
 /// c's nearest point on triangle (a, b, e), Ericson's ClosestPtPointTriangle with its region order (vertex a,
 /// vertex b, edge ab, vertex e, edge ae, edge be, interior), each lane taking the first region that holds.
 AI static V3 triangle_point(const V3& c, const V3& a, const V3& b, const V3& e) {
@@ -151,36 +65,38 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
   const V3 c = sphere_a ? V3{-((R[0] * t[0] + R[3] * t[1]) + R[6] * t[2]), -((R[1] * t[0] + R[4] * t[1]) + R[7] * t[2]),
                              -((R[2] * t[0] + R[5] * t[1]) + R[8] * t[2])}
                         : V3{t[0], t[1], t[2]};
-  HullAddr h;
-  hull_addresses(hull, lanes, h);
-  std::int64_t faces = 1;
-  for (int l = 0; l < W; ++l) faces = std::max(faces, h.last[l] + 1);
-  constexpr std::int64_t face_bytes = 3 * sizeof(std::uint32_t), normal_bytes = 3 * sizeof(double);
-  real best = zero;
-  Addr best_face = h.last - h.last;
-  for (std::int64_t f = 0; f < faces; ++f) {
-    // Lanes past their last face read it again (never strictly better).
-    const Addr fl = h.last < f ? h.last : Addr{} + f;
-    Addr first{};
-    gather_words(h.faces + fl * face_bytes, first);
-    const V3 v = hull_vertex(h, first & 0xffffffffLL);
-    const Addr np = h.normals + fl * normal_bytes;
-    const V3 n = {gather_t(np), gather_t(np + std::int64_t(sizeof(double))), gather_t(np + std::int64_t(2 * sizeof(double)))};
-    const real s = (n.x * (c.x - v.x) + n.y * (c.y - v.y)) + n.z * (c.z - v.z);
-    const mask take = f == 0 ? splat_mask(-1) : s > best;
-    best = select(take, s, best);
-    Addr wide_take;  // take as 64-bit lanes
-    if constexpr (sizeof(T) == 8) wide_take = take;
-    else wide_take = __builtin_convertvector(take, Addr);
-    best_face = wide_take ? fl : best_face;
+  // Each lane's face loop runs in scalar code over its own hull's rows (contiguous loads): the vector form read
+  // every face through hardware gathers (7 per face and native register), which cost ~43% wall on distant pairs on
+  // this Xeon (the Gather Data Sampling microcode, an inference). Same operations in the same order as the
+  // reference, each lane an IEEE scalar computation, so bit for bit the same values in every ISA. Lanes outside
+  // `lanes` keep a zero triangle (their result is masked off below).
+  alignas(64) T cx[W], cy[W], cz[W];
+  std::memcpy(cx, &c.x, sizeof cx);
+  std::memcpy(cy, &c.y, sizeof cy);
+  std::memcpy(cz, &c.z, sizeof cz);
+  alignas(64) T tri[9][W] = {};  // a, b, e: x, y, z
+  for (std::uint32_t bits = lanes; bits != 0; bits &= bits - 1) {
+    const int l = __builtin_ctz(bits);
+    const HullView& h = *hull[l];
+    T best = T(0);
+    std::uint32_t best_face = 0;
+    for (std::uint32_t f = 0; f < h.face_count; ++f) {
+      const double* v = h.vertices + 3 * std::size_t(h.faces[3 * f]);
+      const double* n = h.face_normals + 3 * std::size_t(f);
+      const T s = (T(n[0]) * (cx[l] - T(v[0])) + T(n[1]) * (cy[l] - T(v[1]))) + T(n[2]) * (cz[l] - T(v[2]));
+      if (f == 0 || s > best) best = s, best_face = f;
+    }
+    const std::uint32_t* face = h.faces + 3 * std::size_t(best_face);
+    for (int k = 0; k < 3; ++k) {
+      const double* p = h.vertices + 3 * std::size_t(face[k]);
+      tri[3 * k][l] = T(p[0]);
+      tri[3 * k + 1][l] = T(p[1]);
+      tri[3 * k + 2][l] = T(p[2]);
+    }
   }
-  // The best face's vertex indices: the words at its first and second index (both inside the face array).
-  const Addr fp = h.faces + best_face * face_bytes;
-  Addr w01{}, w12{};
-  gather_words(fp, w01);
-  gather_words(fp + std::int64_t(sizeof(std::uint32_t)), w12);
-  const V3 a = hull_vertex(h, w01 & 0xffffffffLL), b = hull_vertex(h, (w01 >> 32) & 0xffffffffLL),
-           e = hull_vertex(h, (w12 >> 32) & 0xffffffffLL);
+  real m[9];
+  std::memcpy(m, tri, sizeof m);
+  const V3 a = {m[0], m[1], m[2]}, b = {m[3], m[4], m[5]}, e = {m[6], m[7], m[8]};
   const V3 q = triangle_point(c, a, b, e);
   if (sphere_a) {
     pa = {zero, zero, zero};
