@@ -231,6 +231,10 @@ constexpr bool point_hull_pair(ShapeType a, ShapeType b) {
 /// The face loop reads one plane per face and lane: bounded to hulls of up to 10 vertices (2 V - 4 triangles), which
 /// is what was measured (convex8, 12 faces); larger hulls keep GJK's first support point.
 constexpr std::uint32_t kPointHullMaxFaces = 16;
+/// Sphere centres farther than this many hull radii from the hull's centroid keep GJK's first support point: far
+/// away it is nearly as good (distant sphere-convex8 pairs: 1.31 GJK iterations without the candidate, 1.03 with
+/// it), and the candidate's face loop cost more wall time than that saves.
+constexpr double kPointHullNearRadii = 2.0;
 /// Newton steps on the edge angle and on the vertex's Lagrange multiplier (box_ellipsoid_point()).
 constexpr int kBoxEdgeNewtonSteps = 3;
 constexpr int kBoxVertexNewtonSteps = 3;

@@ -21,6 +21,13 @@ static bool point_hull_takes(const HullView& h) {
   return h.vertex_count < kHillClimbMinVertices && h.face_count >= 1 && h.face_count <= kPointHullMaxFaces &&
          h.faces != nullptr && h.face_normals != nullptr;
 }
+/// Whether the sphere centre c (hull frame) is within kPointHullNearRadii hull radii of the hull's centroid: far
+/// centres keep the first support point, which is then nearly as good (see kPointHullNearRadii).
+static bool point_hull_near(const HullView& h, T cx, T cy, T cz) {
+  const T dx = cx - T(h.centroid[0]), dy = cy - T(h.centroid[1]), dz = cz - T(h.centroid[2]);
+  const T reach = T(kPointHullNearRadii) * T(h.radius);
+  return (dx * dx + dy * dy) + dz * dz <= reach * reach;
+}
 /// c's nearest point on triangle (a, b, e), Ericson's ClosestPtPointTriangle with its region order (vertex a,
 /// vertex b, edge ab, vertex e, edge ae, edge be, interior), each lane taking the first region that holds.
 AI static V3 triangle_point(const V3& c, const V3& a, const V3& b, const V3& e) {
@@ -75,9 +82,12 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
   std::memcpy(cy, &c.y, sizeof cy);
   std::memcpy(cz, &c.z, sizeof cz);
   alignas(64) T tri[9][W] = {};  // a, b, e: x, y, z
+  std::uint32_t near = 0;
   for (std::uint32_t bits = lanes; bits != 0; bits &= bits - 1) {
     const int l = __builtin_ctz(bits);
     const HullView& h = *hull[l];
+    if (!point_hull_near(h, cx[l], cy[l], cz[l])) continue;
+    near |= 1u << l;
     T best = T(0);
     std::uint32_t best_face = 0;
     for (std::uint32_t f = 0; f < h.face_count; ++f) {
@@ -94,6 +104,7 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
       tri[3 * k + 2][l] = T(p[2]);
     }
   }
+  if (near == 0) return splat_mask(0);  // no triangle_point() (two divisions) for far-only refills
   real m[9];
   std::memcpy(m, tri, sizeof m);
   const V3 a = {m[0], m[1], m[2]}, b = {m[3], m[4], m[5]}, e = {m[6], m[7], m[8]};
@@ -106,7 +117,7 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
     pa = q;
     pb = {t[0], t[1], t[2]};
   }
-  return lanes_of(lanes) & (norm2(sub(pa, pb)) < splat(std::numeric_limits<T>::infinity()));
+  return lanes_of(near) & (norm2(sub(pa, pb)) < splat(std::numeric_limits<T>::infinity()));
 }
 /// start()'s candidates for the fresh lanes `fresh` of a point_hull_pair() run: where a lane's is finite it
 /// replaces the first support point (take_start()'s writes, unconditionally). Returns those lanes.
@@ -119,7 +130,7 @@ AI static mask point_hull_start(Lanes& L, std::uint32_t fresh) {
     if (point_hull_takes(*s.hull[l])) lanes |= 1u << l;
   }
   if (lanes == 0) return splat_mask(0);
-  V3 pa, pb;
+  V3 pa{}, pb{};  // unwritten when no lane is near
   const mask ok = point_hull_candidate(L.R, L.t, sphere_a, s.hull, lanes, pa, pb);
   if (!any(ok)) return ok;
   const V3 x = sub(pa, pb);

@@ -65,8 +65,9 @@ template <class T> struct Pairs {
 };
 
 /// Sphere-hull pairs (hull A when `hull_a`): hulls of `vertices[i % 4]` points on an ellipsoid, the sphere centre
-/// 1e-4 to 3e-2 m (plus the radius) outside the hull's bounding sphere or closer, random rotations.
-template <class T> Pairs<T> make_pairs(Rng& rng, bool hull_a, const QueryOptions& o, int count) {
+/// 1e-4 to 3e-2 m (plus the radius) outside the hull's bounding sphere or closer, random rotations. `far`: 1 to 2 m
+/// outside instead, beyond kernels::kPointHullNearRadii hull radii (every hull radius here is below 0.35 m).
+template <class T> Pairs<T> make_pairs(Rng& rng, bool hull_a, const QueryOptions& o, int count, bool far = false) {
   Pairs<T> p;
   const int vertices[4] = {8, 10, 12, 24};
   for (int i = 0; i < count; ++i) {
@@ -78,7 +79,8 @@ template <class T> Pairs<T> make_pairs(Rng& rng, bool hull_a, const QueryOptions
     const V u = testing::random_unit_vector(rng);
     double extent = 0;
     for (const V& v : hull.hull->vertices) extent = std::max(extent, v.dot(u));
-    const V c = u * (extent + std::pow(10.0, testing::uniform(rng, -4, -1.5)));
+    const double gap = far ? testing::uniform(rng, 1, 2) : std::pow(10.0, testing::uniform(rng, -4, -1.5));
+    const V c = u * (extent + gap);
     const Eigen::Matrix3d Rh = testing::random_rotation(rng).toRotationMatrix();  // hull in the sphere's frame
     p.keep.emplace_back(hull_a ? hull : sphere);
     const ShapeView& a = p.keep.back().view;
@@ -104,8 +106,8 @@ template <class T> Pairs<T> make_pairs(Rng& rng, bool hull_a, const QueryOptions
 /// `exact_within`: the largest |distance - brute force| of a one-step answer (rounding of T at the pairs' scale);
 /// `percent_one_step` < 0: T's lanes take no candidate (float: kernels/gjk.hpp's point_hull_pair() says why), only
 /// the bits are compared.
-template <class T> void check(double exact_within, int percent_one_step) {
-  Rng rng(2031);
+template <class T> void check(double exact_within, int percent_one_step, bool far = false) {
+  Rng rng(far ? 2032 : 2031);
   int compared = 0, candidates = 0, one_step = 0, exact = 0;
   for (const bool hull_a : {false, true}) {
     for (const QueryLevel level : {QueryLevel::witness, QueryLevel::boolean}) {
@@ -114,8 +116,14 @@ template <class T> void check(double exact_within, int percent_one_step) {
       o.precision = std::is_same_v<T, float> ? Precision::float32 : Precision::float64;
       o.solver = resolve_solver(o.solver, o.level);
       o.tolerance = 1e-8;
-      const Pairs<T> p = make_pairs<T>(rng, hull_a, o, 400);
+      const Pairs<T> p = make_pairs<T>(rng, hull_a, o, 400, far);
       ASSERT_GT(p.setups.size(), 350u);
+      if (far) {  // the gate: no candidate, the lanes' bits below then say they keep the first support point too
+        for (const auto& s : p.setups) {
+          kernels::SupportPoint<T> sp;
+          ASSERT_FALSE(test_reference::point_hull_candidate(s.difference(), sp));
+        }
+      }
       std::vector<kernels::GjkResult<T>> want;
       for (const auto& s : p.setups) want.push_back(test_reference::gjk(s.difference(), s.initial_direction, s.params));
       for (const InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
@@ -161,6 +169,8 @@ template <class T> void check(double exact_within, int percent_one_step) {
 
 TEST(PointHull, LanesHaveTheReferenceBitsAndTheStartIsTheNearestPointDouble) { check<double>(1e-12, 90); }
 TEST(PointHull, FloatLanesHaveTheReferenceBits) { check<float>(0, -1); }
+// Centres beyond kPointHullNearRadii hull radii take no candidate (reference and lanes); fails without the gate.
+TEST(PointHull, FarCentresKeepTheFirstSupportPoint) { check<double>(0, -1, true); }
 
 }  // namespace
 }  // namespace batchcol

@@ -52,6 +52,9 @@ template <class T> bool point_hull_candidate(const MinkowskiDifference<T>& D, Su
                                        -((R(0, 1) * t.x() + R(1, 1) * t.y()) + R(2, 1) * t.z()),
                                        -((R(0, 2) * t.x() + R(1, 2) * t.y()) + R(2, 2) * t.z()))
                              : t;
+  const T dx = c.x() - T(h.centroid[0]), dy = c.y() - T(h.centroid[1]), dz = c.z() - T(h.centroid[2]);
+  const T reach = T(kPointHullNearRadii) * T(h.radius);
+  if (!((dx * dx + dy * dy) + dz * dz <= reach * reach)) return false;  // point_hull_near()
   T best = T(0);
   std::uint32_t best_face = 0;
   for (std::uint32_t f = 0; f < h.face_count; ++f) {
