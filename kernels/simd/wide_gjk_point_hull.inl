@@ -63,7 +63,7 @@ AI static V3 triangle_point(const V3& c, const V3& a, const V3& b, const V3& e) 
   return pick(at_a, a, q);
 }
 
-/// The candidate of the lanes of `lanes` (the hull lanes of a point_hull_pair() run; hull: each lane's view): pa,
+/// The candidate of the lanes of `lanes` (the near hull lanes of a point_hull_pair() run; hull: each lane's view): pa,
 /// pb on A and B (A's frame). Returns the lanes whose candidate is finite.
 AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a, const HullView* const* hull,
                                     std::uint32_t lanes, V3& pa, V3& pb) {
@@ -82,12 +82,9 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
   std::memcpy(cy, &c.y, sizeof cy);
   std::memcpy(cz, &c.z, sizeof cz);
   alignas(64) T tri[9][W] = {};  // a, b, e: x, y, z
-  std::uint32_t near = 0;
   for (std::uint32_t bits = lanes; bits != 0; bits &= bits - 1) {
     const int l = __builtin_ctz(bits);
     const HullView& h = *hull[l];
-    if (!point_hull_near(h, cx[l], cy[l], cz[l])) continue;
-    near |= 1u << l;
     T best = T(0);
     std::uint32_t best_face = 0;
     for (std::uint32_t f = 0; f < h.face_count; ++f) {
@@ -104,7 +101,6 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
       tri[3 * k + 2][l] = T(p[2]);
     }
   }
-  if (near == 0) return splat_mask(0);  // no triangle_point() (two divisions) for far-only refills
   real m[9];
   std::memcpy(m, tri, sizeof m);
   const V3 a = {m[0], m[1], m[2]}, b = {m[3], m[4], m[5]}, e = {m[6], m[7], m[8]};
@@ -117,7 +113,7 @@ AI static mask point_hull_candidate(const real* R, const real* t, bool sphere_a,
     pa = q;
     pb = {t[0], t[1], t[2]};
   }
-  return lanes_of(near) & (norm2(sub(pa, pb)) < splat(std::numeric_limits<T>::infinity()));
+  return lanes_of(lanes) & (norm2(sub(pa, pb)) < splat(std::numeric_limits<T>::infinity()));
 }
 /// start()'s candidates for the fresh lanes `fresh` of a point_hull_pair() run: where a lane's is finite it
 /// replaces the first support point (take_start()'s writes, unconditionally). Returns those lanes.
@@ -127,10 +123,19 @@ AI static mask point_hull_start(Lanes& L, std::uint32_t fresh) {
   std::uint32_t lanes = 0;
   for (std::uint32_t bits = fresh & s.small; bits != 0; bits &= bits - 1) {
     const int l = __builtin_ctz(bits);
-    if (point_hull_takes(*s.hull[l])) lanes |= 1u << l;
+    const HullView& h = *s.hull[l];
+    if (!point_hull_takes(h)) continue;
+    // The centre as point_hull_candidate() computes it, lane l's IEEE scalar operations (the same bits): refills
+    // of far lanes only (most distant pairs) then cost no vector work.
+    const real* R = L.R;
+    const real* t = L.t;
+    const T cx = sphere_a ? -((R[0][l] * t[0][l] + R[3][l] * t[1][l]) + R[6][l] * t[2][l]) : t[0][l];
+    const T cy = sphere_a ? -((R[1][l] * t[0][l] + R[4][l] * t[1][l]) + R[7][l] * t[2][l]) : t[1][l];
+    const T cz = sphere_a ? -((R[2][l] * t[0][l] + R[5][l] * t[1][l]) + R[8][l] * t[2][l]) : t[2][l];
+    if (point_hull_near(h, cx, cy, cz)) lanes |= 1u << l;
   }
   if (lanes == 0) return splat_mask(0);
-  V3 pa{}, pb{};  // unwritten when no lane is near
+  V3 pa, pb;
   const mask ok = point_hull_candidate(L.R, L.t, sphere_a, s.hull, lanes, pa, pb);
   if (!any(ok)) return ok;
   const V3 x = sub(pa, pb);
