@@ -220,11 +220,11 @@ constexpr bool start_candidate_pair(ShapeType a, ShapeType b) {
 }
 /// A sphere against a convex hull, either order: double distance and witness lanes start from the sphere centre's
 /// nearest point on the hull's most separating face (kernels/simd/wide_gjk_point_hull.inl) where the hull has at
-/// most kPointHullMaxFaces faces. Its face loop reads the lanes' hull data by gathers, slow on this Xeon (the Gather
-/// Data Sampling microcode): close sphere-convex8 witness double 1387 -> 1025 instructions per pair (callgrind
-/// AVX2) and 73.0 -> 70.1 ns per pair (bench, 2 threads); boolean double 983 -> 868 instructions but 54.4 -> 61.1 ns,
-/// so boolean lanes keep the first support point. Not float: 779 -> 947 instructions (boolean, computed by start()),
-/// 975 computed W slots at a time at the chunk's set-up.
+/// most kPointHullMaxFaces faces and the centre is near (kPointHullNearRadii). Each lane's face loop is scalar code
+/// over its own hull's rows: the first form gathered them, slow on this Xeon (the Gather Data Sampling microcode, an
+/// inference). Close sphere-convex8 witness double (bench, 2 threads, AVX-512) ~134 -> ~105 ns per pair, distant ~87
+/// -> ~92. Boolean lanes keep the first support point (gathered form: double 983 -> 868 callgrind instructions but
+/// 54.4 -> 61.1 ns; not re-measured with the scalar loop). Not float: 779 -> 947 instructions (boolean, gathered).
 constexpr bool point_hull_pair(ShapeType a, ShapeType b) {
   return (a == ShapeType::sphere && b == ShapeType::convex) || (a == ShapeType::convex && b == ShapeType::sphere);
 }
