@@ -677,6 +677,24 @@ template <class T> struct WideGjk {
   /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
   AI static void start(Lanes& L, bool side, bool dirs = false) {
     if (L.fresh == 0) return;
+    // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
+    // wherever it is finite, so that point is computed only when some fresh lane has no candidate
+    // (wide_gjk_point_hull.inl).
+    if (std::is_same_v<T, double> && side && point_hull_pair(L.A.type, L.B.type)) {
+      const std::uint32_t fresh = L.fresh;
+      const std::uint32_t rest = fresh & ~lane_bits(point_hull_start(L, fresh & ~lane_bits(L.boolean_only)));
+      L.fresh = 0;
+      if (rest == 0) return;
+      V3 sw, sa, sb;
+      minkowski(L, neg(L.d_prev), rest, sw, sa, sb);
+      const mask m = lanes_of(rest);
+      L.w[0] = pick(m, sw, L.w[0]);
+      L.a[0] = pick(m, sa, L.a[0]);
+      L.b[0] = pick(m, sb, L.b[0]);
+      L.x = pick(m, sw, L.x);
+      L.last_s = pick(m, sw, L.last_s);
+      return;
+    }
     V3 sw, sa, sb;
     minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
     const mask m = lanes_of(L.fresh);
@@ -932,6 +950,7 @@ template <class T> struct WideGjk {
     pb = pick(apart, pb, V3{nan, nan, nan});
   }
 
+#include "kernels/simd/wide_gjk_point_hull.inl"
 #include "kernels/simd/wide_gjk_box_ellipsoid.inl"
 #include "kernels/simd/wide_gjk_box_round.inl"
 #include "kernels/simd/wide_gjk_rim_rim.inl"

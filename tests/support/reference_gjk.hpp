@@ -20,6 +20,7 @@
 #include "kernels/minkowski.hpp"
 #include "support/reference_box_ellipsoid.hpp"
 #include "support/reference_box_round.hpp"
+#include "support/reference_point_hull.hpp"
 #include "support/reference_rim_rim.hpp"
 #include "support/reference_round_ellipsoid.hpp"
 #include "support/reference_simplex_projection.hpp"
@@ -370,6 +371,17 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
+  // Sphere-hull pairs in double, distance and witness queries: the centre's nearest point on the most separating face replaces the first support point
+  // wherever it is finite, and the first step is a plain one (wide_gjk_point_hull.inl, reference_point_hull.hpp).
+  if (std::is_same_v<T, double> && !params.boolean_only && point_hull_pair(D.A->type, D.B->type)) {
+    SupportPoint<T> p;
+    if (point_hull_candidate(D, p)) {
+      S.v[0] = p;
+      x = p.w;
+      last_s = x;
+      momentum = false;
+    }
+  }
   // A closed-form start point replaces the first support point where it is closer; the first step is then a plain
   // one (wide_gjk.inl's start()).
   const auto take_start = [&](bool found, const SupportPoint<T>& p) {
