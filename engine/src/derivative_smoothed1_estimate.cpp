@@ -182,6 +182,7 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     return p;
   };
   const Eigen::Vector3d s0 = support(u);
+  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
   // The noise z comes drawn (the caller draws both sides' at once). All the directions, then the support points,
   // then their sums, each in its own loop: the support call clobbers every vector register, so whatever a loop
   // around it kept (the noise, u, e, the sums) lived on the stack.
@@ -225,7 +226,6 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     const double* v = view.hull->vertices;
     double* const index_of = q + 3 * n;  // the first maximum's vertex of each direction (n4 of them)
     std::size_t j_done = 0;  // directions whose sample differences are written
-    const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;
     if (wide) scan_hull_avx2(v, view.hull->vertex_count, d, n4, index_of);
     else scan_hull_sse2(v, view.hull->vertex_count, d, n4, index_of);
     if (wide && core.radius == 0.0) {
@@ -255,7 +255,7 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     // kernels::support()'s ellipsoid, two directions per SSE2 register with its operations in its order (rd = r .* d,
     // m = sqrt((rd_x^2 + rd_y^2) + rd_z^2), (r .* rd) / m, zero where m == 0): the same bits without a call per
     // sample (~47 instructions each, callgrind). The directions are padded with zeros to n4.
-    if (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) {
+    if (wide) {
       ellipsoid_differences_avx2(core.size.data(), d, n, s0.data(), q);
     } else {
       const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
@@ -279,7 +279,7 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
   }
   // Each entry s_rc still adds (S_r - s0_r) z_c sample after sample (q (-z) added is q z subtracted, exactly).
   double sum[3][4];
-  if (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) {
+  if (wide) {
     Eigen::Matrix3d S;
     sample_sums_avx2(q, z, draws, n, static_cast<double>(samples) * e, S.data());
     return S;

@@ -113,8 +113,8 @@ inline void hull_pair_directions(const Eigen::Quaterniond& q_a, const Eigen::Qua
 /// rotation and the projection are written out with Eigen's operations in its order (the same bits, tested against
 /// Eigen in tests/engine/derivatives_lanes_test.cpp): GCC called both out of line from hull_pair(), 27.5 + 11.1
 /// instructions per convex8 pair plus the calls' spills (callgrind AVX2).
-inline __attribute__((always_inline)) bool edge_flat(const Eigen::Quaterniond& unit, const Eigen::Vector3d& edge, const Eigen::Vector3d& n,
-                      Eigen::Vector3d& flat) {
+inline __attribute__((always_inline)) bool edge_flat(const Eigen::Quaterniond& unit, const Eigen::Vector3d& edge,
+                                                     const Eigen::Vector3d& n, Eigen::Vector3d& flat) {
   const double x = unit.x(), y = unit.y(), z = unit.z(), w = unit.w();
   double uv0 = y * edge.z() - z * edge.y(), uv1 = z * edge.x() - x * edge.z(), uv2 = x * edge.y() - y * edge.x();
   uv0 += uv0, uv1 += uv1, uv2 += uv2;

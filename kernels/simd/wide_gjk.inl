@@ -677,27 +677,20 @@ template <class T> struct WideGjk {
   /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
   AI static void start(Lanes& L, bool side, bool dirs = false) {
     if (L.fresh == 0) return;
+    std::uint32_t first = L.fresh;  // the lanes that start from the first support point
     // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
-    // wherever it is finite, so that point is computed only when some fresh lane has no candidate
-    // (wide_gjk_point_hull.inl).
+    // wherever it is finite, so that point is computed only for the fresh lanes without one
+    // (wide_gjk_point_hull.inl). No other start below applies to sphere-hull pairs.
     if (std::is_same_v<T, double> && side && point_hull_pair(L.A.type, L.B.type)) {
-      const std::uint32_t fresh = L.fresh;
-      const std::uint32_t rest = fresh & ~lane_bits(point_hull_start(L, fresh & ~lane_bits(L.boolean_only)));
-      L.fresh = 0;
-      if (rest == 0) return;
-      V3 sw, sa, sb;
-      minkowski(L, neg(L.d_prev), rest, sw, sa, sb);
-      const mask m = lanes_of(rest);
-      L.w[0] = pick(m, sw, L.w[0]);
-      L.a[0] = pick(m, sa, L.a[0]);
-      L.b[0] = pick(m, sb, L.b[0]);
-      L.x = pick(m, sw, L.x);
-      L.last_s = pick(m, sw, L.last_s);
-      return;
+      first &= ~lane_bits(point_hull_start(L, first & ~lane_bits(L.boolean_only)));
+      if (first == 0) {
+        L.fresh = 0;
+        return;
+      }
     }
     V3 sw, sa, sb;
-    minkowski(L, neg(L.d_prev), L.fresh, sw, sa, sb);
-    const mask m = lanes_of(L.fresh);
+    minkowski(L, neg(L.d_prev), first, sw, sa, sb);
+    const mask m = lanes_of(first);
     L.w[0] = pick(m, sw, L.w[0]);
     L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
     L.b[0] = pick(m, sb, L.b[0]);

@@ -371,8 +371,9 @@ GjkResult<T> gjk(const MinkowskiDifference<T>& D, Vec3<T> initial_direction, con
   Vec3<T> last_s = x;
   assert(params.solver != Solver::automatic && "resolve_solver() first (set_gjk_parameters does)");
   bool momentum = params.solver != Solver::gjk;
-  // Sphere-hull pairs in double, distance and witness queries: the centre's nearest point on the most separating face replaces the first support point
-  // wherever it is finite, and the first step is a plain one (wide_gjk_point_hull.inl, reference_point_hull.hpp).
+  // Sphere-hull pairs in double, distance and witness queries: the centre's nearest point on the most separating
+  // face replaces the first support point wherever it is finite, and the first step is a plain one
+  // (wide_gjk_point_hull.inl, reference_point_hull.hpp).
   if (std::is_same_v<T, double> && !params.boolean_only && point_hull_pair(D.A->type, D.B->type)) {
     SupportPoint<T> p;
     if (point_hull_candidate(D, p)) {
