@@ -39,7 +39,8 @@ struct Smoothed1Lanes {
 
 /// The smoothed support-map Jacobian at unit local direction u before its projection (psd_projection()):
 /// 1/(M e) sum_j (S(u + e z_j) - S(u)) z_j^T with z_j standard normal in R^3 and antithetic pairs z_{2k+1} = -z_{2k}
-/// (the baseline S(u) cancels within a pair), symmetrised. The Hessian of the smoothed convex support function is
+/// (the baseline S(u) cancels within a pair: each pair adds (S(u + e z) - S(u - e z)) z^T, and only an odd M's last
+/// sample takes S(u)), symmetrised. The Hessian of the smoothed convex support function is
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
 /// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
 /// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the

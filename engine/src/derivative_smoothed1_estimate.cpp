@@ -101,59 +101,58 @@ __attribute__((noinline)) void scan_hull_avx2(const double* v, std::uint32_t cou
   }
 }
 
-// q_j = v_index[j] - s0 for the n samples of a hull without inflation, a masked load, subtraction and store of three
-// coordinates each (the scalar copy was ~19 instructions a sample with its index conversions and bound tests).
-__attribute__((noinline)) void hull_differences_avx2(const double* v, const double* index, std::size_t n,
-                                                     const double* s0, double* q) {
+// q_k = v_index[2k] - v_index[2k+1] for the `pairs` antithetic pairs of a hull without inflation, two masked loads,
+// a subtraction and a store of three coordinates each (the scalar copy was ~19 instructions a sample with its index
+// conversions and bound tests).
+__attribute__((noinline)) void hull_differences_avx2(const double* v, const double* index, std::size_t pairs,
+                                                     double* q) {
   const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
-  const __m256d base = _mm256_maskload_pd(s0, three);
-  for (std::size_t j = 0; j < n; ++j) {
-    const double* p = v + 3 * static_cast<std::size_t>(index[j]);
-    _mm256_maskstore_pd(q + 3 * j, three, _mm256_sub_pd(_mm256_maskload_pd(p, three), base));
+  for (std::size_t k = 0; k < pairs; ++k) {
+    const double* plus = v + 3 * static_cast<std::size_t>(index[2 * k]);
+    const double* minus = v + 3 * static_cast<std::size_t>(index[2 * k + 1]);
+    _mm256_maskstore_pd(q + 3 * k, three,
+                        _mm256_sub_pd(_mm256_maskload_pd(plus, three), _mm256_maskload_pd(minus, three)));
   }
 }
 // The ellipsoid branch of smoothed_support_estimate() (kernels::support()'s formula in its order, zero where
-// |r .* d| = 0) four directions per AVX2 register, and q_j = S(d_j) - s0 transposed to three coordinates a sample by
-// register shuffles and masked stores: the same bits, half the SSE2 form's instructions per sample.
-__attribute__((noinline)) void ellipsoid_differences_avx2(const double* radii, const double* const* d, std::size_t n,
-                                                          const double* s0, double* q) {
+// |r .* d| = 0) four directions (two antithetic pairs) per AVX2 register, and q_k = S(d_2k) - S(d_2k+1) (each lane
+// minus its neighbour) transposed to three coordinates a pair by register shuffles and masked stores: the same bits
+// as the SSE2 form, half its instructions per sample.
+__attribute__((noinline)) void ellipsoid_differences_avx2(const double* radii, const double* const* d,
+                                                          std::size_t pairs, double* q) {
   const __m256d rx = _mm256_set1_pd(radii[0]), ry = _mm256_set1_pd(radii[1]), rz = _mm256_set1_pd(radii[2]);
-  const __m256d bx = _mm256_set1_pd(s0[0]), by = _mm256_set1_pd(s0[1]), bz = _mm256_set1_pd(s0[2]);
   const __m256d zero = _mm256_setzero_pd();
   const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
-  for (std::size_t j = 0; j < n; j += 4) {  // the directions are padded with zeros to a multiple of 4
+  for (std::size_t j = 0; j < 2 * pairs; j += 4) {  // the directions are padded with zeros to a multiple of 4
     const __m256d ax = _mm256_mul_pd(rx, _mm256_loadu_pd(d[0] + j));
     const __m256d ay = _mm256_mul_pd(ry, _mm256_loadu_pd(d[1] + j));
     const __m256d az = _mm256_mul_pd(rz, _mm256_loadu_pd(d[2] + j));
     const __m256d m = _mm256_sqrt_pd(
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, ax), _mm256_mul_pd(ay, ay)), _mm256_mul_pd(az, az)));
     const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
-    const auto point = [&](__m256d r, __m256d a, __m256d base) {
-      return _mm256_sub_pd(_mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r, a), m), zero, at_zero), base);
+    const auto difference = [&](__m256d r, __m256d a) {  // lanes 0 and 2: S(d_2k) - S(d_2k+1)
+      const __m256d p = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r, a), m), zero, at_zero);
+      return _mm256_sub_pd(p, _mm256_permute_pd(p, 0x5));
     };
-    const __m256d X = point(rx, ax, bx), Y = point(ry, ay, by), Z = point(rz, az, bz);
-    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y);  // x0 y0 x2 y2, x1 y1 x3 y3
-    const __m256d t2 = _mm256_unpacklo_pd(Z, zero), t3 = _mm256_unpackhi_pd(Z, zero);
-    const __m256d rows[4] = {_mm256_permute2f128_pd(t0, t2, 0x20), _mm256_permute2f128_pd(t1, t3, 0x20),
-                             _mm256_permute2f128_pd(t0, t2, 0x31), _mm256_permute2f128_pd(t1, t3, 0x31)};
-    for (std::size_t l = 0; l < 4 && j + l < n; ++l) _mm256_maskstore_pd(q + 3 * (j + l), three, rows[l]);
+    const __m256d X = difference(rx, ax), Y = difference(ry, ay), Z = difference(rz, az);
+    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t2 = _mm256_unpacklo_pd(Z, zero);  // x0 y0 x2 y2, z0 0 z2 0
+    _mm256_maskstore_pd(q + 3 * (j / 2), three, _mm256_permute2f128_pd(t0, t2, 0x20));
+    if (j / 2 + 1 < pairs) _mm256_maskstore_pd(q + 3 * (j / 2 + 1), three, _mm256_permute2f128_pd(t0, t2, 0x31));
   }
 }
 
-// The sample sums of smoothed_support_estimate() with row r of s_rc = sum_j +-(S_r - s0_r) z_c in one AVX2 register
-// (lane 3 unused): the same products and the same order of additions per entry as its SSE2 form, half the
-// instructions (one broadcast, product and sum per row and sample instead of a pair, a scalar and their moves).
+// The sample sums of smoothed_support_estimate() with row r of s_rc = sum_k q_kr z_ck in one AVX2 register (lane 3
+// unused): the same products and the same order of additions per entry as its SSE2 form, half the instructions
+// (one broadcast, product and sum per row and draw instead of a pair, a scalar and their moves).
 // Then, as the SSE2 path's tail, H = sum / scale and S = 0.5 (H + H^T) (written to S: symmetric, so either order), the
 // rows divided in registers and H^T by a register transpose instead of nine scalar divisions and Eigen's expression.
 __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* const* z, std::size_t draws,
-                                                std::size_t n, double scale, double* S) {
+                                                double scale, double* S) {
   __m256d s[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
   for (std::size_t k = 0; k < draws; ++k) {
     const __m256d zk = _mm256_setr_pd(z[0][k], z[1][k], z[2][k], 0.0);
-    const double* qj = q + 6 * k;
-    for (int r = 0; r < 3; ++r) s[r] = _mm256_add_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qj + r), zk));
-    if (2 * k + 1 < n)
-      for (int r = 0; r < 3; ++r) s[r] = _mm256_sub_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qj + 3 + r), zk));
+    const double* qk = q + 3 * k;
+    for (int r = 0; r < 3; ++r) s[r] = _mm256_add_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qk + r), zk));
   }
   const __m256d by = _mm256_set1_pd(scale), half = _mm256_set1_pd(0.5), zero = _mm256_setzero_pd();
   const __m256d h0 = _mm256_div_pd(s[0], by), h1 = _mm256_div_pd(s[1], by), h2 = _mm256_div_pd(s[2], by);
@@ -181,18 +180,24 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     add_swept_radius(p, core.radius, d);
     return p;
   };
-  const Eigen::Vector3d s0 = support(u);
   const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
   // The noise z comes drawn (the caller draws both sides' at once). All the directions, then the support points,
   // then their sums, each in its own loop: the support call clobbers every vector register, so whatever a loop
   // around it kept (the noise, u, e, the sums) lived on the stack.
   const std::size_t draws = static_cast<std::size_t>(samples + 1) / 2;
   const std::size_t n = static_cast<std::size_t>(samples), n4 = (n + 3) & ~std::size_t(3);
+  const std::size_t pairs = n / 2;  // antithetic pairs; an odd M's last sample has no copy
   thread_local std::vector<double> buffer;
   if (buffer.size() < 4 * n4 + 3 * n) buffer.resize(4 * n4 + 3 * n);
   double* const d[3] = {buffer.data(), buffer.data() + n4,
                         buffer.data() + 2 * n4};  // u + e z_j by coordinate, padded with zeros to 4
-  double* const q = buffer.data() + 3 * n4;       // S(u + e z_j) - s0, 3 per sample, then a scan's n4 indices
+  // q_k = S(u + e z_k) - S(u - e z_k) per antithetic pair k (3 each), and an odd M's last q = S(u + e z) - S(u);
+  // after them a scan's n4 indices. The pair's two terms (S(u + e z) - S(u)) z and (S(u - e z) - S(u)) (-z) sum to
+  // q_k z exactly in real arithmetic: the baseline S(u) cancels, so it is neither computed nor subtracted for
+  // even M (one support call per side fewer, one product per pair instead of two; callgrind AVX2 convex8 M = 4:
+  // -453 instructions a pair). The rounding differs from the former per-sample form (S(u+ez) - S(u)) - (S(u-ez) -
+  // S(u)) (the bits changed; the estimator did not).
+  double* const q = buffer.data() + 3 * n4;
   // Sample 2k adds e z_k, its antithetic copy 2k+1 subtracts it: u + e (-z) and u - e z are the same bits.
   // Two draws per SSE2 register (the same products and sums; the scalar loop, ~24 instructions per two draws and
   // coordinate, was ~70 per side at M = 4, callgrind): {u + e z_k, u + e z_k+1} and {u - e z_k, u - e z_k+1}
@@ -219,88 +224,75 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     }
     if (n4 > n) std::fill(dc + n, dc + n4, 0.0);  // GCC called memset for the empty fill (M = 4: ~120 a pair)
   }
+  const auto direction = [&](std::size_t j) { return Eigen::Vector3d(d[0][j], d[1][j], d[2][j]); };
   if (view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
       view.hull->vertex_count > 0) {
     // A scanned hull (kernels::hull_support's small-hull path): every direction's first maximum (scan_hull_*()),
-    // then the sample points.
+    // then the pairs' differences.
     const double* v = view.hull->vertices;
     double* const index_of = q + 3 * n;  // the first maximum's vertex of each direction (n4 of them)
-    std::size_t j_done = 0;  // directions whose sample differences are written
     if (wide) scan_hull_avx2(v, view.hull->vertex_count, d, n4, index_of);
     else scan_hull_sse2(v, view.hull->vertex_count, d, n4, index_of);
     if (wide && core.radius == 0.0) {
-      hull_differences_avx2(v, index_of, n, s0.data(), q);
-      j_done = n4;
-    }
-    for (std::size_t j0 = j_done; j0 < n4; j0 += 4) {
-      const double* const index = index_of + j0;
-      const std::size_t lanes = std::min<std::size_t>(4, n - j0);
-      if (core.radius == 0.0) {
-        for (std::size_t l = 0; l < lanes; ++l) {
-          const double* p = v + 3 * static_cast<std::size_t>(index[l]);
-          double* qj = q + 3 * (j0 + l);
-          qj[0] = p[0] - s0[0], qj[1] = p[1] - s0[1], qj[2] = p[2] - s0[2];
-        }
-        continue;
-      }
-      for (std::size_t l = 0; l < lanes; ++l) {
-        const std::size_t j = j0 + l;
-        const double* p = v + 3 * static_cast<std::size_t>(index[l]);
-        Eigen::Vector3d point(p[0], p[1], p[2]);
-        add_swept_radius(point, core.radius, Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));  // as support()
-        for (int r = 0; r < 3; ++r) q[3 * j + r] = point[r] - s0[r];
+      hull_differences_avx2(v, index_of, pairs, q);
+    } else {
+      const auto point = [&](std::size_t j) {  // as support()
+        const double* p = v + 3 * static_cast<std::size_t>(index_of[j]);
+        Eigen::Vector3d x(p[0], p[1], p[2]);
+        if (core.radius != 0.0) add_swept_radius(x, core.radius, direction(j));
+        return x;
+      };
+      for (std::size_t k = 0; k < pairs; ++k) {
+        const Eigen::Vector3d plus = point(2 * k), minus = point(2 * k + 1);
+        for (int r = 0; r < 3; ++r) q[3 * k + r] = plus[r] - minus[r];
       }
     }
   } else if (view.type == ShapeType::ellipsoid && core.radius == 0.0) {
-    // kernels::support()'s ellipsoid, two directions per SSE2 register with its operations in its order (rd = r .* d,
-    // m = sqrt((rd_x^2 + rd_y^2) + rd_z^2), (r .* rd) / m, zero where m == 0): the same bits without a call per
-    // sample (~47 instructions each, callgrind). The directions are padded with zeros to n4.
+    // kernels::support()'s ellipsoid, two directions (an antithetic pair) per SSE2 register with its operations in
+    // its order (rd = r .* d, m = sqrt((rd_x^2 + rd_y^2) + rd_z^2), (r .* rd) / m, zero where m == 0): the same bits
+    // without a call per sample (~47 instructions each, callgrind). The directions are padded with zeros to n4.
     if (wide) {
-      ellipsoid_differences_avx2(core.size.data(), d, n, s0.data(), q);
+      ellipsoid_differences_avx2(core.size.data(), d, pairs, q);
     } else {
       const V2 rx = V2{} + core.size.x(), ry = V2{} + core.size.y(), rz = V2{} + core.size.z();
-      for (std::size_t j = 0; j < n; j += 2) {
+      for (std::size_t k = 0; k < pairs; ++k) {
         V2 dx, dy, dz;
-        std::memcpy(&dx, d[0] + j, sizeof dx), std::memcpy(&dy, d[1] + j, sizeof dy);
-        std::memcpy(&dz, d[2] + j, sizeof dz);
+        std::memcpy(&dx, d[0] + 2 * k, sizeof dx), std::memcpy(&dy, d[1] + 2 * k, sizeof dy);
+        std::memcpy(&dz, d[2] + 2 * k, sizeof dz);
         const V2 ax = rx * dx, ay = ry * dy, az = rz * dz;
         const V2 m = _mm_sqrt_pd((ax * ax + ay * ay) + az * az);
         const M2 zero = m == 0.0;
         const V2 p[3] = {zero ? V2{} : (rx * ax) / m, zero ? V2{} : (ry * ay) / m, zero ? V2{} : (rz * az) / m};
-        for (std::size_t l = 0; l < 2 && j + l < n; ++l)
-          for (int r = 0; r < 3; ++r) q[3 * (j + l) + r] = p[r][l] - s0[r];
+        for (int r = 0; r < 3; ++r) q[3 * k + r] = p[r][0] - p[r][1];
       }
     }
   } else {
-    for (std::size_t j = 0; j < n; ++j) {
-      const Eigen::Vector3d p = support(Eigen::Vector3d(d[0][j], d[1][j], d[2][j]));
-      for (int r = 0; r < 3; ++r) q[3 * j + r] = p[r] - s0[r];
+    for (std::size_t k = 0; k < pairs; ++k) {
+      const Eigen::Vector3d plus = support(direction(2 * k)), minus = support(direction(2 * k + 1));
+      for (int r = 0; r < 3; ++r) q[3 * k + r] = plus[r] - minus[r];
     }
   }
-  // Each entry s_rc still adds (S_r - s0_r) z_c sample after sample (q (-z) added is q z subtracted, exactly).
+  if (pairs < draws) {  // odd M: the last sample against the baseline (the same point on every path)
+    const Eigen::Vector3d s0 = support(u), last = support(direction(n - 1));
+    for (int r = 0; r < 3; ++r) q[3 * pairs + r] = last[r] - s0[r];
+  }
+  // Each entry s_rc adds q_kr z_ck draw after draw.
   double sum[3][4];
   if (wide) {
     Eigen::Matrix3d S;
-    sample_sums_avx2(q, z, draws, n, static_cast<double>(samples) * e, S.data());
+    sample_sums_avx2(q, z, draws, static_cast<double>(samples) * e, S.data());
     return S;
   } else {
     // Row r's three entries in one SSE2 pair and a scalar.
     V2 s01[3] = {}, s2v = {};
     double s22 = 0.0;
-    const auto add = [&](const double* qj, const V2 z01, double z2v, bool minus) {
-      for (int r = 0; r < 3; ++r) {
-        const V2 t = qj[r] * z01;
-        s01[r] = minus ? s01[r] - t : s01[r] + t;
-      }
-      const V2 q01 = {qj[0], qj[1]}, t2 = q01 * z2v;
-      const double t22 = qj[2] * z2v;
-      s2v = minus ? s2v - t2 : s2v + t2;
-      s22 = minus ? s22 - t22 : s22 + t22;
-    };
     for (std::size_t k = 0; k < draws; ++k) {
       const V2 z01 = {z[0][k], z[1][k]};
-      add(q + 6 * k, z01, z[2][k], false);
-      if (2 * k + 1 < n) add(q + 6 * k + 3, z01, z[2][k], true);
+      const double z2v = z[2][k], *qk = q + 3 * k;
+      for (int r = 0; r < 3; ++r) s01[r] = s01[r] + qk[r] * z01;
+      const V2 q01 = {qk[0], qk[1]};
+      s2v = s2v + q01 * z2v;
+      s22 = s22 + qk[2] * z2v;
     }
     for (int r = 0; r < 3; ++r) sum[r][0] = s01[r][0], sum[r][1] = s01[r][1];
     sum[0][2] = s2v[0], sum[1][2] = s2v[1], sum[2][2] = s22;
