@@ -219,12 +219,30 @@ void PolytopeLanes::solve(double* const* out, InstructionSet isa, std::size_t at
 }
 
 
-void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,
-                      const CurvedSide* curved_b) {
+std::size_t SmoothLanes::take_lane(std::size_t col, const PairGeometry& g) {
   const std::size_t l = count++;
   column[l] = col;
   sd[l] = g.distance;
   for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
+  return l;
+}
+
+void SmoothLanes::zero_given() {
+  // Every lane (those after l are written when added): fixed-size vector stores, where zeroing lanes 0..l became
+  // 18 memset calls (~27 instructions per pair with a given H, callgrind).
+  for (int e = 0; e < 9; ++e)
+    for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
+}
+
+void SmoothLanes::flat_side(Side& s, std::size_t l) {
+  for (int k = 0; k < 4; ++k) s.q[k][l] = 0.0;
+  for (int i = 0; i < 3; ++i) s.radii2[i][l] = 0.0;
+  s.round[l] = 0.0;
+}
+
+void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* curved_a,
+                      const CurvedSide* curved_b) {
+  const std::size_t l = take_lane(col, g);
   const auto side = [&](Side& s, const CurvedSide* c, const Eigen::Matrix3d& H) {
     if (c) {
       if (given)
@@ -236,37 +254,23 @@ void SmoothLanes::add(std::size_t col, const PairGeometry& g, const CurvedSide* 
       return;
     }
     if (!given) {  // the lanes so far (this lane's other side included) have curved sides without H0
-      // Every lane (those after l are written when added): fixed-size vector stores, where zeroing lanes 0..l
-      // became 18 memset calls (~27 instructions per pair with a given H, callgrind).
-      for (int e = 0; e < 9; ++e)
-        for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
+      zero_given();
       given = true;
     }
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) s.H0[3 * i + j][l] = H(i, j);
-    for (int k = 0; k < 4; ++k) s.q[k][l] = 0.0;
-    for (int i = 0; i < 3; ++i) s.radii2[i][l] = 0.0;
-    s.round[l] = 0.0;
+    flat_side(s, l);
   };
   side(a, curved_a, g.H_a);
   side(b, curved_b, g.H_b);
 }
 
 void SmoothLanes::add_given(std::size_t col, const PairGeometry& g) {
-  const std::size_t l = count++;
-  column[l] = col;
-  sd[l] = g.distance;
-  for (int i = 0; i < 3; ++i) n[i][l] = g.normal(i), xa[i][l] = g.witness_a(i), xb[i][l] = g.witness_b(i);
-  if (!given && l > 0) {  // the lanes before have curved sides without H0 (add()'s zeroing)
-    for (int e = 0; e < 9; ++e)
-      for (std::size_t k = 0; k < kLanes; ++k) a.H0[e][k] = b.H0[e][k] = 0.0;
-  }
+  const std::size_t l = take_lane(col, g);
+  if (!given && l > 0) zero_given();  // the lanes before have curved sides without H0
   given = true;
-  for (Side* s : {&a, &b}) {
-    for (int k = 0; k < 4; ++k) s->q[k][l] = 0.0;
-    for (int i = 0; i < 3; ++i) s->radii2[i][l] = 0.0;
-    s->round[l] = 0.0;
-  }
+  flat_side(a, l);
+  flat_side(b, l);
 }
 
 namespace {

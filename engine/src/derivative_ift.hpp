@@ -147,6 +147,11 @@ struct SmoothLanes {
  private:
   template <bool kNormalB, bool kCurved, bool kGiven>
   void solve_lanes(double* const* out, InstructionSet isa, std::size_t at) const;
+  /// add() and add_given()'s common steps: the next lane's column and geometry (returns the lane); +0 in every
+  /// lane's H0 (the lanes added before the first given side); a side with a given H0 (R = radii2 = round = 0).
+  std::size_t take_lane(std::size_t column, const PairGeometry& g);
+  void zero_given();
+  static void flat_side(Side& s, std::size_t l);
 };
 
 /// The separated pairs of polytopes without inflation (H_a = H_b = 0: hulls, boxes, triangles) with at most two
