@@ -79,26 +79,30 @@ void scan_hull_sse2(const double* v, std::uint32_t count, const double* const* d
 // scan_hull_sse2() with four directions in one AVX2 register: the same products, sums, comparisons (_CMP_GT_OQ is
 // _mm_cmpgt_pd's ordered '>'), maxima (vmaxpd returns its second operand on NaN, as maxpd) and indices (vertex
 // numbers counted up in the register, exact), so the same indices.
+// The first maximum's vertex (as a double) of each of the four directions (x, y, w: one coordinate each).
+inline __attribute__((always_inline)) __m256d scan4_avx2(const double* v, std::uint32_t count, __m256d x, __m256d y,
+                                                        __m256d w) {
+  const auto dot = [&](const double* p) {
+    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_broadcast_sd(p), x),
+                                       _mm256_mul_pd(_mm256_broadcast_sd(p + 1), y)),
+                         _mm256_mul_pd(_mm256_broadcast_sd(p + 2), w));
+  };
+  __m256d best = dot(v), at = _mm256_setzero_pd(), found = at;
+  const __m256d one = _mm256_set1_pd(1.0);
+  for (std::uint32_t i = 1; i < count; ++i) {
+    const __m256d di = dot(v + 3 * std::size_t(i));
+    at = _mm256_add_pd(at, one);
+    const __m256d above = _mm256_cmp_pd(di, best, _CMP_GT_OQ);
+    best = _mm256_max_pd(di, best);
+    found = _mm256_blendv_pd(found, at, above);
+  }
+  return found;
+}
 __attribute__((noinline)) void scan_hull_avx2(const double* v, std::uint32_t count, const double* const* d,
                                               std::size_t n4, double* index) {
-  for (std::size_t j0 = 0; j0 < n4; j0 += 4) {
-    const __m256d x = _mm256_loadu_pd(d[0] + j0), y = _mm256_loadu_pd(d[1] + j0), w = _mm256_loadu_pd(d[2] + j0);
-    const auto dot = [&](const double* p) {
-      return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_broadcast_sd(p), x),
-                                         _mm256_mul_pd(_mm256_broadcast_sd(p + 1), y)),
-                           _mm256_mul_pd(_mm256_broadcast_sd(p + 2), w));
-    };
-    __m256d best = dot(v), at = _mm256_setzero_pd(), found = at;
-    const __m256d one = _mm256_set1_pd(1.0);
-    for (std::uint32_t i = 1; i < count; ++i) {
-      const __m256d di = dot(v + 3 * std::size_t(i));
-      at = _mm256_add_pd(at, one);
-      const __m256d above = _mm256_cmp_pd(di, best, _CMP_GT_OQ);
-      best = _mm256_max_pd(di, best);
-      found = _mm256_blendv_pd(found, at, above);
-    }
-    _mm256_storeu_pd(index + j0, found);
-  }
+  for (std::size_t j0 = 0; j0 < n4; j0 += 4)
+    _mm256_storeu_pd(index + j0, scan4_avx2(v, count, _mm256_loadu_pd(d[0] + j0), _mm256_loadu_pd(d[1] + j0),
+                                            _mm256_loadu_pd(d[2] + j0)));
 }
 
 // q_k = v_index[2k] - v_index[2k+1] for the `pairs` antithetic pairs of a hull without inflation, two masked loads,
@@ -141,19 +145,10 @@ __attribute__((noinline)) void ellipsoid_differences_avx2(const double* radii, c
   }
 }
 
-// The sample sums of smoothed_support_estimate() with row r of s_rc = sum_k q_kr z_ck in one AVX2 register (lane 3
-// unused): the same products and the same order of additions per entry as its SSE2 form, half the instructions
-// (one broadcast, product and sum per row and draw instead of a pair, a scalar and their moves).
-// Then, as the SSE2 path's tail, H = sum / scale and S = 0.5 (H + H^T) (written to S: symmetric, so either order), the
-// rows divided in registers and H^T by a register transpose instead of nine scalar divisions and Eigen's expression.
-__attribute__((noinline)) void sample_sums_avx2(const double* q, const double* const* z, std::size_t draws,
-                                                double scale, double* S) {
-  __m256d s[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
-  for (std::size_t k = 0; k < draws; ++k) {
-    const __m256d zk = _mm256_setr_pd(z[0][k], z[1][k], z[2][k], 0.0);
-    const double* qk = q + 3 * k;
-    for (int r = 0; r < 3; ++r) s[r] = _mm256_add_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qk + r), zk));
-  }
+// H = sum / scale and S = 0.5 (H + H^T) from the sums' rows s[r] (lane 3 unused; written to S: symmetric, so
+// either order), the rows divided in registers and H^T by a register transpose instead of nine scalar divisions and
+// Eigen's expression: the SSE2 path's operations.
+inline __attribute__((always_inline)) void sums_to_estimate_avx2(const __m256d* s, double scale, double* S) {
   const __m256d by = _mm256_set1_pd(scale), half = _mm256_set1_pd(0.5), zero = _mm256_setzero_pd();
   const __m256d h0 = _mm256_div_pd(s[0], by), h1 = _mm256_div_pd(s[1], by), h2 = _mm256_div_pd(s[2], by);
   const __m256d t0 = _mm256_unpacklo_pd(h0, h1), t1 = _mm256_unpackhi_pd(h0, h1);    // h00 h10 h02 h12, h01 h11 ..
@@ -167,12 +162,85 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) S[3 * r + c] = rows[r][c];
 }
+
+// The sample sums of smoothed_support_estimate() with row r of s_rc = sum_k q_kr z_ck in one AVX2 register (lane 3
+// unused): the same products and the same order of additions per entry as its SSE2 form, half the instructions
+// (one broadcast, product and sum per row and draw instead of a pair, a scalar and their moves), then the estimate.
+__attribute__((noinline)) void sample_sums_avx2(const double* q, const double* const* z, std::size_t draws,
+                                                double scale, double* S) {
+  __m256d s[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+  for (std::size_t k = 0; k < draws; ++k) {
+    const __m256d zk = _mm256_setr_pd(z[0][k], z[1][k], z[2][k], 0.0);
+    const double* qk = q + 3 * k;
+    for (int r = 0; r < 3; ++r) s[r] = _mm256_add_pd(s[r], _mm256_mul_pd(_mm256_broadcast_sd(qk + r), zk));
+  }
+  sums_to_estimate_avx2(s, scale, S);
+}
+// smoothed_support_estimate() at M = 4 (two antithetic pairs) of a scanned hull or an ellipsoid without inflation,
+// from the noise to S in registers: the four directions one register per coordinate (lanes u + e z_0, u - e z_0,
+// u + e z_1, u - e z_1, as the direction loop), the scan or the ellipsoid formula on them, the pairs' differences,
+// the two draws' sums and the estimate, each with the general path's operations in its order (the same bits). The
+// general path's buffers, loops and calls were ~580 instructions a side with its scan (callgrind AVX2, convex8).
+__attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const double* u, double e,
+                                              const double* const* z, double* S) {
+  const __m256d ev = _mm256_set1_pd(e);
+  __m256d d[3];
+  for (int c = 0; c < 3; ++c) {
+    const __m256d uv = _mm256_set1_pd(u[c]), ez = _mm256_mul_pd(ev, _mm256_setr_pd(z[c][0], z[c][0], z[c][1], z[c][1]));
+    d[c] = _mm256_blend_pd(_mm256_add_pd(uv, ez), _mm256_sub_pd(uv, ez), 0xA);
+  }
+  const __m256d zero = _mm256_setzero_pd();
+  // Draw k's noise (z_0k, z_1k, z_2k, 0), lane 3 zeroed by a blend: GCC built setr(.., 0.0) with a vmovq form
+  // valgrind 3.19 does not decode (its callgrind counts are how this path is measured).
+  const auto noise = [&](int k) {
+    return _mm256_blend_pd(_mm256_setr_pd(z[0][k], z[1][k], z[2][k], z[2][k]), zero, 0x8);
+  };
+  const __m256d z0 = noise(0), z1 = noise(1);
+  __m256d s[3];
+  if (view.type == ShapeType::convex) {
+    const double* v = view.hull->vertices;
+    double at[4];
+    _mm256_storeu_pd(at, scan4_avx2(v, view.hull->vertex_count, d[0], d[1], d[2]));
+    const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
+    const auto point = [&](int j) { return _mm256_maskload_pd(v + 3 * static_cast<std::size_t>(at[j]), three); };
+    const __m256d q0 = _mm256_sub_pd(point(0), point(1)), q1 = _mm256_sub_pd(point(2), point(3));  // x y z 0
+    const __m256d b0[3] = {_mm256_permute4x64_pd(q0, 0x00), _mm256_permute4x64_pd(q0, 0x55),
+                           _mm256_permute4x64_pd(q0, 0xAA)};
+    const __m256d b1[3] = {_mm256_permute4x64_pd(q1, 0x00), _mm256_permute4x64_pd(q1, 0x55),
+                           _mm256_permute4x64_pd(q1, 0xAA)};
+    for (int r = 0; r < 3; ++r)
+      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(b0[r], z0)), _mm256_mul_pd(b1[r], z1));
+  } else {
+    const __m256d r3[3] = {_mm256_set1_pd(view.size[0]), _mm256_set1_pd(view.size[1]), _mm256_set1_pd(view.size[2])};
+    const __m256d ax = _mm256_mul_pd(r3[0], d[0]), ay = _mm256_mul_pd(r3[1], d[1]), az = _mm256_mul_pd(r3[2], d[2]);
+    const __m256d m = _mm256_sqrt_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, ax), _mm256_mul_pd(ay, ay)), _mm256_mul_pd(az, az)));
+    const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
+    const __m256d a[3] = {ax, ay, az};
+    for (int r = 0; r < 3; ++r) {  // lanes 0 and 2: q_0r, q_1r
+      const __m256d p = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r3[r], a[r]), m), zero, at_zero);
+      const __m256d q = _mm256_sub_pd(p, _mm256_permute_pd(p, 0x5));
+      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q, 0x00), z0)),
+                           _mm256_mul_pd(_mm256_permute4x64_pd(q, 0xAA), z1));
+    }
+  }
+  sums_to_estimate_avx2(s, 4.0 * e, S);
+}
+
 #pragma GCC pop_options
 
 }  // namespace
 
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa) {
+  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
+  const bool scanned = view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
+                       view.hull->vertex_count > 0;
+  if (wide && samples == 4 && view.inflation == 0.0 && (scanned || view.type == ShapeType::ellipsoid)) {
+    Eigen::Matrix3d S;
+    estimate4_avx2(view, u.data(), e, z, S.data());
+    return S;
+  }
   const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
   const auto support = [&](const Eigen::Vector3d& d) {
@@ -180,7 +248,6 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     add_swept_radius(p, core.radius, d);
     return p;
   };
-  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
   // The noise z comes drawn (the caller draws both sides' at once). All the directions, then the support points,
   // then their sums, each in its own loop: the support call clobbers every vector register, so whatever a loop
   // around it kept (the noise, u, e, the sums) lived on the stack.
@@ -225,8 +292,7 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Ve
     if (n4 > n) std::fill(dc + n, dc + n4, 0.0);  // GCC called memset for the empty fill (M = 4: ~120 a pair)
   }
   const auto direction = [&](std::size_t j) { return Eigen::Vector3d(d[0][j], d[1][j], d[2][j]); };
-  if (view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
-      view.hull->vertex_count > 0) {
+  if (scanned) {
     // A scanned hull (kernels::hull_support's small-hull path): every direction's first maximum (scan_hull_*()),
     // then the pairs' differences.
     const double* v = view.hull->vertices;
