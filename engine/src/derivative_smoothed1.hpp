@@ -44,9 +44,10 @@ struct Smoothed1Lanes {
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
 /// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
 /// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
-/// caller draws it: kernels::simd::draw_gaussians4_streams() for both sides of a pair). `view`: the shape's plain
-/// record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four directions per AVX2
-/// register and take the ellipsoid sample differences, the hull differences and the sample sums in AVX2 registers,
+/// caller draws it: kernels::simd::draw_gaussians4_pairs() for both sides of 8 pairs at a time). `view`: the
+/// shape's plain record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four
+/// directions per AVX2 register and take the ellipsoid sample differences, the hull differences and the sample sums
+/// in AVX2 registers (at M = 4, scanned hulls and ellipsoids without inflation: all in registers),
 /// with the same bits as the baseline set.
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa = InstructionSet::scalar);

@@ -210,7 +210,7 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
 // One pair, analytic or smoothed1. The support directions are n for a and -n for b, taken to each local frame.
 void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                         const DerivativeOptions& o, InstructionSet isa, std::size_t i, StoreBlock& out,
-                        PairGeometry& hull_geometry) {
+                        PairGeometry& hull_geometry, const double* noise) {
   if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out, hull_geometry)) return;
   DerivativeResults& d = out.d;
   PairGeometry g;
@@ -282,17 +282,11 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
     const auto view = [&](std::uint32_t s) { return ShapeTableAccess::view(shapes, s); };
-    // gaussian_vector<4>(seed, i, k, stream) for every antithetic pair k of side a (stream 1) and b (stream 2),
-    // drawn W at a time by the SIMD kernels (the same bits; one scalar draw cost ~375 instructions, more than the
-    // support call it feeds), both sides in one call: at M = 4 (2 draws per side) one AVX2 register instead of two
-    // half-empty ones.
+    // The pair's noise, drawn by differentiate_results_on() for 8 pairs at a time: side a's coordinate c at c draws,
+    // b's at (4 + c) draws.
     const std::size_t draws = static_cast<std::size_t>(o.samples + 1) / 2;
-    thread_local std::vector<double> noise;
-    if (noise.size() < 8 * draws) noise.resize(8 * draws);
-    double* const z_a[4] = {noise.data(), noise.data() + draws, noise.data() + 2 * draws, noise.data() + 3 * draws};
-    double* const z_b[4] = {noise.data() + 4 * draws, noise.data() + 5 * draws, noise.data() + 6 * draws,
-                            noise.data() + 7 * draws};
-    kernels::simd::draw_gaussians4_streams(isa, splitmix64(splitmix64(o.seed) ^ i), 1, 2, 0, draws, z_a, z_b);
+    const double* const z_a[4] = {noise, noise + draws, noise + 2 * draws, noise + 3 * draws};
+    const double* const z_b[4] = {noise + 4 * draws, noise + 5 * draws, noise + 6 * draws, noise + 7 * draws};
     Eigen::Matrix3d S_a =
         smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
     Eigen::Matrix3d S_b =
@@ -398,8 +392,29 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
     out.normal_b_only = normal_b_only;
     out.isa = isa;
     detail::PairGeometry hull_geometry;
-    for (std::size_t i = begin; i < end; ++i)
-      differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry);
+    if (options.method != DerivativeMethod::smoothed1) {
+      for (std::size_t i = begin; i < end; ++i)
+        differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry, nullptr);
+      return;
+    }
+    // smoothed1: gaussian_vector<4>(seed, i, k, stream) for every antithetic pair k of side a (stream 1) and b
+    // (stream 2) of kChunk pairs at a time, drawn by the SIMD kernels (the same bits as a draw per pair; one scalar
+    // draw cost ~375 instructions, more than the support call it feeds). Per pair, the draws filled one AVX2
+    // register at M = 4 and paid its lane set-up and stores (622 instructions a pair, callgrind AVX2).
+    constexpr std::size_t kChunk = 8;
+    const std::size_t per_pair = 8 * (static_cast<std::size_t>(options.samples + 1) / 2);
+    thread_local std::vector<double> noise;
+    if (noise.size() < kChunk * per_pair) noise.resize(kChunk * per_pair);
+    const std::uint64_t seed_key = detail::splitmix64(options.seed);
+    for (std::size_t first = begin; first < end; first += kChunk) {
+      const std::size_t count = std::min(kChunk, end - first);
+      std::uint64_t keys[kChunk];
+      for (std::size_t j = 0; j < count; ++j) keys[j] = detail::splitmix64(seed_key ^ (first + j));
+      kernels::simd::draw_gaussians4_pairs(isa, keys, count, 1, 2, per_pair / 8, noise.data());
+      for (std::size_t j = 0; j < count; ++j)
+        differentiate_pair(shapes, batch, results, options, isa, first + j, out, hull_geometry,
+                           noise.data() + j * per_pair);
+    }
   });
 }
 

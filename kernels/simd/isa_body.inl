@@ -95,6 +95,10 @@ void draw_gaussians4_streams(std::uint64_t key, std::uint64_t stream_a, std::uin
                              std::size_t count, double* const* z_a, double* const* z_b) {
   WideSamples::gaussians4_streams(key, stream_a, stream_b, k0, count, z_a, z_b);
 }
+void draw_gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
+                           std::uint64_t stream_b, std::size_t draws, double* z) {
+  WideSamples::gaussians4_pairs(keys, pairs, stream_a, stream_b, draws, z);
+}
 #endif
 
 #if defined(BATCHCOL_SIMD_UNIT_CLOSED_FORMS)

@@ -154,5 +154,10 @@ void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream
 /// multiple of W, as at smoothed1's M = 4: one instead of two).
 void draw_gaussians4_streams(InstructionSet isa, std::uint64_t key, std::uint64_t stream_a, std::uint64_t stream_b,
                              std::uint64_t k0, std::size_t count, double* const* z_a, double* const* z_b);
+/// draw_gaussians4_streams(isa, keys[p], stream_a, stream_b, 0, draws, ...) for pairs p < `pairs` in one call, pair
+/// p's draws at z + 8 draws p (stream_a's coordinate c at c draws, stream_b's at (4 + c) draws): the same bits, the
+/// lanes of consecutive pairs sharing registers.
+void draw_gaussians4_pairs(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
+                           std::uint64_t stream_b, std::size_t draws, double* z);
 
 }  // namespace batchcol::kernels::simd

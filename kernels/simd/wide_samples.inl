@@ -161,6 +161,37 @@ struct WideSamples {
     }
   }
 
+  /// draw_gaussians4_streams(keys[p], sa, sb, 0, draws, ...) for `pairs` pairs in one pass: pair p's draws into
+  /// z + 8 draws p (stream sa's coordinate c at c draws, sb's at (4 + c) draws). Lane e of the 2 draws pairs is
+  /// (pair, side, k) in that order with its own (key, k, stream), so the bits are those of a call per pair; the
+  /// registers are full where a call per pair filled one register each (AVX-512 at M = 4) and paid its lane set-up
+  /// and stores per pair (smoothed1 draws a store block's pairs at once: derivatives.cpp).
+  static void gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t sa, std::uint64_t sb,
+                               std::size_t draws, double* z) {
+    const std::size_t per_pair = 2 * draws, total = pairs * per_pair;
+    std::size_t p = 0, r = 0;  // lane e0's pair and its draw within the pair (no division per lane)
+    for (std::size_t e0 = 0; e0 < total; e0 += W) {
+      const std::size_t lanes = std::min<std::size_t>(W, total - e0);
+      u64 key{}, index{}, stream{};
+      std::size_t at[W];
+      for (int l = 0; l < W; ++l) {  // padding lanes (l >= lanes) draw the last lane's sample again, unstored
+        if (std::size_t(l) < lanes) {
+          const bool second = r >= draws;
+          const std::size_t k = second ? r - draws : r;
+          key[l] = keys[p], index[l] = k, stream[l] = second ? sb : sa;
+          at[l] = 8 * draws * p + (second ? 4 * draws : 0) + k;
+          if (++r == per_pair) r = 0, ++p;
+        } else {
+          key[l] = key[l - 1], index[l] = index[l - 1], stream[l] = stream[l - 1];
+        }
+      }
+      real v[4];
+      gaussians<4>(key, index, stream, v);
+      for (std::size_t l = 0; l < lanes; ++l)
+        for (int c = 0; c < 4; ++c) z[at[l] + c * draws] = v[c][l];
+    }
+  }
+
   typedef double v4 __attribute__((vector_size(32)));
   typedef double v4u __attribute__((vector_size(32), aligned(8)));  // an unaligned load of 4 doubles
 

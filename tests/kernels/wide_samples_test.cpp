@@ -198,6 +198,37 @@ TEST(WideSamples, BothSidesDrawsAreTheCounterGenerators) {
   }
 }
 
+TEST(WideSamples, SeveralPairsDrawsAreTheCounterGenerators) {
+  // draw_gaussians4_pairs(): 1 .. 9 pairs of 1 .. 5 draws a side put pair and side boundaries at every lane of
+  // AVX2's 4 and AVX-512's 8 and leave padding lanes; pair p's block gets exactly gaussian_vector<4>(seed, pair_p, k,
+  // stream) of both streams, the sentinel after the last block stays.
+  for (std::size_t pairs = 1; pairs <= 9; ++pairs) {
+    for (std::size_t draws = 1; draws <= 5; ++draws) {
+      std::vector<std::uint64_t> ids(pairs), keys(pairs);
+      for (std::size_t p = 0; p < pairs; ++p) {
+        ids[p] = 1000 * p + draws;
+        keys[p] = detail::splitmix64(detail::splitmix64(43) ^ ids[p]);
+      }
+      for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
+        if (!kernels::simd::cpu_has(isa)) continue;
+        SCOPED_TRACE(to_string(isa));
+        std::vector<double> z(8 * draws * pairs + 1, -7.0);
+        kernels::simd::draw_gaussians4_pairs(isa, keys.data(), pairs, 1, 2, draws, z.data());
+        for (std::size_t p = 0; p < pairs; ++p)
+          for (std::size_t k = 0; k < draws; ++k)
+            for (int side = 0; side < 2; ++side) {
+              double r[4];
+              detail::gaussian_vector<4>(43, ids[p], k, 1 + side, r);
+              for (int c = 0; c < 4; ++c)
+                ASSERT_TRUE(same(z[8 * draws * p + (4 * side + c) * draws + k], r[c]))
+                    << pairs << " " << draws << " " << p << " " << k << " " << side << " " << c;
+            }
+        EXPECT_EQ(z.back(), -7.0);
+      }
+    }
+  }
+}
+
 TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
   // 23 samples (an odd count: 12 firsts, 11 copies), values of all magnitudes, one non-converged sample and one
   // with an infinite entry; the sums are taken in two calls (a pair split over blocks) and in one.
