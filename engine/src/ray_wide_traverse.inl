@@ -1,12 +1,22 @@
 // The body of the wide traversal (see ray_wide_traverse.hpp), included once per instruction set inside a
-// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_BITS(m): the 8 lane bits of a mask.
+// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_VLANES
+// (the lanes of one vector: 16 or 8) and BATCHCOL_WIDE_LE / LT / EQ(a, b): the lane bits of a <= b, a < b, a == b
+// (the comparison straight to a mask: on AVX-512 a vector compare, a vector mask and its bits cost three steps).
 
 namespace {
 
-typedef float V __attribute__((vector_size(32)));
-typedef int M __attribute__((vector_size(32)));
+// A node's 16 slots are tested in kParts vectors of kVLanes floats: one 16-lane vector on AVX-512, two 8-lane halves
+// elsewhere (the same IEEE operations lane by lane, so the same bits on every set).
+constexpr int kVLanes = BATCHCOL_WIDE_VLANES;
+constexpr int kParts = kWideArity / kVLanes;
+typedef float V __attribute__((vector_size(4 * kVLanes)));
 
+// A broadcast (a lane-by-lane loop became 16 masked broadcasts on AVX-512).
+#if BATCHCOL_WIDE_VLANES == 16
+inline V splat(float x) { return V{x, x, x, x, x, x, x, x, x, x, x, x, x, x, x, x}; }
+#else
 inline V splat(float x) { return V{x, x, x, x, x, x, x, x}; }
+#endif
 
 inline V load_at(const WideNode* node, std::size_t byte_offset) {
   V v;
@@ -20,7 +30,7 @@ inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 
 // A child that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
 // larger than the L2 (WideRay::prefetch) its cache lines are requested now, so the loads overlap the work in
-// between; on smaller trees the lines are there anyway and the requests only cost issue slots. A node's four lines;
+// between; on smaller trees the lines are there anyway and the requests only cost issue slots. A node's seven lines;
 // for a leaf with balls, the two lines of its record from the ball on (the caller's leaf records hold the ball and
 // the object together: ray_scene_state.hpp).
 inline void prefetch_child(const WideNode* nodes, std::uint32_t ref, const WideRay& r) {
@@ -31,7 +41,7 @@ inline void prefetch_child(const WideNode* nodes, std::uint32_t ref, const WideR
     return;
   }
   const char* p = reinterpret_cast<const char*>(nodes + ref);
-  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
+  for (int line = 0; line < 7; ++line) __builtin_prefetch(p + 64 * line);
 }
 
 // True when the ray's line passes the leaf's ball farther than its radius plus the margins (ray_wide_traverse.hpp).
@@ -79,7 +89,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   __asm__("" : "+x"(zero_scalar));
   const V zero = splat(zero_scalar);
   // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
-  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
+  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 16 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
   Entry e{0u, 0.0f};  // the root
@@ -109,25 +119,32 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       continue;
     }
     const WideNode* n = nodes + e.ref;
-    V tn = zero;
-    tn = max_into((onx - load_at(n, near_x)) * nix, tn);
-    tn = max_into((ony - load_at(n, near_y)) * niy, tn);
-    tn = max_into((onz - load_at(n, near_z)) * niz, tn);
-    V tf = lim_v;
-    tf = min_into((ofx - load_at(n, far_x)) * nix, tf);
-    tf = min_into((ofy - load_at(n, far_y)) * niy, tf);
-    tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
-    tf = tf * scale + slack;
-    std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
+    V tn[kParts];
+    std::uint32_t bits = 0;
+    for (int p = 0; p < kParts; ++p) {
+      const std::size_t at = sizeof(V) * std::size_t(p);
+      V a = zero;
+      a = max_into((onx - load_at(n, near_x + at)) * nix, a);
+      a = max_into((ony - load_at(n, near_y + at)) * niy, a);
+      a = max_into((onz - load_at(n, near_z + at)) * niz, a);
+      V f = lim_v;
+      f = min_into((ofx - load_at(n, far_x + at)) * nix, f);
+      f = min_into((ofy - load_at(n, far_y + at)) * niy, f);
+      f = min_into((ofz - load_at(n, far_z + at)) * niz, f);
+      f = f * scale + slack;
+      tn[p] = a;
+      bits |= BATCHCOL_WIDE_LE(a, f) << (kVLanes * p);
+    }
     if (bits == 0) {
       if (!pop()) return;
       continue;
     }
-    const V& entry = tn;  // read lane by lane below (a copy into a float array was split and copied twice)
+    // Read lane by lane below (a copy into a float array was split and copied twice).
+    const auto entry = [&tn](std::size_t k) { return tn[k / kVLanes][k % kVLanes]; };
     // One child reached (the common case deep in the tree): it is next, no sort and no stack.
     if ((bits & (bits - 1)) == 0) {
       const int k = __builtin_ctz(bits);
-      e = Entry{n->child[k], entry[k]};
+      e = Entry{n->child[k], entry(std::size_t(k))};
       continue;
     }
     // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
@@ -137,11 +154,11 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     const std::uint32_t rest = bits & (bits - 1);
     if ((rest & (rest - 1)) == 0) {
       const int k0 = __builtin_ctz(bits), k1 = __builtin_ctz(rest);
-      const bool swap = entry[k1] < entry[k0];
+      const bool swap = entry(std::size_t(k1)) < entry(std::size_t(k0));
       const int near = swap ? k1 : k0, far = swap ? k0 : k1;
-      stack[top++] = Entry{n->child[far], entry[far]};
+      stack[top++] = Entry{n->child[far], entry(std::size_t(far))};
       if (r.prefetch) prefetch_child(nodes, n->child[far], r);
-      e = Entry{n->child[near], entry[near]};
+      e = Entry{n->child[near], entry(std::size_t(near))};
       continue;
     }
     // Three or more: each hit child's rank in that order, counted without branches on the data: the hit children
@@ -150,14 +167,18 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     // nearest first, exactly as the stable sort this replaces (and the same on every instruction set).
     // The slots below k come from a table (not a shifted -1), and slot and rank are 64-bit counts (no sign
     // extension before they index): 27 -> 22 instructions a child (callgrind, AVX2).
-    static constexpr std::uint32_t kLowerSlots[kWideArity] = {0x00, 0x01, 0x03, 0x07, 0x0f, 0x1f, 0x3f, 0x7f};
+    static constexpr std::uint32_t kLowerSlots[kWideArity] = {0x0000, 0x0001, 0x0003, 0x0007, 0x000f, 0x001f,
+                                                              0x003f, 0x007f, 0x00ff, 0x01ff, 0x03ff, 0x07ff,
+                                                              0x0fff, 0x1fff, 0x3fff, 0x7fff};
     const int count = __builtin_popcount(bits);
     Entry* const base = stack + top + count - 1;
     for (std::uint64_t b = bits; b != 0; b &= b - 1) {
       const std::size_t k = std::size_t(__builtin_ctzll(b));
-      const float t = entry[k];
+      const float t = entry(k);
       const V tk = splat(t);
-      const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
+      std::uint32_t nearer = 0, same = 0;
+      for (int p = 0; p < kParts; ++p)
+        nearer |= BATCHCOL_WIDE_LT(tn[p], tk) << (kVLanes * p), same |= BATCHCOL_WIDE_EQ(tn[p], tk) << (kVLanes * p);
       const std::ptrdiff_t rank = __builtin_popcountll(std::uint64_t(bits & (nearer | (same & kLowerSlots[k]))));
       base[-rank] = Entry{n->child[k], t};
       if (r.prefetch && rank != 0) prefetch_child(nodes, n->child[k], r);
@@ -180,3 +201,8 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     default: return traverse_octant<7>(nodes, r, limit, visit, context);
   }
 }
+
+#undef BATCHCOL_WIDE_VLANES
+#undef BATCHCOL_WIDE_LE
+#undef BATCHCOL_WIDE_LT
+#undef BATCHCOL_WIDE_EQ
