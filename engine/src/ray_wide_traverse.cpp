@@ -18,8 +18,7 @@ namespace wide_avx512 {
 #define BATCHCOL_WIDE_VLANES 16
 #define BATCHCOL_WIDE_CMP(a, b, op) std::uint32_t(_mm512_cmp_ps_mask(__m512(a), __m512(b), op))
 #define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
-#define BATCHCOL_WIDE_LT(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LT_OQ)
-#define BATCHCOL_WIDE_EQ(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_EQ_OQ)
+#define BATCHCOL_WIDE_ILT(a, b) std::uint32_t(_mm512_cmplt_epi32_mask(__m512i(a), __m512i(b)))
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_CMP
 }  // namespace wide_avx512
@@ -31,8 +30,8 @@ namespace wide_avx2 {
 #define BATCHCOL_WIDE_CMP(a, b, op) std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(__m256(a), __m256(b), op)))
 #define BATCHCOL_WIDE_VLANES 8
 #define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
-#define BATCHCOL_WIDE_LT(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LT_OQ)
-#define BATCHCOL_WIDE_EQ(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_EQ_OQ)
+#define BATCHCOL_WIDE_ILT(a, b) \
+  std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(__m256i(b), __m256i(a)))))
 #include "ray_wide_traverse.inl"
 #undef BATCHCOL_WIDE_CMP
 #define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
@@ -49,8 +48,7 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
 }
 #define BATCHCOL_WIDE_VLANES 8
 #define BATCHCOL_WIDE_LE(a, b) lane_bits((a) <= (b))
-#define BATCHCOL_WIDE_LT(a, b) lane_bits((a) < (b))
-#define BATCHCOL_WIDE_EQ(a, b) lane_bits((a) == (b))
+#define BATCHCOL_WIDE_ILT(a, b) lane_bits((a) < (b))
 #include "ray_wide_traverse.inl"
 template <class V> inline V sqrt_lanes(V v) {
   for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
