@@ -1,5 +1,5 @@
 // RaySceneIndex::update(): snapshot of the scene's objects, world boxes (the scene's own vectorised AABB pass) and
-// the LBVH and its 8-wide collapse, rebuilt when the set of objects changed and refitted otherwise.
+// the LBVH and its 16-wide collapse, rebuilt when the set of objects changed and refitted otherwise.
 #include "ray_scene_state.hpp"
 #include "ray_wide_traverse.hpp"
 #include "rays_common.hpp"

@@ -1,4 +1,4 @@
-// RaySceneIndex::cast(): each ray walks the 8-wide BVH (ray_wide_traverse.hpp; rays outside float's range walk the
+// RaySceneIndex::cast(): each ray walks the 16-wide BVH (ray_wide_traverse.hpp; rays outside float's range walk the
 // binary LBVH in double) depth first, nearest child first, and intersects the objects of the leaves it reaches with
 // the exact kernels (kernels/rays/); halfspaces (unbounded) are tested first for every ray.
 // Closest-hit pruning: a subtree is skipped when its box starts beyond the best hit so far. Ties in t go to the lower

@@ -1,5 +1,5 @@
 // Private state of batchcol::RaySceneIndex: a snapshot of the scene's objects in BVH leaf order, the LBVH and its
-// 8-wide collapse.
+// 16-wide collapse.
 #pragma once
 
 #include "batchcol/rays.hpp"
@@ -47,7 +47,7 @@ struct RaySceneIndex::State {
   broadphase::AabbSoa boxes;  // by scene object index
   std::vector<PoseRecord> poses;
   RayBvh bvh;       // binary LBVH: built, refitted, and traversed (in double) by rays the float test cannot take
-  WideBvh wide;     // its 8-wide collapse, traversed by every other ray
+  WideBvh wide;     // its 16-wide collapse, traversed by every other ray
   // Read at random by the rays (a leaf each visit): on huge pages when large (ray_huge_pages.hpp).
   std::vector<RayLeaf, detail::HugePageAllocator<RayLeaf>> leaves;  // leaf k = object bvh.leaf_object()[k]
   std::vector<RayObject> halfspaces;  // tested against every ray

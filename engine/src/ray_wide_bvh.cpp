@@ -46,16 +46,17 @@ void clear_slot(WideNode& n, int k) {
 // Cost-based choice of each wide node's children (after Ylitie, Karras and Laine, "Efficient incoherent ray
 // traversal on GPUs through compressed wide BVHs", HPG 2017, here for leaves of one object): a ray visits a wide node
 // with a probability proportional to the surface area of its box, and a node costs the same whatever its fill (one
-// SIMD test of 8 slots), while every leaf is a slot somewhere whichever the tree. So the tree with the fewest
+// SIMD test of its 16 slots), while every leaf is a slot somewhere whichever the tree. So the tree with the fewest
 // expected node visits minimises the sum of its wide nodes' areas. cost[x][j - 1] is that sum for the subtree of
 // binary node x when it may fill j slots of its parent: as one slot (x becomes a wide node: its area plus the best
-// split of 8 slots between its children) or, for j >= 2, spread over the slots (j' + (j - j') slots to its two
+// split of 16 slots between its children) or, for j >= 2, spread over the slots (j' + (j - j') slots to its two
 // children, x itself no node). Leaves cost 0. It replaces the greedy rule (open the largest-area internal child
-// until 8 children), cheaper to build but leaving bottom subtrees of 2-3 leaves as nodes of their own: on 10k hulls
-// 3634 wide nodes of 3.75 children there, 2621 of 4.81 here, and 4% fewer traversal instructions per ray (the small
-// nodes it removes have small boxes, so rays seldom reached them: the expected visits fall less than the count).
+// until 8 children), cheaper to build but leaving bottom subtrees of 2-3 leaves as nodes of their own: at 8 slots,
+// on 10k hulls 3634 wide nodes of 3.75 children there, 2621 of 4.81 here, and 4% fewer traversal instructions per
+// ray (the small nodes it removes have small boxes, so rays seldom reached them: the expected visits fall less than
+// the count). At 16 slots the 100k mixed scene has 25927 nodes, 14188 of them with 2 children and 4262 full.
 struct CollapsePlan {
-  std::vector<std::array<double, kWideArity>> cost;       // per binary node, j = 1..8
+  std::vector<std::array<double, kWideArity>> cost;       // per binary node, j = 1..16
   std::vector<std::array<std::uint8_t, kWideArity>> left;  // slots given to child 0 (0: x is one slot, a node)
 
   double of(std::uint32_t ref, int j) const {
@@ -118,9 +119,9 @@ struct CollapsePlan {
     slots(bvh, bvh.nodes()[ref].child[1], j - k, out, count);
   }
 
-  // The children of the wide node made from binary node x: the best split of 8 slots.
+  // The children of the wide node made from binary node x: the best split of 16 slots.
   int wide_children(const RayBvh& bvh, std::uint32_t x, std::uint32_t* out) const {
-    // cost[x][0] chose x as a node: its 8 slots are split as for j = 8 without the "as node" option.
+    // cost[x][0] chose x as a node: its 16 slots are split as for j = 16 without the "as node" option.
     const BvhNode& node = bvh.nodes()[x];
     double best = INFINITY;
     int best_k = 1;

@@ -15,18 +15,25 @@ namespace batchcol {
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512dq,avx512vl,avx512bw")
 namespace wide_avx512 {
-#define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
+#define BATCHCOL_WIDE_VLANES 16
+#define BATCHCOL_WIDE_CMP(a, b, op) std::uint32_t(_mm512_cmp_ps_mask(__m512(a), __m512(b), op))
+#define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
+#define BATCHCOL_WIDE_ILT(a, b) std::uint32_t(_mm512_cmplt_epi32_mask(__m512i(a), __m512i(b)))
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_BITS
+#undef BATCHCOL_WIDE_CMP
 }  // namespace wide_avx512
 #pragma GCC pop_options
 
 #pragma GCC push_options
 #pragma GCC target("avx2")
 namespace wide_avx2 {
-#define BATCHCOL_WIDE_BITS(m) std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(__m256i(m))))
+#define BATCHCOL_WIDE_CMP(a, b, op) std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(__m256(a), __m256(b), op)))
+#define BATCHCOL_WIDE_VLANES 8
+#define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
+#define BATCHCOL_WIDE_ILT(a, b) \
+  std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(__m256i(b), __m256i(a)))))
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_BITS
+#undef BATCHCOL_WIDE_CMP
 #define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
 #include "ray_wide_setup.inl"
 #undef BATCHCOL_SETUP_SQRT
@@ -39,9 +46,10 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
   for (int l = 0; l < 8; ++l) bits |= (m[l] != 0 ? 1u : 0u) << l;
   return bits;
 }
-#define BATCHCOL_WIDE_BITS(m) lane_bits(m)
+#define BATCHCOL_WIDE_VLANES 8
+#define BATCHCOL_WIDE_LE(a, b) lane_bits((a) <= (b))
+#define BATCHCOL_WIDE_ILT(a, b) lane_bits((a) < (b))
 #include "ray_wide_traverse.inl"
-#undef BATCHCOL_WIDE_BITS
 template <class V> inline V sqrt_lanes(V v) {
   for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
   return v;

@@ -1,7 +1,8 @@
-// Closest-first traversal of the 8-wide BVH (ray_wide_bvh.hpp) for one ray, with one float SIMD slab test per node
-// (all 8 child boxes at once). The loop is compiled for AVX-512, AVX2 and the baseline (ray_wide_traverse.cpp) and
-// picked by select_wide_traverse(isa) (RayOptions::isa, `batchcol rays --isa`); every version does the same IEEE
-// operations lane by lane, so the visiting order, and hence every answer, is the same on every instruction set.
+// Closest-first traversal of the 16-wide BVH (ray_wide_bvh.hpp) for one ray, with one float SIMD slab test per node
+// (all 16 child boxes at once on AVX-512, in two 8-lane halves on AVX2 and the baseline). The loop is compiled for
+// AVX-512, AVX2 and the baseline (ray_wide_traverse.cpp) and picked by select_wide_traverse(isa) (RayOptions::isa,
+// `batchcol rays --isa`); every version does the same IEEE operations lane by lane, so the visiting order, and hence
+// every answer, is the same on every instruction set.
 //
 // Conservative float test (no box the exact ray segment reaches is ever rejected), after Ize, "Robust BVH ray
 // traversal", JCGT 2013, adapted to a double ray: per axis the slab plane the ray enters through ("near": lo when

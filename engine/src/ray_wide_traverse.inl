@@ -1,12 +1,41 @@
 // The body of the wide traversal (see ray_wide_traverse.hpp), included once per instruction set inside a
-// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_BITS(m): the 8 lane bits of a mask.
+// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_VLANES
+// (the lanes of one vector: 16 or 8) and BATCHCOL_WIDE_LE / LT / EQ(a, b): the lane bits of a <= b, a < b, a == b
+// (the comparison straight to a mask: on AVX-512 a vector compare, a vector mask and its bits cost three steps).
 
 namespace {
 
-typedef float V __attribute__((vector_size(32)));
-typedef int M __attribute__((vector_size(32)));
+// A node's 16 slots are tested in kParts vectors of kVLanes floats: one 16-lane vector on AVX-512, two 8-lane halves
+// elsewhere (the same IEEE operations lane by lane, so the same bits on every set).
+constexpr int kVLanes = BATCHCOL_WIDE_VLANES;
+constexpr int kParts = kWideArity / kVLanes;
+typedef float V __attribute__((vector_size(4 * kVLanes)));
+typedef std::int32_t VI __attribute__((vector_size(4 * kVLanes)));
 
+// A broadcast (a lane-by-lane loop became 16 masked broadcasts on AVX-512).
+#if BATCHCOL_WIDE_VLANES == 16
+inline V splat(float x) { return V{x, x, x, x, x, x, x, x, x, x, x, x, x, x, x, x}; }
+inline VI splat_int(std::int32_t x) { return VI{x, x, x, x, x, x, x, x, x, x, x, x, x, x, x, x}; }
+#else
 inline V splat(float x) { return V{x, x, x, x, x, x, x, x}; }
+inline VI splat_int(std::int32_t x) { return VI{x, x, x, x, x, x, x, x}; }
+#endif
+
+// kLowerOnes[k][j] = 1 for the slots j below k: the rank loop's tie rule as one integer subtraction (below).
+struct LowerOnes {
+  alignas(64) std::int32_t row[kWideArity][kWideArity];
+  constexpr LowerOnes() : row{} {
+    for (int k = 0; k < kWideArity; ++k)
+      for (int j = 0; j < kWideArity; ++j) row[k][j] = j < k ? 1 : 0;
+  }
+};
+constexpr LowerOnes kLowerOnes;
+
+inline VI load_int(const std::int32_t* p) {
+  VI v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
 
 inline V load_at(const WideNode* node, std::size_t byte_offset) {
   V v;
@@ -20,7 +49,7 @@ inline V min_into(V x, V acc) { return x < acc ? x : acc; }
 
 // A child that was pushed is usually popped soon (after the nearer sibling's subtree, often a single leaf): on trees
 // larger than the L2 (WideRay::prefetch) its cache lines are requested now, so the loads overlap the work in
-// between; on smaller trees the lines are there anyway and the requests only cost issue slots. A node's four lines;
+// between; on smaller trees the lines are there anyway and the requests only cost issue slots. A node's seven lines;
 // for a leaf with balls, the two lines of its record from the ball on (the caller's leaf records hold the ball and
 // the object together: ray_scene_state.hpp).
 inline void prefetch_child(const WideNode* nodes, std::uint32_t ref, const WideRay& r) {
@@ -31,7 +60,7 @@ inline void prefetch_child(const WideNode* nodes, std::uint32_t ref, const WideR
     return;
   }
   const char* p = reinterpret_cast<const char*>(nodes + ref);
-  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
+  for (int line = 0; line < 7; ++line) __builtin_prefetch(p + 64 * line);
 }
 
 // True when the ray's line passes the leaf's ball farther than its radius plus the margins (ray_wide_traverse.hpp).
@@ -79,7 +108,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   __asm__("" : "+x"(zero_scalar));
   const V zero = splat(zero_scalar);
   // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
-  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 8 entries after popping one.
+  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 16 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
   Entry e{0u, 0.0f};  // the root
@@ -109,25 +138,37 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
       continue;
     }
     const WideNode* n = nodes + e.ref;
-    V tn = zero;
-    tn = max_into((onx - load_at(n, near_x)) * nix, tn);
-    tn = max_into((ony - load_at(n, near_y)) * niy, tn);
-    tn = max_into((onz - load_at(n, near_z)) * niz, tn);
-    V tf = lim_v;
-    tf = min_into((ofx - load_at(n, far_x)) * nix, tf);
-    tf = min_into((ofy - load_at(n, far_y)) * niy, tf);
-    tf = min_into((ofz - load_at(n, far_z)) * niz, tf);
-    tf = tf * scale + slack;
-    std::uint32_t bits = BATCHCOL_WIDE_BITS((M)(tn <= tf));
+    V tn[kParts];
+    std::uint32_t bits = 0;
+    for (int p = 0; p < kParts; ++p) {
+      const std::size_t at = sizeof(V) * std::size_t(p);
+      V a = zero;
+      a = max_into((onx - load_at(n, near_x + at)) * nix, a);
+      a = max_into((ony - load_at(n, near_y + at)) * niy, a);
+      a = max_into((onz - load_at(n, near_z + at)) * niz, a);
+      V f = lim_v;
+      f = min_into((ofx - load_at(n, far_x + at)) * nix, f);
+      f = min_into((ofy - load_at(n, far_y + at)) * niy, f);
+      f = min_into((ofz - load_at(n, far_z + at)) * niz, f);
+      f = f * scale + slack;
+      tn[p] = a;
+      bits |= BATCHCOL_WIDE_LE(a, f) << (kVLanes * p);
+    }
     if (bits == 0) {
       if (!pop()) return;
       continue;
     }
-    const V& entry = tn;  // read lane by lane below (a copy into a float array was split and copied twice)
+    // Read lane by lane below (a copy into a float array was split and copied twice); slot k is float k of the
+    // parts, which lie one after the other (tn[k / kVLanes][k % kVLanes] cost 4 more instructions a read on AVX2).
+    const auto entry = [&tn](std::size_t k) {
+      float t;
+      __builtin_memcpy(&t, reinterpret_cast<const char*>(tn) + sizeof(float) * k, sizeof t);
+      return t;
+    };
     // One child reached (the common case deep in the tree): it is next, no sort and no stack.
     if ((bits & (bits - 1)) == 0) {
       const int k = __builtin_ctz(bits);
-      e = Entry{n->child[k], entry[k]};
+      e = Entry{n->child[k], entry(std::size_t(k))};
       continue;
     }
     // Hit children sorted by entry; all but the nearest pushed farthest first, the nearest processed next. Ties
@@ -137,28 +178,37 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
     const std::uint32_t rest = bits & (bits - 1);
     if ((rest & (rest - 1)) == 0) {
       const int k0 = __builtin_ctz(bits), k1 = __builtin_ctz(rest);
-      const bool swap = entry[k1] < entry[k0];
+      const bool swap = entry(std::size_t(k1)) < entry(std::size_t(k0));
       const int near = swap ? k1 : k0, far = swap ? k0 : k1;
-      stack[top++] = Entry{n->child[far], entry[far]};
+      stack[top++] = Entry{n->child[far], entry(std::size_t(far))};
       if (r.prefetch) prefetch_child(nodes, n->child[far], r);
-      e = Entry{n->child[near], entry[near]};
+      e = Entry{n->child[near], entry(std::size_t(near))};
       continue;
     }
     // Three or more: each hit child's rank in that order, counted without branches on the data: the hit children
     // strictly nearer, plus the equally near ones in lower slots (entries are never NaN: tn starts at 0 and the
     // ordered max drops NaN). Rank 0 is next; rank j >= 1 goes j places below the new top, so the stack pops them
     // nearest first, exactly as the stable sort this replaces (and the same on every instruction set).
-    // The slots below k come from a table (not a shifted -1), and slot and rank are 64-bit counts (no sign
-    // extension before they index): 27 -> 22 instructions a child (callgrind, AVX2).
-    static constexpr std::uint32_t kLowerSlots[kWideArity] = {0x00, 0x01, 0x03, 0x07, 0x0f, 0x1f, 0x3f, 0x7f};
+    // One comparison a part, in integers: entries are +0 or positive floats or +inf (never -0: the ordered max keeps
+    // the +0 it starts from against -0; never NaN), whose bit patterns order as the values, so "t_j < t_k, or
+    // t_j = t_k and j < k" is bits_j - [j < k] < bits_k (bits_j = 0 gives -1: below every bits_k, as j's entry is).
+    // [j < k] comes from a table (kLowerOnes); slot and rank are 64-bit counts (no sign extension before they
+    // index). Was two float comparisons a part and a lower-slot mask: 24 -> 20 instructions a child on AVX-512,
+    // 33 -> 27 on AVX2 (its two halves), with the flat entry read above.
     const int count = __builtin_popcount(bits);
     Entry* const base = stack + top + count - 1;
+    VI tn_bits[kParts];
+    __builtin_memcpy(tn_bits, tn, sizeof tn_bits);
     for (std::uint64_t b = bits; b != 0; b &= b - 1) {
       const std::size_t k = std::size_t(__builtin_ctzll(b));
-      const float t = entry[k];
-      const V tk = splat(t);
-      const std::uint32_t nearer = BATCHCOL_WIDE_BITS((M)(tn < tk)), same = BATCHCOL_WIDE_BITS((M)(tn == tk));
-      const std::ptrdiff_t rank = __builtin_popcountll(std::uint64_t(bits & (nearer | (same & kLowerSlots[k]))));
+      const float t = entry(k);
+      std::int32_t t_bits;
+      __builtin_memcpy(&t_bits, &t, sizeof t_bits);
+      const VI tk = splat_int(t_bits);
+      std::uint32_t nearer = 0;
+      for (int p = 0; p < kParts; ++p)
+        nearer |= BATCHCOL_WIDE_ILT(tn_bits[p] - load_int(kLowerOnes.row[k] + kVLanes * p), tk) << (kVLanes * p);
+      const std::ptrdiff_t rank = __builtin_popcountll(std::uint64_t(bits & nearer));
       base[-rank] = Entry{n->child[k], t};
       if (r.prefetch && rank != 0) prefetch_child(nodes, n->child[k], r);
     }
@@ -180,3 +230,7 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     default: return traverse_octant<7>(nodes, r, limit, visit, context);
   }
 }
+
+#undef BATCHCOL_WIDE_VLANES
+#undef BATCHCOL_WIDE_LE
+#undef BATCHCOL_WIDE_ILT

@@ -289,6 +289,59 @@ TEST(RayWideBvh, ChildrenAreVisitedNearestFirstTiesInSlotOrderInEveryOctant) {
   }
 }
 
+TEST(RayWideBvh, SixteenChildrenInOneNodeAreRankedAcrossBothHalves) {
+  // Sixteen boxes fit one wide node (kWideArity = 16; an 8-wide tree needed 3 nodes here). AVX2 and the baseline
+  // test its slots as two 8-lane halves and AVX-512 as one 16-lane vector; entries tie within and across the halves
+  // (x_lo 3 appears five times, 1 three times), so a rank that ignored the other half or its slot order would show.
+  // Two origins: far outside (every entry positive), and inside the five boxes at x_lo 3, whose entries are then 0
+  // (the rank compares entry bits, and 0 is the edge of that rule). Every octant, every instruction set: the
+  // visiting order is by entry, ties in slot order.
+  const float x_lo[16] = {3.0f, 0.0f, 1.0f, 3.0f, 6.0f, 2.0f, 3.0f, 1.0f,
+                          4.0f, 3.0f, 7.0f, 1.0f, 3.0f, 5.0f, 8.0f, 9.0f};
+  broadphase::AabbSoa b;
+  b.resize(16);
+  for (std::size_t i = 0; i < 16; ++i) {
+    b.min_x[i] = x_lo[i], b.max_x[i] = x_lo[i] + 0.5f;
+    b.min_y[i] = b.min_z[i] = -1.0f, b.max_y[i] = b.max_z[i] = 1.0f;
+  }
+  RayBvh bvh;
+  bvh.build(b);
+  WideBvh wide;
+  wide.collapse(bvh, b);
+  ASSERT_EQ(wide.nodes().size(), 1u);  // every leaf is a child of the root
+  const WideNode& root = wide.nodes()[0];
+  for (const bool inside : {false, true}) {
+    for (int octant = 0; octant < 8; ++octant) {
+      const double sx = octant & 1 ? -1.0 : 1.0, sy = octant & 2 ? -1.0 : 1.0, sz = octant & 4 ? -1.0 : 1.0;
+      const double ox = inside ? 3.25 : -50.0 * sx + 4.75;
+      const double o[3] = {ox, 0.0, 0.0}, d[3] = {sx, 1e-3 * sy, 1e-3 * sz};
+      std::vector<int> slots;
+      const auto box = [&](int s) { return bvh.leaf_object()[root.child[s] & ~kLeafBit]; };
+      for (int s = 0; s < kWideArity; ++s) {
+        if (root.child[s] == kWideEmpty) continue;
+        const double far = sx > 0 ? double(b.max_x[box(s)]) - ox : ox - double(b.min_x[box(s)]);
+        if (far >= 0.0) slots.push_back(s);  // not behind the origin
+      }
+      ASSERT_EQ(slots.size(), inside ? (sx > 0 ? 11u : 10u) : 16u);
+      const auto entry = [&](int s) {
+        const double near = sx > 0 ? double(b.min_x[box(s)]) - ox : ox - double(b.max_x[box(s)]);
+        return std::max(near, 0.0);
+      };
+      std::stable_sort(slots.begin(), slots.end(), [&](int a, int c) { return entry(a) < entry(c); });
+      std::vector<std::uint32_t> expected;
+      for (int s : slots) expected.push_back(root.child[s] & ~kLeafBit);
+      const WideRay ray = make_wide_ray(o, d);
+      for (int isa = 0; isa < 3; ++isa) {
+        if (const WideTraverse traverse = wide_traverse_for(isa)) {
+          Leaves seen;
+          traverse(wide.nodes().data(), ray, wide_limit(INFINITY), record, &seen);
+          EXPECT_EQ(seen.seen, expected) << "inside " << inside << " octant " << octant << " isa " << isa;
+        }
+      }
+    }
+  }
+}
+
 TEST(RayWideBvh, FloatTestIsTightAndTheSameOnEveryInstructionSet) {
   // Random rays: every leaf the float test visits is hit by the exact test on the box widened by 1e-5 of its scale,
   // and every leaf the exact test hits on the box narrowed by 1e-5 is visited (no test this bounds can pass by
