@@ -110,14 +110,14 @@ BATCHCOL_API void cast_rays(const ShapeTable& shapes, const ShapeRayBatch& batch
 /// Wall-clock milliseconds of the last RaySceneIndex::update().
 struct RaySceneTimings {
   double boxes_ms = 0;    // world boxes and object transforms from the scene
-  double build_ms = 0;    // Morton codes, radix sort, hierarchy, 8-wide collapse (0 when refitted)
+  double build_ms = 0;    // Morton codes, radix sort, hierarchy, 16-wide collapse (0 when refitted)
   double refit_ms = 0;    // bottom-up box refit and the wide nodes' box copy (0 when rebuilt)
-  double wide_ms = 0;     // the part of build_ms / refit_ms spent on the 8-wide nodes (collapse or box copy)
+  double wide_ms = 0;     // the part of build_ms / refit_ms spent on the 16-wide nodes (collapse or box copy)
   double total_ms = 0;
 };
 
 /// The scene's acceleration structure for rays: a linear BVH (Karras 2012) over the objects' world boxes, built in
-/// parallel from Morton codes and collapsed into an 8-wide BVH (float boxes, one SIMD test per node), both refitted
+/// parallel from Morton codes and collapsed into a 16-wide BVH (float boxes, one SIMD test per node), both refitted
 /// (boxes only) when only poses changed since the last update. It snapshots the
 /// scene's objects and poses at update(): later scene changes are seen at the next update().
 class BATCHCOL_API RaySceneIndex {
