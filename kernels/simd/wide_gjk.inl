@@ -675,7 +675,10 @@ template <class T> struct WideGjk {
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
   /// `side`: the run may have distance / witness lanes (side_start(); boolean runs never do).
   /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
-  AI static void start(Lanes& L, bool side, bool dirs = false) {
+  /// `nesterov`: the run's solver reads last_s (Nesterov's momentum point, the only reader).
+  /// A boolean run without `dirs` never reads a[] and b[] (no points, no Newton tracking: loop()'s `track`), and a
+  /// run of another solver never reads last_s: they are not written (measured in loop()'s comment).
+  AI static void start(Lanes& L, bool side, bool dirs = false, bool nesterov = true) {
     if (L.fresh == 0) return;
     std::uint32_t first = L.fresh;  // the lanes that start from the first support point
     // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
@@ -692,10 +695,12 @@ template <class T> struct WideGjk {
     minkowski(L, neg(L.d_prev), first, sw, sa, sb);
     const mask m = lanes_of(first);
     L.w[0] = pick(m, sw, L.w[0]);
-    L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
-    L.b[0] = pick(m, sb, L.b[0]);
+    if (side || dirs) {
+      L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
+      L.b[0] = pick(m, sb, L.b[0]);
+    }
     L.x = pick(m, sw, L.x);
-    L.last_s = pick(m, sw, L.last_s);
+    if (nesterov) L.last_s = pick(m, sw, L.last_s);
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     if constexpr (std::is_same_v<T, double>) {
       if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
@@ -1366,6 +1371,7 @@ template <class T> struct WideGjk {
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
     const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
+    const bool nesterov = solver == Solver::nesterov;  // last_s's only reader (start())
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -1383,7 +1389,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L, !Boolean, Dirs);
+      start(L, !Boolean, Dirs, nesterov);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
@@ -1542,7 +1548,7 @@ template <class T> struct WideGjk {
         L.x = pick(moves, proj.x, L.x);
         const mask steps = moves & ~ends_contains;
         L.d_prev = pick(steps, d, L.d_prev);
-        L.last_s = pick(steps, sw, L.last_s);
+        if (nesterov) L.last_s = pick(steps, sw, L.last_s);
         // Newton's direction for the next iteration (newton_direction()), where this support point gives one:
         //  - lb > 0 (separated cores: H + lb I is positive definite); not on polytope pairs (flat_newton_side());
         //  - the step turns the direction by at most kNewtonSwitch (|delta| estimates the angle to the optimal
