@@ -33,7 +33,19 @@ template <class T> struct WideGjk {
   static V3 cross(const V3& a, const V3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
   }
-  static V3 pick(mask m, const V3& a, const V3& b) { return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)}; }
+  /// select() for this file's masks, whose lanes are all 0 or -1 (comparisons, their and / or / not, lanes_of(),
+  /// splat_mask(0 / -1) and lane fields set to 0 / -1), so their sign bit is their truth: on AVX2 one vblendvps /
+  /// vblendvpd on the mask itself, where GCC's vector a ? b : c first compares the mask with zero (often twice, to
+  /// swap the operands back).
+  /// (V: real or mask.)
+  template <class V> AI static V blend(mask m, V a, V b) {
+    if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(T) == 4)
+      return V(_mm256_blendv_ps(__m256(b), __m256(a), __m256(m)));
+    else if constexpr (BATCHCOL_SIMD_BYTES == 32 && sizeof(T) == 8)
+      return V(_mm256_blendv_pd(__m256d(b), __m256d(a), __m256d(m)));
+    else return select(m, a, b);
+  }
+  static V3 pick(mask m, const V3& a, const V3& b) { return {blend(m, a.x, b.x), blend(m, a.y, b.y), blend(m, a.z, b.z)}; }
   static mask equal(const V3& a, const V3& b) { return (a.x == b.x) & (a.y == b.y) & (a.z == b.z); }
   static real splat(T v) { return real{} + v; }
   static mask splat_mask(Int v) { return mask{} + v; }
@@ -92,14 +104,14 @@ template <class T> struct WideGjk {
     const real zero = splat(T(0));
     switch (s.type) {
       case ShapeType::sphere: return {zero, zero, zero};
-      case ShapeType::capsule: return {zero, zero, select(d.z < zero, -s.s1, s.s1)};
-      case ShapeType::box: return {select(d.x < zero, -s.s0, s.s0), select(d.y < zero, -s.s1, s.s1), select(d.z < zero, -s.s2, s.s2)};
+      case ShapeType::capsule: return {zero, zero, blend(d.z < zero, -s.s1, s.s1)};
+      case ShapeType::box: return {blend(d.x < zero, -s.s0, s.s0), blend(d.y < zero, -s.s1, s.s1), blend(d.z < zero, -s.s2, s.s2)};
       case ShapeType::cylinder: {
         const real rho = wsqrt<T>(d.x * d.x + d.y * d.y);
-        const real z = select(d.z < zero, -s.s1, s.s1);
+        const real z = blend(d.z < zero, -s.s1, s.s1);
         const real k = s.s0 / rho;
         const mask axis = rho == zero;
-        return {select(axis, zero, d.x * k), select(axis, zero, d.y * k), z};
+        return {blend(axis, zero, d.x * k), blend(axis, zero, d.y * k), z};
       }
       case ShapeType::cone: {
         const real rho = wsqrt<T>(d.x * d.x + d.y * d.y);
@@ -107,7 +119,7 @@ template <class T> struct WideGjk {
         const mask apex = h * d.z >= (-h) * d.z + s.s0 * rho;
         const real k = s.s0 / rho;
         const mask axis = rho == zero;
-        const V3 rim = {select(axis, zero, d.x * k), select(axis, zero, d.y * k), -h};
+        const V3 rim = {blend(axis, zero, d.x * k), blend(axis, zero, d.y * k), -h};
         return pick(apex, V3{zero, zero, h}, rim);
       }
       case ShapeType::ellipsoid: {
@@ -143,7 +155,7 @@ template <class T> struct WideGjk {
       const real x = t.vx[i], y = t.vy[i], z = t.vz[i];
       const real di = (x * d.x + y * d.y) + z * d.z;
       const mask better = di > best;
-      best = select(better, di, best);
+      best = blend(better, di, best);
       r = pick(better, V3{x, y, z}, r);
     }
     return r;
@@ -199,25 +211,25 @@ template <class T> struct WideGjk {
     // were done lane by lane).
     typedef std::int32_t I32 __attribute__((vector_size(4 * W)));
     const real zero = splat(T(0)), one = splat(T(1));
-    const real ax = select(d.x < zero, -d.x, d.x), ay = select(d.y < zero, -d.y, d.y), az = select(d.z < zero, -d.z, d.z);
+    const real ax = blend(d.x < zero, -d.x, d.x), ay = blend(d.y < zero, -d.y, d.y), az = blend(d.z < zero, -d.z, d.z);
     const mask yx = ay > ax;
-    real major = select(yx, ay, ax), u = select(yx, d.z, d.y), v = select(yx, d.x, d.z);
+    real major = blend(yx, ay, ax), u = blend(yx, d.z, d.y), v = blend(yx, d.x, d.z);
     const mask zx = az > major;
-    major = select(zx, az, major);
-    u = select(zx, d.x, u);
-    v = select(zx, d.y, v);
-    const real along = select(zx, d.z, select(yx, d.y, d.x));
-    const real face = select(zx, splat(T(4)), select(yx, splat(T(2)), zero)) + select(along < zero, one, zero);
+    major = blend(zx, az, major);
+    u = blend(zx, d.x, u);
+    v = blend(zx, d.y, v);
+    const real along = blend(zx, d.z, blend(yx, d.y, d.x));
+    const real face = blend(zx, splat(T(4)), blend(yx, splat(T(2)), zero)) + blend(along < zero, one, zero);
     const real grid = splat(T(kHullStartGrid)), half = splat(T(0.5 * kHullStartGrid));
     const real k = half / major;
     const mask ok = (major > zero) & (k <= splat(std::numeric_limits<T>::max()));
     // [0, grid) -> its integer part, [grid, inf) -> grid - 1, below 1 and NaN -> 0: in range before converting
     const real fu = u * k + half, fv = v * k + half;
-    const real cu = select(fu >= one, select(fu < grid, fu, grid - one), zero);
-    const real cv = select(fv >= one, select(fv < grid, fv, grid - one), zero);
+    const real cu = blend(fu >= one, blend(fu < grid, fu, grid - one), zero);
+    const real cv = blend(fv >= one, blend(fv < grid, fv, grid - one), zero);
     const real iu = __builtin_convertvector(__builtin_convertvector(cu, I32), real);  // truncated, as uint32_t(f)
     const real iv = __builtin_convertvector(__builtin_convertvector(cv, I32), real);
-    const real c = select(ok, (face * grid + iu) * grid + iv, splat(T(-1)));  // -1: kNoHullVertex as uint32_t
+    const real c = blend(ok, (face * grid + iu) * grid + iv, splat(T(-1)));  // -1: kNoHullVertex as uint32_t
     const I32 ci = __builtin_convertvector(c, I32);
     std::memcpy(cell, &ci, sizeof ci);
   }
@@ -255,9 +267,9 @@ template <class T> struct WideGjk {
     const real k = s.s0 / (rho2 * wsqrt<T>(rho2));
     mask ok = rho2 > zero;
     if (s.type == ShapeType::cone) ok &= ~(s.s1 * u.z >= (-s.s1) * u.z + s.s0 * wsqrt<T>(rho2));  // support()'s apex test
-    h.xx = select(ok, (k * u.y) * u.y, zero);
-    h.yy = select(ok, (k * u.x) * u.x, zero);
-    h.xy = select(ok, -((k * u.x) * u.y), zero);
+    h.xx = blend(ok, (k * u.y) * u.y, zero);
+    h.yy = blend(ok, (k * u.x) * u.x, zero);
+    h.xy = blend(ok, -((k * u.x) * u.y), zero);
     return h;
   }
   /// An ellipsoid's support Hessian in A's frame from its support point: g = the support point's offset from the
@@ -270,9 +282,9 @@ template <class T> struct WideGjk {
     const real m = dot(g, u);
     const mask ok = m > zero;
     const real im = splat(T(1)) / m;
-    return {select(ok, (M.xx - g.x * g.x) * im, zero), select(ok, (M.yy - g.y * g.y) * im, zero),
-            select(ok, (M.zz - g.z * g.z) * im, zero), select(ok, (M.xy - g.x * g.y) * im, zero),
-            select(ok, (M.xz - g.x * g.z) * im, zero), select(ok, (M.yz - g.y * g.z) * im, zero)};
+    return {blend(ok, (M.xx - g.x * g.x) * im, zero), blend(ok, (M.yy - g.y * g.y) * im, zero),
+            blend(ok, (M.zz - g.z * g.z) * im, zero), blend(ok, (M.xy - g.x * g.y) * im, zero),
+            blend(ok, (M.xz - g.x * g.z) * im, zero), blend(ok, (M.yz - g.y * g.z) * im, zero)};
   }
   /// R diag(r^2) R^T (R row-major): an ellipsoid's metric in A's frame.
   AI static Sym ellipsoid_metric(const Side& s, const real* R) {
@@ -299,8 +311,8 @@ template <class T> struct WideGjk {
     }
     const real k = s.s0 / (rho2 * rho);
     const V3 kc = scale(k, c);
-    return {select(ok, kc.x * c.x, zero), select(ok, kc.y * c.y, zero), select(ok, kc.z * c.z, zero),
-            select(ok, kc.x * c.y, zero), select(ok, kc.x * c.z, zero), select(ok, kc.y * c.z, zero)};
+    return {blend(ok, kc.x * c.x, zero), blend(ok, kc.y * c.y, zero), blend(ok, kc.z * c.z, zero),
+            blend(ok, kc.x * c.y, zero), blend(ok, kc.x * c.z, zero), blend(ok, kc.y * c.z, zero)};
   }
 
   /// Vertex i of `v` (packed xyz triples, `count` of them) into row i of one lane's column of the table, from
@@ -359,12 +371,12 @@ template <class T> struct WideGjk {
   AI static Proj pick(mask m, const Proj& a, const Proj& b) {
     Proj r;
     r.x = pick(m, a.x, b.x);
-    r.count = select(m, a.count, b.count);
+    r.count = blend(m, a.count, b.count);
     for (int i = 0; i < 4; ++i) {
-      r.index[i] = select(m, a.index[i], b.index[i]);
-      r.lambda[i] = select(m, a.lambda[i], b.lambda[i]);
+      r.index[i] = blend(m, a.index[i], b.index[i]);
+      r.lambda[i] = blend(m, a.lambda[i], b.lambda[i]);
     }
-    r.contains = select(m, a.contains, b.contains);
+    r.contains = blend(m, a.contains, b.contains);
     return r;
   }
   static Proj empty() {
@@ -383,7 +395,7 @@ template <class T> struct WideGjk {
     mask kind, i, j;
   };
   AI static Edge pick(mask m, const Edge& a, const Edge& b) {
-    return {pick(m, a.x, b.x), select(m, a.u, b.u), select(m, a.kind, b.kind), select(m, a.i, b.i), select(m, a.j, b.j)};
+    return {pick(m, a.x, b.x), blend(m, a.u, b.u), blend(m, a.kind, b.kind), blend(m, a.i, b.i), blend(m, a.j, b.j)};
   }
   /// The segment from qi to qj (input indices i, j in each lane): the reference's segment(), same operations.
   AI static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
@@ -393,24 +405,24 @@ template <class T> struct WideGjk {
     const real zero = splat(T(0)), one = splat(T(1));
     const mask at_i = (tt == zero) | (u <= zero), at_j = ~at_i & (u >= one);
     const V3 inner = add(scale(one - u, qi), scale(u, qj));
-    return {pick(at_i, qi, pick(at_j, qj, inner)), u, select(at_i, splat_mask(0), select(at_j, splat_mask(1), splat_mask(2))), i, j};
+    return {pick(at_i, qi, pick(at_j, qj, inner)), u, blend(at_i, splat_mask(0), blend(at_j, splat_mask(1), splat_mask(2))), i, j};
   }
   AI static Proj to_proj(const Edge& e) {
     const mask inner = e.kind == splat_mask(2), at_j = e.kind == splat_mask(1);
     const real zero = splat(T(0)), one = splat(T(1));
     Proj r = empty();
     r.x = e.x;
-    r.count = select(inner, splat_mask(2), splat_mask(1));
-    r.index[0] = select(at_j, e.j, e.i);
-    r.index[1] = select(inner, e.j, splat_mask(0));
-    r.lambda[0] = select(inner, one - e.u, one);
-    r.lambda[1] = select(inner, e.u, zero);
+    r.count = blend(inner, splat_mask(2), splat_mask(1));
+    r.index[0] = blend(at_j, e.j, e.i);
+    r.index[1] = blend(inner, e.j, splat_mask(0));
+    r.lambda[0] = blend(inner, one - e.u, one);
+    r.lambda[1] = blend(inner, e.u, zero);
     return r;
   }
   static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
     // which 0: the first kept axis (drop + 1) % 3; which 1: the second (drop + 2) % 3.
-    if (which == 0) return select(drop0, p.y, select(drop1, p.z, p.x));
-    return select(drop0, p.z, select(drop1, p.x, p.y));
+    if (which == 0) return blend(drop0, p.y, blend(drop1, p.z, p.x));
+    return blend(drop0, p.z, blend(drop1, p.x, p.y));
   }
 
   static real area(real au, real av, real bu, real bv, real cu, real cv) {
@@ -440,16 +452,16 @@ template <class T> struct WideGjk {
     return h;
   }
   AI static Plane pick(mask m, const Plane& a, const Plane& b) {
-    return {pick(m, a.n, b.n), select(m, a.nn, b.nn), select(m, a.sn, b.sn), select(m, a.t, b.t)};
+    return {pick(m, a.n, b.n), blend(m, a.nn, b.nn), blend(m, a.sn, b.sn), blend(m, a.t, b.t)};
   }
   AI static Face face(const V3& qi, const V3& qj, const V3& qk, const Plane& h) {
     const real zero = splat(T(0));
     const V3& n = h.n;
     const real nn = h.nn;
     const V3 p0 = scale(h.t, n);
-    const real ax = select(n.x < zero, -n.x, n.x), ay = select(n.y < zero, -n.y, n.y), az = select(n.z < zero, -n.z, n.z);
+    const real ax = blend(n.x < zero, -n.x, n.x), ay = blend(n.y < zero, -n.y, n.y), az = blend(n.z < zero, -n.z, n.z);
     const mask d1 = ay > ax;
-    const mask d2 = az > select(d1, ay, ax);
+    const mask d2 = az > blend(d1, ay, ax);
     const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
     // The four points in the kept coordinates (u, v), selected once.
     const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
@@ -494,8 +506,8 @@ template <class T> struct WideGjk {
   /// Face m of tetrahedron p[0..2], s that keeps s (vertex 3), per lane (m = 0: old vertices 1, 2; m = 1: 0, 2;
   /// m = 2: 0, 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
   AI static Face face_keeping_3(const V3* p, const V3& s, const Plane* h, mask m0, mask m2, mask& i, mask& j) {
-    i = select(m0, splat_mask(1), splat_mask(0));
-    j = select(m2, splat_mask(1), splat_mask(2));
+    i = blend(m0, splat_mask(1), splat_mask(0));
+    j = blend(m2, splat_mask(1), splat_mask(2));
     return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), s, pick(m0, h[0], pick(m2, h[2], h[1])));
   }
 
@@ -552,18 +564,18 @@ template <class T> struct WideGjk {
       real far = zero;
       mask choice = splat_mask(0);
       for (int m = 0; m < 3; ++m) {
-        const real q = select(h[m].nn > zero, h[m].sn * h[m].t, splat(T(-1)));
+        const real q = blend(h[m].nn > zero, h[m].sn * h[m].t, splat(T(-1)));
         const mask take = cand[m] & (~have_first | (q > far));
-        far = select(take, q, far);
-        choice = select(take, splat_mask(m), choice);
+        far = blend(take, q, far);
+        choice = blend(take, splat_mask(m), choice);
         have_first |= cand[m];
       }
       first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
     }
     // One face: the triangle lanes' p0 p1 s (triangle()), the tetrahedron lanes' first face (face_keeping_3()'s
     // vertices and indices).
-    const mask fi = select(first_0, splat_mask(1), splat_mask(0));
-    const mask fj = select(three, splat_mask(1), select(first_2, splat_mask(1), splat_mask(2)));
+    const mask fi = blend(first_0, splat_mask(1), splat_mask(0));
+    const mask fj = blend(three, splat_mask(1), blend(first_2, splat_mask(1), splat_mask(2)));
     // Computed whatever the lanes (only segment lanes is rare): no branch, and no default value to write first.
     const mask first_1 = have_first & ~first_0 & ~first_2;
     const Face f = face(pick(first_0, p[1], p[0]), pick(three, p[1], pick(first_2, p[1], p[2])), s,
@@ -596,16 +608,16 @@ template <class T> struct WideGjk {
         // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
         mask i, j;
         const Face g = face_keeping_3(p, s, h, taken[0], taken[2], i, j);
-        const real ni = select(taken[0], En[1], En[0]), nj = select(taken[2], En[1], En[2]);
+        const real ni = blend(taken[0], En[1], En[0]), nj = blend(taken[2], En[1], En[2]);
         const mask to_j = takes_j(g, ni, nj);
-        const real n2 = select(g.use, norm2(g.x), select(to_j, nj, ni));
+        const real n2 = blend(g.use, norm2(g.x), blend(to_j, nj, ni));
         const mask take = round & (~have | (n2 < best_n2));
-        best_n2 = select(take, n2, best_n2);
-        best_use = select(take, g.use, best_use);
-        best_edge = select(take, select(to_j, j, i), best_edge);
+        best_n2 = blend(take, n2, best_n2);
+        best_use = blend(take, g.use, best_use);
+        best_edge = blend(take, blend(to_j, j, i), best_edge);
         bf.x = pick(take, g.x, bf.x);
-        for (int m = 0; m < 3; ++m) bf.lambda[m] = select(take, g.lambda[m], bf.lambda[m]);
-        bi = select(take, i, bi), bj = select(take, j, bj);
+        for (int m = 0; m < 3; ++m) bf.lambda[m] = blend(take, g.lambda[m], bf.lambda[m]);
+        bi = blend(take, i, bi), bj = blend(take, j, bj);
         have |= round;
       }
     }
@@ -617,21 +629,21 @@ template <class T> struct WideGjk {
     const mask use_face = (three & f.use) | first_ok | (from_best & best_use);
     Face a = f;
     a.x = pick(from_best, bf.x, f.x);
-    for (int m = 0; m < 3; ++m) a.lambda[m] = select(from_best, bf.lambda[m], f.lambda[m]);
-    Proj r = pick(use_face, face_proj(a, select(from_best, bi, fi), select(from_best, bj, fj), newest), to_proj(e));
+    for (int m = 0; m < 3; ++m) a.lambda[m] = blend(from_best, bf.lambda[m], f.lambda[m]);
+    Proj r = pick(use_face, face_proj(a, blend(from_best, bi, fi), blend(from_best, bj, fj), newest), to_proj(e));
     if (any(four)) {
       // No visible face: no candidate (x infinite, count 0); the origin inside: the whole tetrahedron.
       const mask none = from_best & ~have;
       const real inf = splat(std::numeric_limits<T>::infinity());
       r.x = pick(none, V3{inf, inf, inf}, r.x);
-      r.count = select(none, splat_mask(0), r.count);
+      r.count = blend(none, splat_mask(0), r.count);
       if (any(inside)) {
         r.x = pick(inside, V3{zero, zero, zero}, r.x);
-        r.count = select(inside, splat_mask(4), r.count);
+        r.count = blend(inside, splat_mask(4), r.count);
         r.contains = inside;
         for (int m = 0; m < 4; ++m) {
-          r.index[m] = select(inside, splat_mask(m), r.index[m]);
-          r.lambda[m] = select(inside, V[m] / total, r.lambda[m]);
+          r.index[m] = blend(inside, splat_mask(m), r.index[m]);
+          r.lambda[m] = blend(inside, V[m] / total, r.lambda[m]);
         }
       }
     }
@@ -675,7 +687,10 @@ template <class T> struct WideGjk {
   /// d_prev holds the initial direction): one SIMD Minkowski support instead of one scalar per refill.
   /// `side`: the run may have distance / witness lanes (side_start(); boolean runs never do).
   /// `dirs` (drive_boolean_directions()): a[0] keeps the search direction d_prev instead of the point of A.
-  AI static void start(Lanes& L, bool side, bool dirs = false) {
+  /// `nesterov`: the run's solver reads last_s (Nesterov's momentum point, the only reader).
+  /// A boolean run without `dirs` never reads a[] and b[] (no points, no Newton tracking: loop()'s `track`), and a
+  /// run of another solver never reads last_s: they are not written (measured in loop()'s comment).
+  AI static void start(Lanes& L, bool side, bool dirs = false, bool nesterov = true) {
     if (L.fresh == 0) return;
     std::uint32_t first = L.fresh;  // the lanes that start from the first support point
     // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
@@ -692,10 +707,12 @@ template <class T> struct WideGjk {
     minkowski(L, neg(L.d_prev), first, sw, sa, sb);
     const mask m = lanes_of(first);
     L.w[0] = pick(m, sw, L.w[0]);
-    L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
-    L.b[0] = pick(m, sb, L.b[0]);
+    if (side || dirs) {
+      L.a[0] = pick(m, dirs ? L.d_prev : sa, L.a[0]);  // start_lane() set slot[0] = 0
+      L.b[0] = pick(m, sb, L.b[0]);
+    }
     L.x = pick(m, sw, L.x);
-    L.last_s = pick(m, sw, L.last_s);
+    if (nesterov) L.last_s = pick(m, sw, L.last_s);
     if (side && side_start_pair(L.A.type, L.B.type)) side_start(L, m & ~L.boolean_only);
     if constexpr (std::is_same_v<T, double>) {
       if (side && (L.rim_given || start_candidate_pair(L.A.type, L.B.type))) {
@@ -739,18 +756,18 @@ template <class T> struct WideGjk {
     const V3 b = {L.R[2], L.R[5], L.R[8]};
     const real beta = b.z, cb = dot(c, b), bb = norm2(b);
     const real denom = bb - beta * beta;
-    const real zb1 = select(denom > zero, (beta * c.z - cb) / denom, zero);
+    const real zb1 = blend(denom > zero, (beta * c.z - cb) / denom, zero);
     const mask out_b1 = (zb1 > hb) | (zb1 < -hb);
-    const real zb1c = select(zb1 > hb, hb, select(zb1 < -hb, -hb, zb1));
+    const real zb1c = blend(zb1 > hb, hb, blend(zb1 < -hb, -hb, zb1));
     const real za = c.z + zb1c * beta;
     const mask out_a = (za > ha) | (za < -ha);
-    const real zac = select(za > ha, ha, select(za < -ha, -ha, za));
+    const real zac = blend(za > ha, ha, blend(za < -ha, -ha, za));
     const real zb2 = (zac * beta - cb) / bb;
     const mask out_b2 = (zb2 > hb) | (zb2 < -hb);
-    const real zb = select(out_a, select(zb2 > hb, hb, select(zb2 < -hb, -hb, zb2)), zb1c);
+    const real zb = blend(out_a, blend(zb2 > hb, hb, blend(zb2 < -hb, -hb, zb2)), zb1c);
     mask ok = m;
     if (L.A.type == ShapeType::cylinder) ok &= ~out_a;
-    if (L.B.type == ShapeType::cylinder) ok &= ~select(out_a, out_b2, out_b1);
+    if (L.B.type == ShapeType::cylinder) ok &= ~blend(out_a, out_b2, out_b1);
     const V3 qa = {zero, zero, zac}, qb = add(c, scale(zb, b));
     const V3 v = sub(qa, qb);
     const real vn = norm(v);
@@ -824,9 +841,9 @@ template <class T> struct WideGjk {
         const real r1 = g * ir, r2 = (h - r1 * r1) * ir;
         const real f1 = kr * r1 + ry * v1b, f2 = kr * r2 + ry * v2b;
         const real den = f2 + (f1 * r1) * ir;
-        dt = select(den > zero, -f1 / den, zero);
+        dt = blend(den > zero, -f1 / den, zero);
       } else {
-        dt = select(h > zero, -g / h, zero);
+        dt = blend(h > zero, -g / h, zero);
       }
       const real C1 = C - dt * S, S1 = S + dt * C;
       const real inv = one / wsqrt<T>(C1 * C1 + S1 * S1);
@@ -884,7 +901,7 @@ template <class T> struct WideGjk {
       const mask take = ok & (~has | (n2 < best));
       pa = pick(take, qa, pa);
       pb = pick(take, qb, pb);
-      best = select(take, n2, best);
+      best = blend(take, n2, best);
       has |= take;
     };
     const V3 c = {t[0], t[1], t[2]}, b = {R[2], R[5], R[8]};
@@ -1075,14 +1092,14 @@ template <class T> struct WideGjk {
     const mask m = lanes_of(bits), none = splat_mask(0);
     const real zero = splat(T(0));
     L.fresh |= bits;
-    L.lambda[0] = select(m, splat(T(1)), L.lambda[0]);
-    L.count = select(m, splat_mask(1), L.count);
-    L.slot[0] = select(m, none, L.slot[0]);
+    L.lambda[0] = blend(m, splat(T(1)), L.lambda[0]);
+    L.count = blend(m, splat_mask(1), L.count);
+    L.slot[0] = blend(m, none, L.slot[0]);
     L.d_prev = pick(m, init, L.d_prev);
     L.direction = pick(m, V3{zero, zero, zero}, L.direction);
-    L.lower = select(m, splat(-std::numeric_limits<T>::infinity()), L.lower);
-    L.k = select(m, none, L.k);
-    L.stale = select(m, none, L.stale);
+    L.lower = blend(m, splat(-std::numeric_limits<T>::infinity()), L.lower);
+    L.k = blend(m, none, L.k);
+    L.stale = blend(m, none, L.stale);
   }
 
   static void refill(Lanes& L, int l, const PairSetup<T>& s, std::int64_t p, Solver solver) {
@@ -1278,7 +1295,7 @@ template <class T> struct WideGjk {
     }
     if (any(use & is_face)) {
       const real s = wsqrt<T>(mm);
-      const V3 f = divide(m, select(dot(m, n) < zero, -s, s));
+      const V3 f = divide(m, blend(dot(m, n) < zero, -s, s));
       delta = pick(is_face, sub(f, n), delta);
     }
     step2 = norm2(delta);
@@ -1366,6 +1383,7 @@ template <class T> struct WideGjk {
     // Else no lane ever has L.newton; boolean lanes never take Newton steps (newton_lanes below).
     const bool newton_run = !Boolean && newton_pair_type(L.A.type, L.B.type);
     const bool flat_run = !Boolean && flat_newton_side(L.A.type, L.B.type) != 0;  // feature_direction()
+    const bool nesterov = solver == Solver::nesterov;  // last_s's only reader (start())
     // Finishes lane l with `status` and refills it (or empties it).
     const auto close = [&](int l, GjkStatus status) {
       source.done(L, l, status);
@@ -1383,7 +1401,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L, !Boolean, Dirs);
+      start(L, !Boolean, Dirs, nesterov);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {
@@ -1396,7 +1414,7 @@ template <class T> struct WideGjk {
         continue;  // refilled lanes start with k = 0
       }
       mask live = lanes_of(active);
-      L.k = select(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
+      L.k = blend(live, L.k + 1, L.k);  // the reference's r.iterations = k + 1
 
       const V3 x = L.x;
       const real xx = norm2(x);
@@ -1437,7 +1455,7 @@ template <class T> struct WideGjk {
         if (any(newton_step)) {
           d = pick(newton_step, L.newton_dir, d);
           L.momentum &= ~newton_step;
-          L.newton_steps = select(newton_step, L.newton_steps + 1, L.newton_steps);
+          L.newton_steps = blend(newton_step, L.newton_steps + 1, L.newton_steps);
         }
         L.newton_next = splat_mask(0);  // set again below, only for lanes that take a step
       }
@@ -1457,8 +1475,8 @@ template <class T> struct WideGjk {
       const real dnorm = any(live & (~plain | turned)) ? norm(d) : xn;
       const real lb = dot(sw, d) / dnorm;
       const mask progress = lb > L.lower + T(0.1) * (xn - L.lower);
-      L.stale = select(live, select(progress, splat_mask(0), L.stale + 1), L.stale);
-      L.lower = select(live, wmax(L.lower, lb), L.lower);
+      L.stale = blend(live, blend(progress, splat_mask(0), L.stale + 1), L.stale);
+      L.lower = blend(live, wmax(L.lower, lb), L.lower);
       L.direction = pick(live, d, L.direction);
       const mask ends_separated = live & boolean_only & (lb > L.core_margin);
       live &= ~ends_separated;
@@ -1491,8 +1509,8 @@ template <class T> struct WideGjk {
             used[q] = splat_mask(0);
             for (int m = 0; m < 3; ++m) used[q] |= (L.count > splat_mask(m)) & (L.slot[m] == splat_mask(q));
           }
-          const mask free = select(~used[0], splat_mask(0),
-                                   select(~used[1], splat_mask(1), select(~used[2], splat_mask(2), splat_mask(3))));
+          const mask free = blend(~used[0], splat_mask(0),
+                                   blend(~used[1], splat_mask(1), blend(~used[2], splat_mask(2), splat_mask(3))));
           for (int q = 0; q < 4; ++q) {
             const mask here = live & (free == splat_mask(q));
             L.a[q] = pick(here, Dirs ? d : sa, L.a[q]);
@@ -1533,16 +1551,16 @@ template <class T> struct WideGjk {
           L.w[m] = r;
           if (track) {
             mask q = pslot[m];
-            for (int o = m + 1; o < 4; ++o) q = select(from_q[o], pslot[o], q);
+            for (int o = m + 1; o < 4; ++o) q = blend(from_q[o], pslot[o], q);
             L.slot[m] = q;
           }
-          if (!Boolean) L.lambda[m] = select(moves, proj.lambda[m], L.lambda[m]);  // a boolean output has no weights
+          if (!Boolean) L.lambda[m] = blend(moves, proj.lambda[m], L.lambda[m]);  // a boolean output has no weights
         }
-        L.count = select(moves, proj.count, L.count);
+        L.count = blend(moves, proj.count, L.count);
         L.x = pick(moves, proj.x, L.x);
         const mask steps = moves & ~ends_contains;
         L.d_prev = pick(steps, d, L.d_prev);
-        L.last_s = pick(steps, sw, L.last_s);
+        if (nesterov) L.last_s = pick(steps, sw, L.last_s);
         // Newton's direction for the next iteration (newton_direction()), where this support point gives one:
         //  - lb > 0 (separated cores: H + lb I is positive definite); not on polytope pairs (flat_newton_side());
         //  - the step turns the direction by at most kNewtonSwitch (|delta| estimates the angle to the optimal
@@ -1571,7 +1589,7 @@ template <class T> struct WideGjk {
           read = flat_run ? newton_lanes & gap_open & ~(newton_step & ~(newton_gap <= T(0.5) * L.newton_gap))
                           : newton_lanes & (newton_step | ((lb > zero) & gap_open));
           if (flat_run && !any(read) && any(newton_lanes))
-            L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
+            L.newton_gap = blend(newton_lanes, newton_gap, L.newton_gap);  // the bookkeeping of the block below
         }
         if (newton_live && any(read)) {
           const V3 n = scale(one / dnorm, d);  // one division (face()'s weights say why)
@@ -1604,14 +1622,14 @@ template <class T> struct WideGjk {
             // (measured, mean iterations: box-ellipsoid 13.0 -> 12.2, ellipsoid-convex8 14.7 -> 13.3). Near the
             // optimum (step2 ~ eps^2, the tilt) only the certified gap tells progress: it must halve per Newton step.
             skip = failed | (newton_lanes & newton_step & ~(newton_gap <= T(0.5) * L.newton_gap));
-            L.newton_gap = select(newton_lanes, newton_gap, L.newton_gap);
+            L.newton_gap = blend(newton_lanes, newton_gap, L.newton_gap);
           } else {
             L.newton &= ~failed;
           }
           const mask want = newton_lanes & L.newton & ~skip & valid & (step2 <= T(kNewtonSwitch * kNewtonSwitch)) &
                              gap_open;
           L.newton_dir = pick(want, nd, L.newton_dir);
-          L.newton_step2 = select(want, step2, L.newton_step2);
+          L.newton_step2 = blend(want, step2, L.newton_step2);
           L.newton_next = want;
         }
       }

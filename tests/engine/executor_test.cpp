@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <set>
+#include <utility>
 #include <string>
 
 namespace batchcol {
@@ -265,7 +267,8 @@ TEST(Executor, MarginMakesNearPairsCollide) {
     }
 }
 
-// The default solver is `automatic`: polyak for boolean queries, gjk for the other levels except momentum_pays()'s
+// The default solver is `automatic`: polyak for boolean queries (gjk for plain_boolean_pays()'s pair types), gjk
+// for the other levels except momentum_pays()'s
 // pair types (an ellipsoid against an ellipsoid, cylinder, cone or hull), which run polyak there too. Each
 // pair's results are its resolved solver's, bit for bit, and not those of the other solvers (iteration counts
 // differ on some pair).
@@ -276,11 +279,25 @@ TEST(Executor, AutomaticSolverRunsPolyakForBooleanAndEllipsoidPairsAndGjkOtherwi
     EXPECT_EQ(resolve_solver(Solver::automatic, level), Solver::gjk);
   for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak})
     EXPECT_EQ(resolve_solver(named, QueryLevel::boolean), named);
-  // Per pair type: boolean stays polyak; the other levels polyak exactly for momentum_pays()'s pairs, in either
-  // order; a named solver is never changed.
+  // Per pair type: boolean polyak but gjk for the six pair types plain_boolean_pays() lists (capsule-box,
+  // capsule-cylinder, capsule-cone, box-cylinder, box-cone, cone-cone, either order); the other levels polyak
+  // exactly for momentum_pays()'s pairs, in either order; a named solver is never changed.
+  const auto plain_boolean = [](ShapeType a, ShapeType b) {
+    const std::set<std::pair<ShapeType, ShapeType>> listed = {
+        {ShapeType::capsule, ShapeType::box},  {ShapeType::capsule, ShapeType::cylinder},
+        {ShapeType::capsule, ShapeType::cone}, {ShapeType::box, ShapeType::cylinder},
+        {ShapeType::box, ShapeType::cone},     {ShapeType::cone, ShapeType::cone}};
+    return listed.count({a, b}) + listed.count({b, a}) > 0;
+  };
+  EXPECT_TRUE(plain_boolean_pays(ShapeType::cylinder, ShapeType::box));
+  EXPECT_FALSE(plain_boolean_pays(ShapeType::cylinder, ShapeType::cylinder));
   for (ShapeType a : testing::bounded_shape_types())
     for (ShapeType b : testing::bounded_shape_types()) {
-      EXPECT_EQ(resolve_solver(Solver::automatic, QueryLevel::boolean, a, b), Solver::polyak);
+      EXPECT_EQ(resolve_solver(Solver::automatic, QueryLevel::boolean, a, b),
+                plain_boolean(a, b) ? Solver::gjk : Solver::polyak)
+          << to_string(a) << "-" << to_string(b);
+      for (Solver named : {Solver::gjk, Solver::nesterov, Solver::polyak})
+        EXPECT_EQ(resolve_solver(named, QueryLevel::boolean, a, b), named);
       const bool ellipsoid = a == ShapeType::ellipsoid || b == ShapeType::ellipsoid;
       const ShapeType other = a == ShapeType::ellipsoid ? b : a;
       const bool partner = other == ShapeType::ellipsoid || other == ShapeType::cylinder || other == ShapeType::cone ||
