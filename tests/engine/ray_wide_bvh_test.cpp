@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace batchcol {
@@ -247,45 +248,60 @@ TEST(RayWideBvh, FloatTestNeverMissesABoxTheSegmentTouches) {
   EXPECT_GT(grazing, 1000);
 }
 
+/// One wide node over unit-height boxes [x_lo, x_lo + 0.5] x [-1, 1]^2 (the ordering tests' scenes): every leaf a
+/// child of the root, which the tests check as their premise.
+struct RowOfBoxes {
+  broadphase::AabbSoa b;
+  RayBvh bvh;
+  WideBvh wide;
+  RowOfBoxes(const float* x_lo, std::size_t n) {
+    b.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      b.min_x[i] = x_lo[i], b.max_x[i] = x_lo[i] + 0.5f;
+      b.min_y[i] = b.min_z[i] = -1.0f, b.max_y[i] = b.max_z[i] = 1.0f;
+    }
+    bvh.build(b);
+    wide.collapse(bvh, b);
+  }
+  const WideNode& root() const { return wide.nodes()[0]; }
+  std::uint32_t object(int slot) const { return bvh.leaf_object()[root().child[slot] & ~kLeafBit]; }
+};
+
+/// Every instruction set's traversal of `row` by the ray (o, d) visits the leaves of `slots` in their order.
+void expect_visits(const RowOfBoxes& row, const std::vector<int>& slots, const double* o, const double* d,
+                   const std::string& what) {
+  std::vector<std::uint32_t> expected;
+  for (int s : slots) expected.push_back(row.root().child[s] & ~kLeafBit);
+  const WideRay ray = make_wide_ray(o, d);
+  for (int isa = 0; isa < 3; ++isa) {
+    if (const WideTraverse traverse = wide_traverse_for(isa)) {
+      Leaves seen;
+      traverse(row.wide.nodes().data(), ray, wide_limit(INFINITY), record, &seen);
+      EXPECT_EQ(seen.seen, expected) << what << " isa " << isa;
+    }
+  }
+}
+
 TEST(RayWideBvh, ChildrenAreVisitedNearestFirstTiesInSlotOrderInEveryOctant) {
   // Seven boxes in one wide node (three of them identical, so their entries tie), crossed by a ray along +-x in each
   // of the 8 direction octants: the traversal runs one loop per octant and ranks 3+ hit children without a sort, and
   // must visit them by entry (the near plane: x_lo going +x, x_hi going -x), equal entries in slot order.
   const float x_lo[7] = {0.0f, 3.0f, 1.0f, 3.0f, 5.0f, 2.0f, 3.0f};
-  broadphase::AabbSoa b;
-  b.resize(7);
-  for (std::size_t i = 0; i < 7; ++i) {
-    b.min_x[i] = x_lo[i], b.max_x[i] = x_lo[i] + 0.5f;
-    b.min_y[i] = b.min_z[i] = -1.0f, b.max_y[i] = b.max_z[i] = 1.0f;
-  }
-  RayBvh bvh;
-  bvh.build(b);
-  WideBvh wide;
-  wide.collapse(bvh, b);
-  ASSERT_EQ(wide.nodes().size(), 1u);  // the premise: every leaf is a child of the root
-  const WideNode& root = wide.nodes()[0];
+  const RowOfBoxes row(x_lo, 7);
+  ASSERT_EQ(row.wide.nodes().size(), 1u);  // the premise: every leaf is a child of the root
   for (int octant = 0; octant < 8; ++octant) {
     const double sx = octant & 1 ? -1.0 : 1.0, sy = octant & 2 ? -1.0 : 1.0, sz = octant & 4 ? -1.0 : 1.0;
     const double o[3] = {-50.0 * sx + 2.75, 0.0, 0.0}, d[3] = {sx, 1e-3 * sy, 1e-3 * sz};
     std::vector<int> slots;
     for (int s = 0; s < kWideArity; ++s)
-      if (root.child[s] != kWideEmpty) slots.push_back(s);
+      if (row.root().child[s] != kWideEmpty) slots.push_back(s);
     ASSERT_EQ(slots.size(), 7u);
     const auto entry = [&](int s) {
-      const std::uint32_t i = bvh.leaf_object()[root.child[s] & ~kLeafBit];
-      return sx > 0 ? double(b.min_x[i]) : -double(b.max_x[i]);
+      const std::uint32_t i = row.object(s);
+      return sx > 0 ? double(row.b.min_x[i]) : -double(row.b.max_x[i]);
     };
     std::stable_sort(slots.begin(), slots.end(), [&](int a, int c) { return entry(a) < entry(c); });
-    std::vector<std::uint32_t> expected;
-    for (int s : slots) expected.push_back(root.child[s] & ~kLeafBit);
-    const WideRay ray = make_wide_ray(o, d);
-    for (int isa = 0; isa < 3; ++isa) {
-      if (const WideTraverse traverse = wide_traverse_for(isa)) {
-        Leaves seen;
-        traverse(wide.nodes().data(), ray, wide_limit(INFINITY), record, &seen);
-        EXPECT_EQ(seen.seen, expected) << "octant " << octant << " isa " << isa;
-      }
-    }
+    expect_visits(row, slots, o, d, "octant " + std::to_string(octant));
   }
 }
 
@@ -298,27 +314,18 @@ TEST(RayWideBvh, SixteenChildrenInOneNodeAreRankedAcrossBothHalves) {
   // visiting order is by entry, ties in slot order.
   const float x_lo[16] = {3.0f, 0.0f, 1.0f, 3.0f, 6.0f, 2.0f, 3.0f, 1.0f,
                           4.0f, 3.0f, 7.0f, 1.0f, 3.0f, 5.0f, 8.0f, 9.0f};
-  broadphase::AabbSoa b;
-  b.resize(16);
-  for (std::size_t i = 0; i < 16; ++i) {
-    b.min_x[i] = x_lo[i], b.max_x[i] = x_lo[i] + 0.5f;
-    b.min_y[i] = b.min_z[i] = -1.0f, b.max_y[i] = b.max_z[i] = 1.0f;
-  }
-  RayBvh bvh;
-  bvh.build(b);
-  WideBvh wide;
-  wide.collapse(bvh, b);
-  ASSERT_EQ(wide.nodes().size(), 1u);  // every leaf is a child of the root
-  const WideNode& root = wide.nodes()[0];
+  const RowOfBoxes row(x_lo, 16);
+  ASSERT_EQ(row.wide.nodes().size(), 1u);  // every leaf is a child of the root
+  const auto& b = row.b;
   for (const bool inside : {false, true}) {
     for (int octant = 0; octant < 8; ++octant) {
       const double sx = octant & 1 ? -1.0 : 1.0, sy = octant & 2 ? -1.0 : 1.0, sz = octant & 4 ? -1.0 : 1.0;
       const double ox = inside ? 3.25 : -50.0 * sx + 4.75;
       const double o[3] = {ox, 0.0, 0.0}, d[3] = {sx, 1e-3 * sy, 1e-3 * sz};
       std::vector<int> slots;
-      const auto box = [&](int s) { return bvh.leaf_object()[root.child[s] & ~kLeafBit]; };
+      const auto box = [&](int s) { return row.object(s); };
       for (int s = 0; s < kWideArity; ++s) {
-        if (root.child[s] == kWideEmpty) continue;
+        if (row.root().child[s] == kWideEmpty) continue;
         const double far = sx > 0 ? double(b.max_x[box(s)]) - ox : ox - double(b.min_x[box(s)]);
         if (far >= 0.0) slots.push_back(s);  // not behind the origin
       }
@@ -328,16 +335,7 @@ TEST(RayWideBvh, SixteenChildrenInOneNodeAreRankedAcrossBothHalves) {
         return std::max(near, 0.0);
       };
       std::stable_sort(slots.begin(), slots.end(), [&](int a, int c) { return entry(a) < entry(c); });
-      std::vector<std::uint32_t> expected;
-      for (int s : slots) expected.push_back(root.child[s] & ~kLeafBit);
-      const WideRay ray = make_wide_ray(o, d);
-      for (int isa = 0; isa < 3; ++isa) {
-        if (const WideTraverse traverse = wide_traverse_for(isa)) {
-          Leaves seen;
-          traverse(wide.nodes().data(), ray, wide_limit(INFINITY), record, &seen);
-          EXPECT_EQ(seen.seen, expected) << "inside " << inside << " octant " << octant << " isa " << isa;
-        }
-      }
+      expect_visits(row, slots, o, d, "inside " + std::to_string(inside) + " octant " + std::to_string(octant));
     }
   }
 }
