@@ -1,7 +1,7 @@
 // The body of the wide traversal (see ray_wide_traverse.hpp), included once per instruction set inside a
-// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_VLANES
-// (the lanes of one vector: 16 or 8) and BATCHCOL_WIDE_LE / LT / EQ(a, b): the lane bits of a <= b, a < b, a == b
-// (the comparison straight to a mask: on AVX-512 a vector compare, a vector mask and its bits cost three steps).
+// `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_VLANES (the lanes of one vector:
+// 16 or 8) and BATCHCOL_WIDE_LE(a, b) / BATCHCOL_WIDE_ILT(a, b): the lane bits of float a <= b and of signed 32-bit
+// a < b (the comparison straight to a mask: on AVX-512 a vector compare, a vector mask and its bits cost three steps).
 
 namespace {
 
@@ -108,7 +108,7 @@ void traverse_octant(const WideNode* nodes, const WideRay& r, float limit, WideL
   __asm__("" : "+x"(zero_scalar));
   const V zero = splat(zero_scalar);
   // Each wide level descends at least one level of the binary tree, whose depth is at most 64 (every level of a
-  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most 16 entries after popping one.
+  // Karras tree splits on a distinct bit of the 64-bit keys); a node pushes at most kWideArity - 1 entries after popping one.
   Entry stack[64 * (kWideArity - 1) + 2];
   int top = 0;
   Entry e{0u, 0.0f};  // the root

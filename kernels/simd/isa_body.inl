@@ -91,10 +91,6 @@ void accumulate_samples(const double* values, const Status* status, const double
 void draw_gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count, double* const* z) {
   WideSamples::gaussians4(key, stream, k0, count, z);
 }
-void draw_gaussians4_streams(std::uint64_t key, std::uint64_t stream_a, std::uint64_t stream_b, std::uint64_t k0,
-                             std::size_t count, double* const* z_a, double* const* z_b) {
-  WideSamples::gaussians4_streams(key, stream_a, stream_b, k0, count, z_a, z_b);
-}
 void draw_gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
                            std::uint64_t stream_b, std::size_t draws, double* z) {
   WideSamples::gaussians4_pairs(keys, pairs, stream_a, stream_b, draws, z);

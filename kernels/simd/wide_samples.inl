@@ -105,7 +105,7 @@ struct WideSamples {
   template <int N> static void gaussians(u64 key, u64 index, std::uint64_t stream, real* z) {
     gaussians<N>(key, index, u64{} + stream, z);
   }
-  /// The same with a stream per lane too (lanes of both sides of a pair: gaussians4_streams()).
+  /// The same with a stream per lane too (lanes of both sides of several pairs: gaussians4_pairs()).
   template <int N> static void gaussians(u64 key, u64 index, u64 stream, real* z) {
     u64 state = splitmix(splitmix(key ^ index) ^ stream);
     for (int g = 0; g < N; g += 2) {
@@ -132,37 +132,8 @@ struct WideSamples {
     }
   }
 
-  /// gaussians4() of streams sa and sb (a pair's two sides) in one pass: lane e < count draws k0 + e of stream sa
-  /// into za[c][e], lane count + e draw k0 + e of stream sb into zb[c][e]. Each lane's state is its own (key, k,
-  /// stream), so the bits are those of two gaussians4() calls; a register holds both sides' draws where two calls
-  /// each left part of theirs empty (smoothed1 at M = 4: two draws per side, 2 + 2 of AVX2's 4 lanes instead of two
-  /// registers half used: one register's series instead of two).
-  static void gaussians4_streams(std::uint64_t key, std::uint64_t sa, std::uint64_t sb, std::uint64_t k0,
-                                 std::size_t count, double* const* za, double* const* zb) {
-    const std::size_t total = 2 * count;
-    for (std::size_t e0 = 0; e0 < total; e0 += W) {
-      const std::size_t lanes = std::min<std::size_t>(W, total - e0);
-      u64 index{}, stream{};
-      for (int l = 0; l < W; ++l) {  // padding lanes (l >= lanes) draw the last lane's sample again, unstored
-        const std::size_t e = e0 + std::min<std::size_t>(std::size_t(l), lanes - 1);
-        const bool second = e >= count;
-        index[l] = k0 + (second ? e - count : e);
-        stream[l] = second ? sb : sa;
-      }
-      real v[4];
-      gaussians<4>(u64{} + key, index, stream, v);
-      for (std::size_t l = 0; l < lanes; ++l) {
-        const std::size_t e = e0 + l;
-        const bool second = e >= count;
-        double* const* z = second ? zb : za;
-        const std::size_t j = second ? e - count : e;
-        for (int c = 0; c < 4; ++c) z[c][j] = v[c][l];
-      }
-    }
-  }
-
-  /// draw_gaussians4_streams(keys[p], sa, sb, 0, draws, ...) for `pairs` pairs in one pass: pair p's draws into
-  /// z + 8 draws p (stream sa's coordinate c at c draws, sb's at (4 + c) draws). Lane e of the 2 draws pairs is
+  /// gaussians4() of both streams sa and sb (a pair's two sides) for `pairs` pairs in one pass: pair p's draws (key
+  /// keys[p], k = 0 .. draws) into z + 8 draws p (stream sa's coordinate c at c draws, sb's at (4 + c) draws). Lane e of the 2 draws pairs is
   /// (pair, side, k) in that order with its own (key, k, stream), so the bits are those of a call per pair; the
   /// registers are full where a call per pair filled one register each (AVX-512 at M = 4) and paid its lane set-up
   /// and stores per pair (smoothed1 draws a store block's pairs at once: derivatives.cpp).

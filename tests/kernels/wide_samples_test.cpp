@@ -165,39 +165,6 @@ TEST(WideSamples, SmoothedFirstOrderDrawsAreTheCounterGenerators) {
   }
 }
 
-TEST(WideSamples, BothSidesDrawsAreTheCounterGenerators) {
-  // Both streams of a pair in one call (smoothed1's two sides): counts 1 .. 9 put the boundary between the two
-  // streams at every lane of AVX2's 4 and AVX-512's 8 (and past a register), and leave padding lanes; each stream's
-  // arrays get exactly its draws (sentinels around them stay).
-  for (std::uint64_t pair : {0ull, 5ull, 1000003ull}) {
-    for (std::size_t count = 1; count <= 9; ++count) {
-      const std::uint64_t key = detail::splitmix64(detail::splitmix64(41) ^ pair);
-      for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
-        if (!kernels::simd::cpu_has(isa)) continue;
-        SCOPED_TRACE(to_string(isa));
-        const std::size_t span = count + 1;  // one sentinel after each array
-        std::vector<double> buffer(8 * span, -7.0);
-        double* const za[4] = {&buffer[0], &buffer[span], &buffer[2 * span], &buffer[3 * span]};
-        double* const zb[4] = {&buffer[4 * span], &buffer[5 * span], &buffer[6 * span], &buffer[7 * span]};
-        kernels::simd::draw_gaussians4_streams(isa, key, 1, 2, 3, count, za, zb);
-        for (std::size_t k = 0; k < count; ++k) {
-          double ra[4], rb[4];
-          detail::gaussian_vector<4>(41, pair, 3 + k, 1, ra);
-          detail::gaussian_vector<4>(41, pair, 3 + k, 2, rb);
-          for (int c = 0; c < 4; ++c) {
-            ASSERT_TRUE(same(za[c][k], ra[c])) << pair << " " << count << " " << k << " " << c;
-            ASSERT_TRUE(same(zb[c][k], rb[c])) << pair << " " << count << " " << k << " " << c;
-          }
-        }
-        for (int c = 0; c < 4; ++c) {
-          EXPECT_EQ(za[c][count], -7.0);
-          EXPECT_EQ(zb[c][count], -7.0);
-        }
-      }
-    }
-  }
-}
-
 TEST(WideSamples, SeveralPairsDrawsAreTheCounterGenerators) {
   // draw_gaussians4_pairs(): 1 .. 9 pairs of 1 .. 5 draws a side put pair and side boundaries at every lane of
   // AVX2's 4 and AVX-512's 8 and leave padding lanes; pair p's block gets exactly gaussian_vector<4>(seed, pair_p, k,

@@ -262,7 +262,7 @@ Command add_bench_command(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--query", s->query, "boolean, distance, witness or penetration")->capture_default_str();
   app->add_option("--precision", s->precision, "double or float")->capture_default_str();
-  app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean and for ellipsoid-ellipsoid, -cylinder, -cone and -convex, else gjk)")->capture_default_str();
+  app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (polyak for boolean except gjk for capsule-box/-cylinder/-cone, box-cylinder/-cone and cone-cone; polyak for ellipsoid-ellipsoid, -cylinder, -cone and -convex at every level; else gjk)")->capture_default_str();
   app->add_option("--threads", s->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str();

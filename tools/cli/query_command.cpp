@@ -108,7 +108,7 @@ Command add_query_command(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand("query", "Run the pairs of a batch file and write one result row per pair");
   app->add_option("batch", s->batch_path, "Batch file (JSON)")->required();
   s->query_flag = app->add_option("--query", s->query, "boolean, distance, witness or penetration");
-  s->solver_flag = app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (the default: polyak for boolean and for ellipsoid-ellipsoid, -cylinder, -cone and -convex, else gjk)");
+  s->solver_flag = app->add_option("--solver", s->solver, "gjk, nesterov, polyak or automatic (the default: polyak for boolean except gjk for capsule-box/-cylinder/-cone, box-cylinder/-cone and cone-cone; polyak for ellipsoid-ellipsoid, -cylinder, -cone and -convex at every level; else gjk)");
   s->tolerance_flag = app->add_option("--tolerance", s->tolerance, "Distance tolerance in metres")
                           ->check(finite_non_negative());
   s->max_iterations_flag = app->add_option("--max-iterations", s->max_iterations, "GJK iterations per pair")

@@ -163,8 +163,9 @@ constexpr bool plain_boolean_pays(ShapeType a, ShapeType b) {
 /// The solver `requested` runs as at `level` on a pair of types `a`, `b` (never `automatic`): resolve_solver()
 /// with polyak for the distance / witness / penetration levels of momentum_pays()'s pair types, and gjk for the
 /// boolean level of plain_boolean_pays()'s. Every path that
-/// runs a pair (the batch-array GJK, the per-pair path, the scalar solve) resolves with the pair's types, so a
-/// pair's result does not depend on the path.
+/// runs a pair as a query (the batch-array GJK, the per-pair path, the scalar solve) resolves with the pair's
+/// types, so a pair's result does not depend on the path. (smoothed0's perturbed samples are not queries: they run
+/// the level's solver, resolve_solver(requested, level), documented in the README's solver convention.)
 inline Solver resolve_solver(Solver requested, QueryLevel level, ShapeType a, ShapeType b) {
   if (requested == Solver::automatic && level != QueryLevel::boolean && momentum_pays(a, b)) return Solver::polyak;
   if (requested == Solver::automatic && level == QueryLevel::boolean && plain_boolean_pays(a, b)) return Solver::gjk;
