@@ -122,24 +122,31 @@ __attribute__((noinline)) void hull_differences_avx2(const double* v, const doub
 // |r .* d| = 0) four directions (two antithetic pairs) per AVX2 register, and q_k = S(d_2k) - S(d_2k+1) (each lane
 // minus its neighbour) transposed to three coordinates a pair by register shuffles and masked stores: the same bits
 // as the SSE2 form, half its instructions per sample.
+// kernels::support()'s ellipsoid formula (r .* r .* d / |r .* d|, zero where |r .* d| = 0) for four directions
+// (two antithetic pairs) in one register, then each lane minus its neighbour: lanes 0 and 2 of q[c] hold coordinate
+// c of S(d_2k) - S(d_2k+1). One operation order for both callers, so both give the SSE2 form's bits.
+inline __attribute__((always_inline)) void ellipsoid_differences4(const __m256d r[3], const __m256d d[3],
+                                                                  __m256d q[3]) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d a[3] = {_mm256_mul_pd(r[0], d[0]), _mm256_mul_pd(r[1], d[1]), _mm256_mul_pd(r[2], d[2])};
+  const __m256d m = _mm256_sqrt_pd(
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(a[0], a[0]), _mm256_mul_pd(a[1], a[1])), _mm256_mul_pd(a[2], a[2])));
+  const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
+  for (int c = 0; c < 3; ++c) {
+    const __m256d p = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r[c], a[c]), m), zero, at_zero);
+    q[c] = _mm256_sub_pd(p, _mm256_permute_pd(p, 0x5));
+  }
+}
 __attribute__((noinline)) void ellipsoid_differences_avx2(const double* radii, const double* const* d,
                                                           std::size_t pairs, double* q) {
-  const __m256d rx = _mm256_set1_pd(radii[0]), ry = _mm256_set1_pd(radii[1]), rz = _mm256_set1_pd(radii[2]);
+  const __m256d r[3] = {_mm256_set1_pd(radii[0]), _mm256_set1_pd(radii[1]), _mm256_set1_pd(radii[2])};
   const __m256d zero = _mm256_setzero_pd();
   const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
   for (std::size_t j = 0; j < 2 * pairs; j += 4) {  // the directions are padded with zeros to a multiple of 4
-    const __m256d ax = _mm256_mul_pd(rx, _mm256_loadu_pd(d[0] + j));
-    const __m256d ay = _mm256_mul_pd(ry, _mm256_loadu_pd(d[1] + j));
-    const __m256d az = _mm256_mul_pd(rz, _mm256_loadu_pd(d[2] + j));
-    const __m256d m = _mm256_sqrt_pd(
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, ax), _mm256_mul_pd(ay, ay)), _mm256_mul_pd(az, az)));
-    const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
-    const auto difference = [&](__m256d r, __m256d a) {  // lanes 0 and 2: S(d_2k) - S(d_2k+1)
-      const __m256d p = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r, a), m), zero, at_zero);
-      return _mm256_sub_pd(p, _mm256_permute_pd(p, 0x5));
-    };
-    const __m256d X = difference(rx, ax), Y = difference(ry, ay), Z = difference(rz, az);
-    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t2 = _mm256_unpacklo_pd(Z, zero);  // x0 y0 x2 y2, z0 0 z2 0
+    const __m256d dj[3] = {_mm256_loadu_pd(d[0] + j), _mm256_loadu_pd(d[1] + j), _mm256_loadu_pd(d[2] + j)};
+    __m256d x[3];
+    ellipsoid_differences4(r, dj, x);
+    const __m256d t0 = _mm256_unpacklo_pd(x[0], x[1]), t2 = _mm256_unpacklo_pd(x[2], zero);  // x0 y0 x2 y2, z0 0 z2 0
     _mm256_maskstore_pd(q + 3 * (j / 2), three, _mm256_permute2f128_pd(t0, t2, 0x20));
     if (j / 2 + 1 < pairs) _mm256_maskstore_pd(q + 3 * (j / 2 + 1), three, _mm256_permute2f128_pd(t0, t2, 0x31));
   }
@@ -212,17 +219,11 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const doubl
       s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(b0[r], z0)), _mm256_mul_pd(b1[r], z1));
   } else {
     const __m256d r3[3] = {_mm256_set1_pd(view.size[0]), _mm256_set1_pd(view.size[1]), _mm256_set1_pd(view.size[2])};
-    const __m256d ax = _mm256_mul_pd(r3[0], d[0]), ay = _mm256_mul_pd(r3[1], d[1]), az = _mm256_mul_pd(r3[2], d[2]);
-    const __m256d m = _mm256_sqrt_pd(
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ax, ax), _mm256_mul_pd(ay, ay)), _mm256_mul_pd(az, az)));
-    const __m256d at_zero = _mm256_cmp_pd(m, zero, _CMP_EQ_OQ);
-    const __m256d a[3] = {ax, ay, az};
-    for (int r = 0; r < 3; ++r) {  // lanes 0 and 2: q_0r, q_1r
-      const __m256d p = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(r3[r], a[r]), m), zero, at_zero);
-      const __m256d q = _mm256_sub_pd(p, _mm256_permute_pd(p, 0x5));
-      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q, 0x00), z0)),
-                           _mm256_mul_pd(_mm256_permute4x64_pd(q, 0xAA), z1));
-    }
+    __m256d q[3];
+    ellipsoid_differences4(r3, d, q);
+    for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
+      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0x00), z0)),
+                           _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0xAA), z1));
   }
   sums_to_estimate_avx2(s, 4.0 * e, S);
 }
