@@ -99,4 +99,24 @@ template <int N> void gaussian_vector(std::uint64_t seed, std::uint64_t pair, st
   for (int k = 0; k < N; k += 2) rng.gaussian_pair(z[k], z[k + 1]);
 }
 
+/// smoothed1's support noise (engine/src/derivatives.cpp; kernels::simd::draw_support_noise() draws it W pairs per
+/// register with these bits): normals 2j and 2j + 1 of a pair with key splitmix64(splitmix64(seed) ^ pair) are
+/// one Box-Muller transform of the j-th output x of the SplitMix64 sequence started at the key, its high 32 bits
+/// the radius' uniform (hi + 1) 2^-32 in (0, 1] and its low 32 bits the angle's lo 2^-32 in [0, 1). One 64-bit
+/// mix per two normals where gaussian_vector<4> paid two mixes of key set-up per lane and one per uniform (with
+/// AVX2's emulated 64-bit products, those mixes were most of the draw), and only the 3 normals a side uses per
+/// draw instead of 4: issue 18's M = 4 budget. 32-bit uniforms cut the radius at sqrt(64 ln 2) = 6.66 (a
+/// normal's two-sided tail beyond it has probability 3e-11) and quantise the angle to 2^-32 of a turn: far below
+/// the estimator's sampling error at any M the API takes.
+inline void support_noise_pair(std::uint64_t key, std::uint64_t j, double& g0, double& g1) {
+  const std::uint64_t x = splitmix64(key + j * 0x9E3779B97F4A7C15ull);
+  const double u_radius = (static_cast<double>(x >> 32) + 1.0) * 0x1.0p-32;
+  const double u_angle = static_cast<double>(x & 0xFFFFFFFFull) * 0x1.0p-32;
+  const double radius = std::sqrt(-2.0 * log_unit(u_radius));
+  double s, c;
+  sincos_turn(u_angle, s, c);
+  g0 = radius * c;
+  g1 = radius * s;
+}
+
 }  // namespace batchcol::detail

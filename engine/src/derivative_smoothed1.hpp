@@ -42,9 +42,9 @@ struct Smoothed1Lanes {
 /// (the baseline S(u) cancels within a pair: each pair adds (S(u + e z) - S(u - e z)) z^T, and only an odd M's last
 /// sample takes S(u)), symmetrised. The Hessian of the smoothed convex support function is
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
-/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
-/// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
-/// caller draws it: kernels::simd::draw_gaussians4_pairs() for both sides of 8 pairs at a time). `view`: the
+/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 3, k < (M + 1) / 2; z[3] is not
+/// read): the noise of antithetic pair k (the caller draws it: kernels::simd::draw_support_noise() for both sides
+/// of 8 pairs at a time, counter_rng.hpp's support_noise_pair()). `view`: the
 /// shape's plain record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four
 /// directions per AVX2 register and take the ellipsoid sample differences, the hull differences and the sample sums
 /// in AVX2 registers (at M = 4, scanned hulls and ellipsoids without inflation: all in registers),

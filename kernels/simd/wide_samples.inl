@@ -132,34 +132,30 @@ struct WideSamples {
     }
   }
 
-  /// gaussians4() of both streams sa and sb (a pair's two sides) for `pairs` pairs in one pass: pair p's draws (key
-  /// keys[p], k = 0 .. draws) into z + 8 draws p (stream sa's coordinate c at c draws, sb's at (4 + c) draws). Lane e of the 2 draws pairs is
-  /// (pair, side, k) in that order with its own (key, k, stream), so the bits are those of a call per pair; the
-  /// registers are full where a call per pair filled one register each (AVX-512 at M = 4) and paid its lane set-up
-  /// and stores per pair (smoothed1 draws a store block's pairs at once: derivatives.cpp).
-  static void gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t sa, std::uint64_t sb,
-                               std::size_t draws, double* z) {
-    const std::size_t per_pair = 2 * draws, total = pairs * per_pair;
-    std::size_t p = 0, r = 0;  // lane e0's pair and its draw within the pair (no division per lane)
-    for (std::size_t e0 = 0; e0 < total; e0 += W) {
-      const std::size_t lanes = std::min<std::size_t>(W, total - e0);
-      u64 key{}, index{}, stream{};
-      std::size_t at[W];
-      for (int l = 0; l < W; ++l) {  // padding lanes (l >= lanes) draw the last lane's sample again, unstored
-        if (std::size_t(l) < lanes) {
-          const bool second = r >= draws;
-          const std::size_t k = second ? r - draws : r;
-          key[l] = keys[p], index[l] = k, stream[l] = second ? sb : sa;
-          at[l] = 8 * draws * p + (second ? 4 * draws : 0) + k;
-          if (++r == per_pair) r = 0, ++p;
-        } else {
-          key[l] = key[l - 1], index[l] = index[l - 1], stream[l] = stream[l - 1];
+  /// engine/src/counter_rng.hpp's support_noise_pair(keys[p], j) for every j < 3 draws of pairs p < `pairs` into
+  /// z[6 draws p + 2 j], z[6 draws p + 2 j + 1] (smoothed1's noise of a store block's pairs), W pairs per register:
+  /// the lanes are pairs, so their keys are one load and each j one 64-bit mix per lane (no per-lane key set-up).
+  /// The 32-bit halves convert exactly through the 2^52 exponent trick on every set.
+  static void support_noise(const std::uint64_t* keys, std::size_t pairs, std::size_t draws, double* z) {
+    const std::size_t per_pair = 6 * draws, transforms = 3 * draws;
+    const u64 low32 = u64{} + 0xFFFFFFFFull, exponent = u64{} + 0x4330000000000000ull;
+    for (std::size_t p0 = 0; p0 < pairs; p0 += W) {
+      const int lanes = int(std::min<std::size_t>(W, pairs - p0));
+      u64 key{};
+      for (int l = 0; l < W; ++l) key[l] = keys[p0 + std::size_t(std::min(l, lanes - 1))];  // padding: unstored
+      double* const out = z + p0 * per_pair;
+      for (std::size_t j = 0; j < transforms; ++j) {
+        const u64 x = splitmix(key + j * 0x9E3779B97F4A7C15ull);
+        const real hi = (real)((x >> 32) | exponent) - 0x1.0p52, lo = (real)((x & low32) | exponent) - 0x1.0p52;
+        const real radius = wsqrt<double>(-2.0 * log_unit((hi + 1.0) * 0x1.0p-32));
+        real s, c;
+        sincos_turn(lo * 0x1.0p-32, s, c);
+        const real g0 = radius * c, g1 = radius * s;
+        for (int l = 0; l < lanes; ++l) {
+          const double two[2] = {g0[l], g1[l]};
+          std::memcpy(out + std::size_t(l) * per_pair + 2 * j, two, sizeof two);
         }
       }
-      real v[4];
-      gaussians<4>(key, index, stream, v);
-      for (std::size_t l = 0; l < lanes; ++l)
-        for (int c = 0; c < 4; ++c) z[at[l] + c * draws] = v[c][l];
     }
   }
 
