@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace batchcol::detail {
 
@@ -51,6 +52,10 @@ struct Smoothed1Lanes {
 /// with the same bits as the baseline set.
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa = InstructionSet::scalar);
+/// The same for shape `shape` of `shapes` (the bits of the view's call): the M = 4 AVX2 path reads the table's
+/// type, inflation, radii and hull arrays instead of a ShapeView built per side (smoothed1's per-pair calls).
+Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
+                                          double e, int samples, const double* const* z, InstructionSet isa);
 
 
 }  // namespace batchcol::detail

@@ -281,16 +281,15 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     const auto direction_noise = [&](const Shape& s) {
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
-    const auto view = [&](std::uint32_t s) { return ShapeTableAccess::view(shapes, s); };
     // The pair's noise, drawn by differentiate_results_on() for 8 pairs at a time: side a's coordinate c at c draws,
     // b's at (3 + c) draws (the estimate reads coordinates 0 .. 2; z[3] is never read).
     const std::size_t draws = static_cast<std::size_t>(o.samples + 1) / 2;
     const double* const z_a[4] = {noise, noise + draws, noise + 2 * draws, noise + 2 * draws};
     const double* const z_b[4] = {noise + 3 * draws, noise + 4 * draws, noise + 5 * draws, noise + 5 * draws};
     Eigen::Matrix3d S_a =
-        smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
+        smoothed_support_estimate(shapes, batch.shape_a[i], u_a, direction_noise(a), o.samples, z_a, isa);
     Eigen::Matrix3d S_b =
-        smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b, isa);
+        smoothed_support_estimate(shapes, batch.shape_b[i], u_b, direction_noise(b), o.samples, z_b, isa);
     // Separated pairs (every smooth_pair(): smoothed1 has no flats): the projections and rotations for the block's
     // pairs together at the flush, with these bits.
     if (smooth_pair(g)) {

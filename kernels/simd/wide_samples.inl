@@ -73,25 +73,61 @@ struct WideSamples {
   }
   /// counter_rng.hpp's sincos_turn: the quarter turn q = int(4u + 0.5) removed exactly, then the series.
   static void sincos_turn(real u, real& sin, real& cos) {
-    // q = int(4u + 0.5) (u in (0, 1]: 0 .. 4), as the scalar code's truncation. Without AVX-512DQ: rounded through
-    // the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's low mantissa bits.
-#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
-    const mask q = __builtin_convertvector(4.0 * u + 0.5, mask);
-    const real qd = __builtin_convertvector(q, real);
-#else
-    const real v = 4.0 * u + 0.5;
-    real qd = (v + 0x1.8p52) - 0x1.8p52;
-    qd = select(qd > v, qd - 1.0, qd);
-    const mask q = (mask)(qd + 0x1.8p52);
-#endif
+    mask q;
+    real qd;
+    quarter_turn(u, q, qd);
     const real x = 6.283185307179586 * (u - 0.25 * qd);
     real sx, cx;
     sinc_cos_small(x, sx, cx);
     sx *= x;
+    rotate_quarters(q, sx, cx, sin, cos);
+  }
+  /// q = int(4u + 0.5) (u in [0, 1]: 0 .. 4), as the scalar code's truncation, and q as a double. Without
+  /// AVX-512DQ: rounded through the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's
+  /// low mantissa bits.
+  static void quarter_turn(real u, mask& q, real& qd) {
+#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
+    q = __builtin_convertvector(4.0 * u + 0.5, mask);
+    qd = __builtin_convertvector(q, real);
+#else
+    const real v = 4.0 * u + 0.5;
+    qd = (v + 0x1.8p52) - 0x1.8p52;
+    qd = select(qd > v, qd - 1.0, qd);
+    q = (mask)(qd + 0x1.8p52);
+#endif
+  }
+  /// sin and cos of x + q pi/2 from sx = sin x, cx = cos x.
+  static void rotate_quarters(mask q, real sx, real cx, real& sin, real& cos) {
     const mask quarter = q & 3;
     const mask q1 = quarter == 1, q2 = quarter == 2, q3 = quarter == 3;
     sin = select(q1, cx, select(q2, -sx, select(q3, -cx, sx)));
     cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
+  }
+
+  /// counter_rng.hpp's log_unit_short and sincos_turn_short (support_noise()'s), lane by lane.
+  static real log_unit_short(real u) {
+    const u64 bits = (u64)u;
+    mask k = mask((bits >> 52)) - 1023;
+    const u64 mbits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+    real m = (real)mbits;
+    const mask big = m > 1.4142135623730951;
+    m = select(big, m * 0.5, m);
+    k = select(big, k + 1, k);
+    const real s = (m - 1.0) / (m + 1.0), z = s * s;
+    const real p = (((((1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z + 1.0 / 3.0) * z + 1.0;
+    return exact_small(k) * 0.6931471805599453 + 2.0 * s * p;
+  }
+  static void sincos_turn_short(real u, real& sin, real& cos) {
+    mask q;
+    real qd;
+    quarter_turn(u, q, qd);
+    const real x = 6.283185307179586 * (u - 0.25 * qd), z = x * x;
+    const real sx =
+        x * (((((-1.0 / 39916800.0 * z + 1.0 / 362880.0) * z - 1.0 / 5040.0) * z + 1.0 / 120.0) * z - 1.0 / 6.0) * z +
+             1.0);
+    const real cx = ((((((1.0 / 479001600.0) * z - 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z +
+                      1.0 / 24.0) * z - 0.5) * z + 1.0;
+    rotate_quarters(q, sx, cx, sin, cos);
   }
 
   /// gaussian_vector<N>(seed, pair, k, stream) for k = k0 .. k0 + W - 1, lane by lane (key: splitmix(splitmix(seed)
@@ -147,9 +183,9 @@ struct WideSamples {
       for (std::size_t j = 0; j < transforms; ++j) {
         const u64 x = splitmix(key + j * 0x9E3779B97F4A7C15ull);
         const real hi = (real)((x >> 32) | exponent) - 0x1.0p52, lo = (real)((x & low32) | exponent) - 0x1.0p52;
-        const real radius = wsqrt<double>(-2.0 * log_unit((hi + 1.0) * 0x1.0p-32));
+        const real radius = wsqrt<double>(-2.0 * log_unit_short((hi + 1.0) * 0x1.0p-32));
         real s, c;
-        sincos_turn(lo * 0x1.0p-32, s, c);
+        sincos_turn_short(lo * 0x1.0p-32, s, c);
         const real g0 = radius * c, g1 = radius * s;
         for (int l = 0; l < lanes; ++l) {
           const double two[2] = {g0[l], g1[l]};
