@@ -141,7 +141,7 @@ struct WideSamples {
   template <int N> static void gaussians(u64 key, u64 index, std::uint64_t stream, real* z) {
     gaussians<N>(key, index, u64{} + stream, z);
   }
-  /// The same with a stream per lane too (lanes of both sides of several pairs: gaussians4_pairs()).
+  /// The same with a stream per lane too (the form the two above forward to).
   template <int N> static void gaussians(u64 key, u64 index, u64 stream, real* z) {
     u64 state = splitmix(splitmix(key ^ index) ^ stream);
     for (int g = 0; g < N; g += 2) {
