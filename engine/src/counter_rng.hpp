@@ -99,4 +99,58 @@ template <int N> void gaussian_vector(std::uint64_t seed, std::uint64_t pair, st
   for (int k = 0; k < N; k += 2) rng.gaussian_pair(z[k], z[k + 1]);
 }
 
+/// log_unit() and sincos_turn() with shorter series for support_noise_pair(): log to s^11 (relative error below
+/// z^6 / 13 = 5e-11 at |s| <= 0.172), sin to x^11 and cos to x^12 (below 1e-11 at |x| <= pi/4). Noise needs the
+/// normal distribution, not the last bits of its deviates: 5e-11 is far below any sampling error.
+inline double log_unit_short(double u) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &u, sizeof bits);
+  int k = static_cast<int>(bits >> 52) - 1023;
+  bits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+  double m;
+  std::memcpy(&m, &bits, sizeof m);
+  if (m > 1.4142135623730951) {
+    m *= 0.5;
+    ++k;
+  }
+  const double s = (m - 1.0) / (m + 1.0), z = s * s;
+  const double p = (((((1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z + 1.0 / 3.0) * z + 1.0;
+  return k * 0.6931471805599453 + 2.0 * s * p;
+}
+inline void sincos_turn_short(double u, double& sin, double& cos) {
+  const int q = static_cast<int>(4.0 * u + 0.5);
+  const double x = 6.283185307179586 * (u - 0.25 * q), z = x * x;
+  const double sx =
+      x * (((((-1.0 / 39916800.0 * z + 1.0 / 362880.0) * z - 1.0 / 5040.0) * z + 1.0 / 120.0) * z - 1.0 / 6.0) * z +
+           1.0);
+  const double cx = ((((((1.0 / 479001600.0) * z - 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z +
+                      1.0 / 24.0) * z - 0.5) * z + 1.0;
+  switch (q & 3) {
+    case 0: sin = sx, cos = cx; break;
+    case 1: sin = cx, cos = -sx; break;
+    case 2: sin = -sx, cos = -cx; break;
+    default: sin = -cx, cos = sx; break;
+  }
+}
+
+/// smoothed1's support noise (engine/src/derivatives.cpp; kernels::simd::draw_support_noise() draws it W pairs per
+/// register with these bits): normals 2j and 2j + 1 of a pair with key splitmix64(splitmix64(seed) ^ pair) are
+/// one Box-Muller transform of the j-th output x of the SplitMix64 sequence started at the key, its high 32 bits
+/// the radius' uniform (hi + 1) 2^-32 in (0, 1] and its low 32 bits the angle's lo 2^-32 in [0, 1). One 64-bit
+/// mix per two normals where gaussian_vector<4> paid two mixes of key set-up per lane and one per uniform (with
+/// AVX2's emulated 64-bit products, those mixes were most of the draw), and only the 3 normals a side uses per
+/// draw instead of 4: issue 18's M = 4 budget. 32-bit uniforms cut the radius at sqrt(64 ln 2) = 6.66 (a
+/// normal's two-sided tail beyond it has probability 3e-11) and quantise the angle to 2^-32 of a turn: far below
+/// the estimator's sampling error at any M the API takes.
+inline void support_noise_pair(std::uint64_t key, std::uint64_t j, double& g0, double& g1) {
+  const std::uint64_t x = splitmix64(key + j * 0x9E3779B97F4A7C15ull);
+  const double u_radius = (static_cast<double>(x >> 32) + 1.0) * 0x1.0p-32;
+  const double u_angle = static_cast<double>(x & 0xFFFFFFFFull) * 0x1.0p-32;
+  const double radius = std::sqrt(-2.0 * log_unit_short(u_radius));
+  double s, c;
+  sincos_turn_short(u_angle, s, c);
+  g0 = radius * c;
+  g1 = radius * s;
+}
+
 }  // namespace batchcol::detail

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace batchcol::detail {
 
@@ -42,15 +43,19 @@ struct Smoothed1Lanes {
 /// (the baseline S(u) cancels within a pair: each pair adds (S(u + e z) - S(u - e z)) z^T, and only an odd M's last
 /// sample takes S(u)), symmetrised. The Hessian of the smoothed convex support function is
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
-/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 4, k < (M + 1) / 2): the noise
-/// of antithetic pair k, gaussian_vector<4>(seed, pair, k, stream) (z_{2k} is its first three coordinates; the
-/// caller draws it: kernels::simd::draw_gaussians4_pairs() for both sides of 8 pairs at a time). `view`: the
+/// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 3, k < (M + 1) / 2; z[3] is not
+/// read): the noise of antithetic pair k (the caller draws it: kernels::simd::draw_support_noise() for both sides
+/// of 8 pairs at a time, counter_rng.hpp's support_noise_pair()). `view`: the
 /// shape's plain record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four
 /// directions per AVX2 register and take the ellipsoid sample differences, the hull differences and the sample sums
 /// in AVX2 registers (at M = 4, scanned hulls and ellipsoids without inflation: all in registers),
 /// with the same bits as the baseline set.
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa = InstructionSet::scalar);
+/// The same for shape `shape` of `shapes` (the bits of the view's call): the M = 4 AVX2 path reads the table's
+/// type, inflation, radii and hull arrays instead of a ShapeView built per side (smoothed1's per-pair calls).
+Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
+                                          double e, int samples, const double* const* z, InstructionSet isa);
 
 
 }  // namespace batchcol::detail

@@ -5,6 +5,7 @@
 #include "derivative_smoothed1.hpp"
 
 #include "derivative_support.hpp"
+#include "shape_table_access.hpp"
 #include "kernels/shape_core.hpp"
 #include "kernels/support.hpp"
 
@@ -188,8 +189,10 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
 // u + e z_1, u - e z_1, as the direction loop), the scan or the ellipsoid formula on them, the pairs' differences,
 // the two draws' sums and the estimate, each with the general path's operations in its order (the same bits). The
 // general path's buffers, loops and calls were ~580 instructions a side with its scan (callgrind AVX2, convex8).
-__attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const double* u, double e,
-                                              const double* const* z, double* S) {
+// The shape by its type, radii (ellipsoid) and hull (convex) rather than a ShapeView: the table's caller passes
+// them from ShapeTableAccess's arrays without building a view (~45 instructions a side, callgrind AVX2).
+__attribute__((noinline)) void estimate4_avx2(ShapeType type, const double* radii, const HullView* hull,
+                                              const double* u, double e, const double* const* z, double* S) {
   const __m256d ev = _mm256_set1_pd(e);
   __m256d d[3];
   for (int c = 0; c < 3; ++c) {
@@ -204,10 +207,10 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const doubl
   };
   const __m256d z0 = noise(0), z1 = noise(1);
   __m256d s[3];
-  if (view.type == ShapeType::convex) {
-    const double* v = view.hull->vertices;
+  if (type == ShapeType::convex) {
+    const double* v = hull->vertices;
     double at[4];
-    _mm256_storeu_pd(at, scan4_avx2(v, view.hull->vertex_count, d[0], d[1], d[2]));
+    _mm256_storeu_pd(at, scan4_avx2(v, hull->vertex_count, d[0], d[1], d[2]));
     const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
     const auto point = [&](int j) { return _mm256_maskload_pd(v + 3 * static_cast<std::size_t>(at[j]), three); };
     const __m256d q0 = _mm256_sub_pd(point(0), point(1)), q1 = _mm256_sub_pd(point(2), point(3));  // x y z 0
@@ -218,7 +221,7 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const doubl
     for (int r = 0; r < 3; ++r)
       s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(b0[r], z0)), _mm256_mul_pd(b1[r], z1));
   } else {
-    const __m256d r3[3] = {_mm256_set1_pd(view.size[0]), _mm256_set1_pd(view.size[1]), _mm256_set1_pd(view.size[2])};
+    const __m256d r3[3] = {_mm256_set1_pd(radii[0]), _mm256_set1_pd(radii[1]), _mm256_set1_pd(radii[2])};
     __m256d q[3];
     ellipsoid_differences4(r3, d, q);
     for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
@@ -230,9 +233,14 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeView& view, const doubl
 
 #pragma GCC pop_options
 
+bool scanned_hull(const HullView& hull) { return !kernels::hull_climbs(hull) && hull.vertex_count > 0; }
 bool scanned_hull(const ShapeView& view) {
-  return view.type == ShapeType::convex && view.hull && !kernels::hull_climbs(*view.hull) &&
-         view.hull->vertex_count > 0;
+  return view.type == ShapeType::convex && view.hull && scanned_hull(*view.hull);
+}
+// estimate4_avx2()'s cases: M = 4, no inflation, an ellipsoid or a scanned hull.
+bool estimate4_case(bool wide, int samples, ShapeType type, double inflation, const HullView* hull) {
+  return wide && samples == 4 && inflation == 0.0 &&
+         (type == ShapeType::ellipsoid || (type == ShapeType::convex && hull && scanned_hull(*hull)));
 }
 
 // smoothed_support_estimate() on every path but estimate4_avx2()'s. Out of line: its frame and register saves
@@ -373,12 +381,28 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
 Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
                                           const double* const* z, InstructionSet isa) {
   const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
-  if (wide && samples == 4 && view.inflation == 0.0 && (view.type == ShapeType::ellipsoid || scanned_hull(view))) {
-    Eigen::Matrix3d S;
-    estimate4_avx2(view, u.data(), e, z, S.data());
-    return S;
+  Eigen::Matrix3d S;
+  if (estimate4_case(wide, samples, view.type, view.inflation, view.hull))
+    estimate4_avx2(view.type, view.size, view.hull, u.data(), e, z, S.data());
+  else
+    S = general_estimate(view, u, e, samples, z, wide);
+  return S;
+}
+
+Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
+                                          double e, int samples, const double* const* z, InstructionSet isa) {
+  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;
+  const ShapeType type = ShapeTableAccess::types(shapes)[shape];
+  const HullView* hull = &ShapeTableAccess::hulls(shapes)[shape];
+  Eigen::Matrix3d S;
+  if (estimate4_case(wide, samples, type, ShapeTableAccess::inflations(shapes)[shape], hull)) {
+    const double radii[3] = {ShapeTableAccess::sizes(shapes, 0)[shape], ShapeTableAccess::sizes(shapes, 1)[shape],
+                             ShapeTableAccess::sizes(shapes, 2)[shape]};
+    estimate4_avx2(type, radii, hull, u.data(), e, z, S.data());
+  } else {
+    S = general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide);
   }
-  return general_estimate(view, u, e, samples, z, wide);
+  return S;
 }
 
 }  // namespace batchcol::detail

@@ -281,16 +281,15 @@ void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const 
     const auto direction_noise = [&](const Shape& s) {
       return o.noise_scale == NoiseScale::relative ? o.noise : o.noise / s.bounding_radius();
     };
-    const auto view = [&](std::uint32_t s) { return ShapeTableAccess::view(shapes, s); };
     // The pair's noise, drawn by differentiate_results_on() for 8 pairs at a time: side a's coordinate c at c draws,
-    // b's at (4 + c) draws.
+    // b's at (3 + c) draws (the estimate reads coordinates 0 .. 2; z[3] is never read).
     const std::size_t draws = static_cast<std::size_t>(o.samples + 1) / 2;
-    const double* const z_a[4] = {noise, noise + draws, noise + 2 * draws, noise + 3 * draws};
-    const double* const z_b[4] = {noise + 4 * draws, noise + 5 * draws, noise + 6 * draws, noise + 7 * draws};
+    const double* const z_a[4] = {noise, noise + draws, noise + 2 * draws, noise + 2 * draws};
+    const double* const z_b[4] = {noise + 3 * draws, noise + 4 * draws, noise + 5 * draws, noise + 5 * draws};
     Eigen::Matrix3d S_a =
-        smoothed_support_estimate(view(batch.shape_a[i]), u_a, direction_noise(a), o.samples, z_a, isa);
+        smoothed_support_estimate(shapes, batch.shape_a[i], u_a, direction_noise(a), o.samples, z_a, isa);
     Eigen::Matrix3d S_b =
-        smoothed_support_estimate(view(batch.shape_b[i]), u_b, direction_noise(b), o.samples, z_b, isa);
+        smoothed_support_estimate(shapes, batch.shape_b[i], u_b, direction_noise(b), o.samples, z_b, isa);
     // Separated pairs (every smooth_pair(): smoothed1 has no flats): the projections and rotations for the block's
     // pairs together at the flush, with these bits.
     if (smooth_pair(g)) {
@@ -397,12 +396,12 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
         differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry, nullptr);
       return;
     }
-    // smoothed1: gaussian_vector<4>(seed, i, k, stream) for every antithetic pair k of side a (stream 1) and b
-    // (stream 2) of kChunk pairs at a time, drawn by the SIMD kernels (the same bits as a draw per pair; one scalar
-    // draw cost ~375 instructions, more than the support call it feeds). Per pair, the draws filled one AVX2
-    // register at M = 4 and paid its lane set-up and stores (622 instructions a pair, callgrind AVX2).
+    // smoothed1: the 3 normals of every antithetic pair k of both sides (counter_rng.hpp's support_noise_pair(),
+    // 6 per k) of kChunk pairs at a time, drawn by the SIMD kernels with a pair per lane (the same bits on every
+    // set). The former draw, gaussian_vector<4>(seed, i, k, stream) per side and k with its own key set-up, cost
+    // 570 instructions a pair at M = 4 (callgrind AVX2, convex8).
     constexpr std::size_t kChunk = 8;
-    const std::size_t per_pair = 8 * (static_cast<std::size_t>(options.samples + 1) / 2);
+    const std::size_t per_pair = 6 * (static_cast<std::size_t>(options.samples + 1) / 2);
     thread_local std::vector<double> noise;
     if (noise.size() < kChunk * per_pair) noise.resize(kChunk * per_pair);
     const std::uint64_t seed_key = detail::splitmix64(options.seed);
@@ -410,7 +409,7 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
       const std::size_t count = std::min(kChunk, end - first);
       std::uint64_t keys[kChunk];
       for (std::size_t j = 0; j < count; ++j) keys[j] = detail::splitmix64(seed_key ^ (first + j));
-      kernels::simd::draw_gaussians4_pairs(isa, keys, count, 1, 2, per_pair / 8, noise.data());
+      kernels::simd::draw_support_noise(isa, keys, count, per_pair / 6, noise.data());
       for (std::size_t j = 0; j < count; ++j)
         differentiate_pair(shapes, batch, results, options, isa, first + j, out, hull_geometry,
                            noise.data() + j * per_pair);

@@ -33,8 +33,7 @@ namespace batchcol::kernels::simd {
   void build_samples(const SamplePlan* const*, std::size_t, std::size_t, std::uint64_t, std::size_t, std::size_t, \
                      const SampleArrays&, const SampleArrays&);                                                    \
   void draw_gaussians4(std::uint64_t, std::uint64_t, std::uint64_t, std::size_t, double* const*);                  \
-  void draw_gaussians4_pairs(const std::uint64_t*, std::size_t, std::uint64_t, std::uint64_t, std::size_t,         \
-                             double*);                                                                             \
+  void draw_support_noise(const std::uint64_t*, std::size_t, std::size_t, double*);                               \
   void accumulate_samples(const double*, const Status*, const double* const*, std::size_t, std::size_t,            \
                           SampleSums&);                                                                            \
   void start_cells_double(const double*, std::size_t, std::uint32_t*);                                             \
@@ -89,13 +88,13 @@ struct IsaKernels {
   decltype(&scalar::accumulate_samples) accumulate_samples;
   decltype(&scalar::start_cells_double) start_cells_double;
   decltype(&scalar::start_cells_float) start_cells_float;
-  decltype(&scalar::draw_gaussians4_pairs) draw_gaussians4_pairs;
+  decltype(&scalar::draw_support_noise) draw_support_noise;
 };
 #define BATCHCOL_ISA_TABLE(ns)                                                                               \
   IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
                &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float, &ns::gjk_samples_double,   \
                &ns::gjk_samples_float, &ns::build_samples, &ns::draw_gaussians4, &ns::accumulate_samples,      \
-               &ns::start_cells_double, &ns::start_cells_float, &ns::draw_gaussians4_pairs }
+               &ns::start_cells_double, &ns::start_cells_float, &ns::draw_support_noise }
 // Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
 // same bits), scalar, avx2, avx512.
 constexpr IsaKernels kIsaKernels[] = {BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(scalar), BATCHCOL_ISA_TABLE(avx2),
@@ -190,9 +189,9 @@ void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream
   kernels_of(isa).draw_gaussians4(key, stream, k0, count, z);
 }
 
-void draw_gaussians4_pairs(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
-                           std::uint64_t stream_b, std::size_t draws, double* z) {
-  kernels_of(isa).draw_gaussians4_pairs(keys, pairs, stream_a, stream_b, draws, z);
+void draw_support_noise(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::size_t draws,
+                        double* z) {
+  kernels_of(isa).draw_support_noise(keys, pairs, draws, z);
 }
 
 namespace {

@@ -91,9 +91,8 @@ void accumulate_samples(const double* values, const Status* status, const double
 void draw_gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count, double* const* z) {
   WideSamples::gaussians4(key, stream, k0, count, z);
 }
-void draw_gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
-                           std::uint64_t stream_b, std::size_t draws, double* z) {
-  WideSamples::gaussians4_pairs(keys, pairs, stream_a, stream_b, draws, z);
+void draw_support_noise(const std::uint64_t* keys, std::size_t pairs, std::size_t draws, double* z) {
+  WideSamples::support_noise(keys, pairs, draws, z);
 }
 #endif
 

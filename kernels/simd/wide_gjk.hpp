@@ -149,11 +149,10 @@ void accumulate_samples(InstructionSet isa, const double* values, const Status* 
 /// z[0..3][k - k0], W draws per register (key = splitmix64(splitmix64(seed) ^ pair)). The same bits on every set.
 void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream, std::uint64_t k0,
                      std::size_t count, double* const* z);
-/// draw_gaussians4(isa, keys[p], stream_a, 0, draws, ...) and the same of stream_b (a pair's two sides) for pairs
-/// p < `pairs` in one call, pair p's draws at z + 8 draws p (stream_a's coordinate c at c draws, stream_b's at
-/// (4 + c) draws): the bits of those calls, the lanes of both sides and of consecutive pairs sharing registers
-/// (smoothed1 draws a store block's pairs at once).
-void draw_gaussians4_pairs(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::uint64_t stream_a,
-                           std::uint64_t stream_b, std::size_t draws, double* z);
+/// engine/src/counter_rng.hpp's support_noise_pair(keys[p], j) for j < 3 draws into z[6 draws p + 2 j] and the
+/// next entry, pairs p < `pairs` (smoothed1's noise of a block of pairs, W pairs per register). The same bits on
+/// every set.
+void draw_support_noise(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::size_t draws,
+                        double* z);
 
 }  // namespace batchcol::kernels::simd

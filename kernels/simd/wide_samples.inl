@@ -73,25 +73,61 @@ struct WideSamples {
   }
   /// counter_rng.hpp's sincos_turn: the quarter turn q = int(4u + 0.5) removed exactly, then the series.
   static void sincos_turn(real u, real& sin, real& cos) {
-    // q = int(4u + 0.5) (u in (0, 1]: 0 .. 4), as the scalar code's truncation. Without AVX-512DQ: rounded through
-    // the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's low mantissa bits.
-#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
-    const mask q = __builtin_convertvector(4.0 * u + 0.5, mask);
-    const real qd = __builtin_convertvector(q, real);
-#else
-    const real v = 4.0 * u + 0.5;
-    real qd = (v + 0x1.8p52) - 0x1.8p52;
-    qd = select(qd > v, qd - 1.0, qd);
-    const mask q = (mask)(qd + 0x1.8p52);
-#endif
+    mask q;
+    real qd;
+    quarter_turn(u, q, qd);
     const real x = 6.283185307179586 * (u - 0.25 * qd);
     real sx, cx;
     sinc_cos_small(x, sx, cx);
     sx *= x;
+    rotate_quarters(q, sx, cx, sin, cos);
+  }
+  /// q = int(4u + 0.5) (u in [0, 1]: 0 .. 4), as the scalar code's truncation, and q as a double. Without
+  /// AVX-512DQ: rounded through the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's
+  /// low mantissa bits.
+  static void quarter_turn(real u, mask& q, real& qd) {
+#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
+    q = __builtin_convertvector(4.0 * u + 0.5, mask);
+    qd = __builtin_convertvector(q, real);
+#else
+    const real v = 4.0 * u + 0.5;
+    qd = (v + 0x1.8p52) - 0x1.8p52;
+    qd = select(qd > v, qd - 1.0, qd);
+    q = (mask)(qd + 0x1.8p52);
+#endif
+  }
+  /// sin and cos of x + q pi/2 from sx = sin x, cx = cos x.
+  static void rotate_quarters(mask q, real sx, real cx, real& sin, real& cos) {
     const mask quarter = q & 3;
     const mask q1 = quarter == 1, q2 = quarter == 2, q3 = quarter == 3;
     sin = select(q1, cx, select(q2, -sx, select(q3, -cx, sx)));
     cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
+  }
+
+  /// counter_rng.hpp's log_unit_short and sincos_turn_short (support_noise()'s), lane by lane.
+  static real log_unit_short(real u) {
+    const u64 bits = (u64)u;
+    mask k = mask((bits >> 52)) - 1023;
+    const u64 mbits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+    real m = (real)mbits;
+    const mask big = m > 1.4142135623730951;
+    m = select(big, m * 0.5, m);
+    k = select(big, k + 1, k);
+    const real s = (m - 1.0) / (m + 1.0), z = s * s;
+    const real p = (((((1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z + 1.0 / 3.0) * z + 1.0;
+    return exact_small(k) * 0.6931471805599453 + 2.0 * s * p;
+  }
+  static void sincos_turn_short(real u, real& sin, real& cos) {
+    mask q;
+    real qd;
+    quarter_turn(u, q, qd);
+    const real x = 6.283185307179586 * (u - 0.25 * qd), z = x * x;
+    const real sx =
+        x * (((((-1.0 / 39916800.0 * z + 1.0 / 362880.0) * z - 1.0 / 5040.0) * z + 1.0 / 120.0) * z - 1.0 / 6.0) * z +
+             1.0);
+    const real cx = ((((((1.0 / 479001600.0) * z - 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z +
+                      1.0 / 24.0) * z - 0.5) * z + 1.0;
+    rotate_quarters(q, sx, cx, sin, cos);
   }
 
   /// gaussian_vector<N>(seed, pair, k, stream) for k = k0 .. k0 + W - 1, lane by lane (key: splitmix(splitmix(seed)
@@ -105,7 +141,7 @@ struct WideSamples {
   template <int N> static void gaussians(u64 key, u64 index, std::uint64_t stream, real* z) {
     gaussians<N>(key, index, u64{} + stream, z);
   }
-  /// The same with a stream per lane too (lanes of both sides of several pairs: gaussians4_pairs()).
+  /// The same with a stream per lane too (the form the two above forward to).
   template <int N> static void gaussians(u64 key, u64 index, u64 stream, real* z) {
     u64 state = splitmix(splitmix(key ^ index) ^ stream);
     for (int g = 0; g < N; g += 2) {
@@ -132,34 +168,30 @@ struct WideSamples {
     }
   }
 
-  /// gaussians4() of both streams sa and sb (a pair's two sides) for `pairs` pairs in one pass: pair p's draws (key
-  /// keys[p], k = 0 .. draws) into z + 8 draws p (stream sa's coordinate c at c draws, sb's at (4 + c) draws). Lane e of the 2 draws pairs is
-  /// (pair, side, k) in that order with its own (key, k, stream), so the bits are those of a call per pair; the
-  /// registers are full where a call per pair filled one register each (AVX-512 at M = 4) and paid its lane set-up
-  /// and stores per pair (smoothed1 draws a store block's pairs at once: derivatives.cpp).
-  static void gaussians4_pairs(const std::uint64_t* keys, std::size_t pairs, std::uint64_t sa, std::uint64_t sb,
-                               std::size_t draws, double* z) {
-    const std::size_t per_pair = 2 * draws, total = pairs * per_pair;
-    std::size_t p = 0, r = 0;  // lane e0's pair and its draw within the pair (no division per lane)
-    for (std::size_t e0 = 0; e0 < total; e0 += W) {
-      const std::size_t lanes = std::min<std::size_t>(W, total - e0);
-      u64 key{}, index{}, stream{};
-      std::size_t at[W];
-      for (int l = 0; l < W; ++l) {  // padding lanes (l >= lanes) draw the last lane's sample again, unstored
-        if (std::size_t(l) < lanes) {
-          const bool second = r >= draws;
-          const std::size_t k = second ? r - draws : r;
-          key[l] = keys[p], index[l] = k, stream[l] = second ? sb : sa;
-          at[l] = 8 * draws * p + (second ? 4 * draws : 0) + k;
-          if (++r == per_pair) r = 0, ++p;
-        } else {
-          key[l] = key[l - 1], index[l] = index[l - 1], stream[l] = stream[l - 1];
+  /// engine/src/counter_rng.hpp's support_noise_pair(keys[p], j) for every j < 3 draws of pairs p < `pairs` into
+  /// z[6 draws p + 2 j], z[6 draws p + 2 j + 1] (smoothed1's noise of a store block's pairs), W pairs per register:
+  /// the lanes are pairs, so their keys are one load and each j one 64-bit mix per lane (no per-lane key set-up).
+  /// The 32-bit halves convert exactly through the 2^52 exponent trick on every set.
+  static void support_noise(const std::uint64_t* keys, std::size_t pairs, std::size_t draws, double* z) {
+    const std::size_t per_pair = 6 * draws, transforms = 3 * draws;
+    const u64 low32 = u64{} + 0xFFFFFFFFull, exponent = u64{} + 0x4330000000000000ull;
+    for (std::size_t p0 = 0; p0 < pairs; p0 += W) {
+      const int lanes = int(std::min<std::size_t>(W, pairs - p0));
+      u64 key{};
+      for (int l = 0; l < W; ++l) key[l] = keys[p0 + std::size_t(std::min(l, lanes - 1))];  // padding: unstored
+      double* const out = z + p0 * per_pair;
+      for (std::size_t j = 0; j < transforms; ++j) {
+        const u64 x = splitmix(key + j * 0x9E3779B97F4A7C15ull);
+        const real hi = (real)((x >> 32) | exponent) - 0x1.0p52, lo = (real)((x & low32) | exponent) - 0x1.0p52;
+        const real radius = wsqrt<double>(-2.0 * log_unit_short((hi + 1.0) * 0x1.0p-32));
+        real s, c;
+        sincos_turn_short(lo * 0x1.0p-32, s, c);
+        const real g0 = radius * c, g1 = radius * s;
+        for (int l = 0; l < lanes; ++l) {
+          const double two[2] = {g0[l], g1[l]};
+          std::memcpy(out + std::size_t(l) * per_pair + 2 * j, two, sizeof two);
         }
       }
-      real v[4];
-      gaussians<4>(key, index, stream, v);
-      for (std::size_t l = 0; l < lanes; ++l)
-        for (int c = 0; c < 4; ++c) z[at[l] + c * draws] = v[c][l];
     }
   }
 

@@ -1,6 +1,6 @@
 // smoothed_support_estimate() (smoothed1's support-map Jacobian estimate) is, on every instruction set and every
 // shape path (scanned hull, inflated hull, ellipsoid, the general support call; M = 4's register path and the
-// buffered one), bit for bit the antithetic-difference form
+// buffered one), through a ShapeView and through the shape table, bit for bit the antithetic-difference form
 //   S = sym(1/(M e) sum_k (S(u + e z_k) - S(u - e z_k)) z_k^T)   (+ (S(u + e z) - S(u)) z^T for an odd M's last draw)
 // with the sums taken draw after draw from +0. The form before (each sample against the baseline S(u), both
 // samples of a pair summed separately) rounds differently and fails this test.
@@ -83,11 +83,16 @@ TEST(DerivativesSmoothed1Estimate, IsTheAntitheticDifferenceFormOnEveryPathAndSe
         const Eigen::Matrix3d want = reference_estimate(view, u, e, samples, z);
         for (const InstructionSet isa : sets) {
           const Eigen::Matrix3d got = detail::smoothed_support_estimate(view, u, e, samples, zp, isa);
-          ++compared;
+          // The shape-table form (smoothed1's per-pair call: the table's arrays instead of a view) too.
+          const Eigen::Matrix3d table = detail::smoothed_support_estimate(
+              shapes, static_cast<std::uint32_t>(id), u, e, samples, zp, isa);
+          compared += 2;
           ASSERT_EQ(std::memcmp(got.data(), want.data(), sizeof(double) * 9), 0)
               << name << " M = " << samples << " trial " << trial << " " << to_string(isa) << "\n"
               << got << "\nwant\n"
               << want;
+          ASSERT_EQ(std::memcmp(table.data(), want.data(), sizeof(double) * 9), 0)
+              << name << " (table) M = " << samples << " trial " << trial << " " << to_string(isa);
         }
       }
     }

@@ -165,35 +165,53 @@ TEST(WideSamples, SmoothedFirstOrderDrawsAreTheCounterGenerators) {
   }
 }
 
-TEST(WideSamples, SeveralPairsDrawsAreTheCounterGenerators) {
-  // draw_gaussians4_pairs(): 1 .. 9 pairs of 1 .. 5 draws a side put pair and side boundaries at every lane of
-  // AVX2's 4 and AVX-512's 8 and leave padding lanes; pair p's block gets exactly gaussian_vector<4>(seed, pair_p, k,
-  // stream) of both streams, the sentinel after the last block stays.
+TEST(WideSamples, SupportNoiseIsTheCounterGenerators) {
+  // draw_support_noise(): 1 .. 9 pairs (AVX2's 4 and AVX-512's 8 lanes full, partial and padded) of 1 .. 5 draws;
+  // pair p's block gets exactly support_noise_pair(key_p, j) for j < 3 draws, the sentinel after the last block stays.
   for (std::size_t pairs = 1; pairs <= 9; ++pairs) {
     for (std::size_t draws = 1; draws <= 5; ++draws) {
-      std::vector<std::uint64_t> ids(pairs), keys(pairs);
-      for (std::size_t p = 0; p < pairs; ++p) {
-        ids[p] = 1000 * p + draws;
-        keys[p] = detail::splitmix64(detail::splitmix64(43) ^ ids[p]);
-      }
+      std::vector<std::uint64_t> keys(pairs);
+      for (std::size_t p = 0; p < pairs; ++p) keys[p] = detail::splitmix64(detail::splitmix64(43) ^ (1000 * p + draws));
       for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
         if (!kernels::simd::cpu_has(isa)) continue;
         SCOPED_TRACE(to_string(isa));
-        std::vector<double> z(8 * draws * pairs + 1, -7.0);
-        kernels::simd::draw_gaussians4_pairs(isa, keys.data(), pairs, 1, 2, draws, z.data());
+        std::vector<double> z(6 * draws * pairs + 1, -7.0);
+        kernels::simd::draw_support_noise(isa, keys.data(), pairs, draws, z.data());
         for (std::size_t p = 0; p < pairs; ++p)
-          for (std::size_t k = 0; k < draws; ++k)
-            for (int side = 0; side < 2; ++side) {
-              double r[4];
-              detail::gaussian_vector<4>(43, ids[p], k, 1 + side, r);
-              for (int c = 0; c < 4; ++c)
-                ASSERT_TRUE(same(z[8 * draws * p + (4 * side + c) * draws + k], r[c]))
-                    << pairs << " " << draws << " " << p << " " << k << " " << side << " " << c;
-            }
+          for (std::size_t j = 0; j < 3 * draws; ++j) {
+            double g0, g1;
+            detail::support_noise_pair(keys[p], j, g0, g1);
+            ASSERT_TRUE(same(z[6 * draws * p + 2 * j], g0)) << pairs << " " << draws << " " << p << " " << j;
+            ASSERT_TRUE(same(z[6 * draws * p + 2 * j + 1], g1)) << pairs << " " << draws << " " << p << " " << j;
+          }
         EXPECT_EQ(z.back(), -7.0);
       }
     }
   }
+}
+
+TEST(WideSamples, SupportNoiseIsStandardNormal) {
+  // support_noise_pair()'s 32-bit uniforms: the moments of 2^20 normals (both outputs of 2^19 transforms over
+  // 2^13 keys) against N(0, 1)'s, each within 6 of its standard errors (mean 1/sqrt(n), variance sqrt(2/n),
+  // fourth moment sqrt(96/n)), the two outputs' correlation too, and P(|z| > 3) within 6 standard errors of 0.0027.
+  const int keys = 1 << 13, per_key = 64;
+  double m1 = 0, m2 = 0, m4 = 0, cross = 0, tail = 0;
+  for (int p = 0; p < keys; ++p) {
+    const std::uint64_t key = detail::splitmix64(detail::splitmix64(5) ^ std::uint64_t(p));
+    for (int j = 0; j < per_key; ++j) {
+      double g[2];
+      detail::support_noise_pair(key, std::uint64_t(j), g[0], g[1]);
+      cross += g[0] * g[1];
+      for (double v : g) m1 += v, m2 += v * v, m4 += v * v * v * v, tail += std::abs(v) > 3.0;
+    }
+  }
+  const double n = 2.0 * keys * per_key;
+  EXPECT_NEAR(m1 / n, 0.0, 6.0 / std::sqrt(n));
+  EXPECT_NEAR(m2 / n, 1.0, 6.0 * std::sqrt(2.0 / n));
+  EXPECT_NEAR(m4 / n, 3.0, 6.0 * std::sqrt(96.0 / n));
+  EXPECT_NEAR(cross / (n / 2), 0.0, 6.0 / std::sqrt(n / 2));
+  const double p3 = 0.0026997960632601866;
+  EXPECT_NEAR(tail / n, p3, 6.0 * std::sqrt(p3 * (1 - p3) / n));
 }
 
 TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
