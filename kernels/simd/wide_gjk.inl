@@ -681,6 +681,8 @@ template <class T> struct WideGjk {
     // start() computes them.
     bool rim_given = false;
     V3 rim_a, rim_b;
+    // Sources that give first points (GivesFirst): each refilled lane's first support point D.support(-d_prev).
+    V3 first_w;
   };
 
   /// The reference's first support point, D.support(-initial direction), for the freshly refilled lanes (their
@@ -690,7 +692,9 @@ template <class T> struct WideGjk {
   /// `nesterov`: the run's solver reads last_s (Nesterov's momentum point, the only reader).
   /// A boolean run without `dirs` never reads a[] and b[] (no points, no Newton tracking: loop()'s `track`), and a
   /// run of another solver never reads last_s: they are not written (measured in loop()'s comment).
-  AI static void start(Lanes& L, bool side, bool dirs = false, bool nesterov = true) {
+  /// `given` (boolean runs of a GivesFirst source): the source wrote each fresh lane's first support point into
+  /// L.first_w, so no support is computed here.
+  AI static void start(Lanes& L, bool side, bool dirs = false, bool nesterov = true, bool given = false) {
     if (L.fresh == 0) return;
     std::uint32_t first = L.fresh;  // the lanes that start from the first support point
     // Sphere-hull runs in double, distance and witness lanes: the candidate replaces the first support point
@@ -704,7 +708,8 @@ template <class T> struct WideGjk {
       }
     }
     V3 sw, sa, sb;
-    minkowski(L, neg(L.d_prev), first, sw, sa, sb);
+    if (!side && given) sw = sa = sb = L.first_w;  // sa, sb: read by no boolean run (b[0] of `dirs` unused)
+    else minkowski(L, neg(L.d_prev), first, sw, sa, sb);
     const mask m = lanes_of(first);
     L.w[0] = pick(m, sw, L.w[0]);
     if (side || dirs) {
@@ -1156,14 +1161,19 @@ template <class T> struct WideGjk {
 
   /// Support point of D = A - B in direction dir, all lanes (kernels/minkowski.hpp's MinkowskiDifference::support).
   AI static void minkowski(Lanes& L, const V3& dir, std::uint32_t live, V3& w, V3& a, V3& b) {
-    a = support(L.A, dir, live);
+    minkowski(L.A, L.B, L.R, L.t, dir, live, w, a, b);
+  }
+  /// The same for sides and a pose held elsewhere (the batch-array set-up's first support points, computed W pairs
+  /// per register before their lanes are refilled: wide_gjk_pairs.inl).
+  AI static void minkowski(Side& A, Side& B, const real (&R)[9], const real (&t)[3], const V3& dir, std::uint32_t live,
+                           V3& w, V3& a, V3& b) {
+    a = support(A, dir, live);
     const V3 m = neg(dir);
-    const real* R = L.R;
     const V3 d_in_b = {(R[0] * m.x + R[3] * m.y) + R[6] * m.z, (R[1] * m.x + R[4] * m.y) + R[7] * m.z,
                        (R[2] * m.x + R[5] * m.y) + R[8] * m.z};
-    const V3 sb = support(L.B, d_in_b, live);
-    b = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + L.t[0], ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + L.t[1],
-         ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + L.t[2]};
+    const V3 sb = support(B, d_in_b, live);
+    b = {((R[0] * sb.x + R[1] * sb.y) + R[2] * sb.z) + t[0], ((R[3] * sb.x + R[4] * sb.y) + R[5] * sb.z) + t[1],
+         ((R[6] * sb.x + R[7] * sb.y) + R[8] * sb.z) + t[2]};
     w = sub(a, b);
   }
 
@@ -1359,6 +1369,13 @@ template <class T> struct WideGjk {
   struct LoadsLanes<S, std::void_t<decltype(std::declval<S&>().load_lanes(std::declval<Lanes&>(), 0u))>>
       : std::true_type {};
 
+  /// Sources that write each refilled lane's first support point into L.first_w (`static constexpr bool
+  /// gives_first = true`, boolean runs only: no points of A and B), computed at their set-up W pairs per register
+  /// with minkowski()'s operations on the values the lane gets (the same bits): start() then computes none, where
+  /// it computed one W-wide support per pass for the ~1-2 lanes refilled since the last pass (WideGjkPairs).
+  template <class S, class = void> struct GivesFirst : std::false_type {};
+  template <class S> struct GivesFirst<S, std::void_t<decltype(S::gives_first)>> : std::bool_constant<S::gives_first> {};
+
   template <bool Boolean, bool Dirs = false, class Source>
   static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
@@ -1401,7 +1418,7 @@ template <class T> struct WideGjk {
     };
 
     while (active != 0) {
-      start(L, !Boolean, Dirs, nesterov);
+      start(L, !Boolean, Dirs, nesterov, Boolean && GivesFirst<Source>::value);
       // Budget spent (the reference's loop ends): max_iterations, or overlap when x reached the origin.
       const mask at_budget = L.k >= L.max_iterations;
       if (const std::uint32_t bits = lane_bits(at_budget) & active) {

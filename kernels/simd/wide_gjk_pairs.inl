@@ -40,7 +40,11 @@ template <class T> struct WideGjkPairs {
   };
   struct Chunk : Slots<kChunk> {
     static_assert(kChunk <= 64, "one bit per slot");
+    static_assert(kChunk % std::size_t(W) == 0, "whole registers of T");
     std::uint64_t left = 0;
+    /// Boolean runs of primitives (gives_first()): each slot's first support point w = D.support(-init),
+    /// first_points()'s, W slots per register.
+    T first[3][kChunk];
   };
 
   /// x, y, z and a zero in one 32-byte vector: the output's rotation column by column, so that A's frame to the
@@ -118,7 +122,10 @@ template <class T> struct WideGjkPairs {
     return r;
   }
 
-  struct Source {
+  template <bool Given> struct SourceOf {
+    /// Given: a boolean run of primitives (gives_first()), whose first support points are computed at set-up
+    /// (first_points()) and given to the loop (WideGjk::GivesFirst).
+    static constexpr bool gives_first = Given;
     const PairView& in;
     const QueryOptions& options;
     ShapeType type_a, type_b;
@@ -140,13 +147,20 @@ template <class T> struct WideGjkPairs {
     Int momentum = options.solver != Solver::gjk ? Int(-1) : Int(0);
     Chunk chunk;
     LanePair lane[W];  // written by load() before done() reads it
+    struct Sides {
+      typename G::Side a, b;
+    };
+    struct NoSides {};
+    [[no_unique_address]] std::conditional_t<Given, Sides, NoSides> first_sides;  // first_points()'s (types, sizes)
 
     // A constructor, not aggregate initialisation: that value-initialises the members it is not given, which
     // would zero the chunk's ~25 KB at every run (one run_plain() per type-pair group of a tile, a few dozen pairs
     // in a mixed batch).
-    Source(const PairView& in_, const QueryOptions& options_, ShapeType a, ShapeType b, const std::uint32_t* pairs_,
+    SourceOf(const PairView& in_, const QueryOptions& options_, ShapeType a, ShapeType b, const std::uint32_t* pairs_,
            std::size_t n_, const ResultView& out_, std::uint32_t* fallback_)
-        : in(in_), options(options_), type_a(a), type_b(b), pairs(pairs_), n(n_), out(out_), fallback(fallback_) {}
+        : in(in_), options(options_), type_a(a), type_b(b), pairs(pairs_), n(n_), out(out_), fallback(fallback_) {
+      if constexpr (Given) first_sides.a.type = a, first_sides.b.type = b;
+    }
 
     /// The lanes' fields that are the same for every pair of the run (set_gjk_parameters()'s values):
     /// max_iterations, the relative tolerance, boolean_only, and the momentum normalisation (normalised
@@ -167,7 +181,28 @@ template <class T> struct WideGjkPairs {
       chunk.left = 0;
       const std::size_t end = std::min(n, read + kChunk);
       fill_slots(chunk, read, end, [&](std::size_t s, std::uint32_t valid) { chunk.left |= std::uint64_t(valid) << s; });
+      if constexpr (Given) first_points(end - read);
       read = end;
+    }
+    /// The first support point of slots [0, count), W per register: start()'s minkowski(L, -d_prev) on the values
+    /// load() copies into a lane (R, t, the sizes, d_prev = init), so the same operations on the same values per
+    /// lane: the same bits. In a loop pass only the ~1-2 lanes refilled since the last pass need it, so start()
+    /// computed a whole register's supports for them (box-cylinder boolean float: ~85 instructions a pair, AVX2).
+    /// The last register's lanes past the slots fill_slots() wrote compute on stale values, never loaded.
+    void first_points(std::size_t count) {
+      const Chunk& c = chunk;
+      typename G::Side &side_a = first_sides.a, &side_b = first_sides.b;
+      for (std::size_t s = 0; s < count; s += std::size_t(W)) {
+        typename G::real R[9], t[3];
+        for (int e = 0; e < 9; ++e) R[e] = lanes_at(c.R[e] + s);
+        for (int i = 0; i < 3; ++i) t[i] = lanes_at(c.t[i] + s);
+        side_a.s0 = lanes_at(c.size_a[0] + s), side_a.s1 = lanes_at(c.size_a[1] + s), side_a.s2 = lanes_at(c.size_a[2] + s);
+        side_b.s0 = lanes_at(c.size_b[0] + s), side_b.s1 = lanes_at(c.size_b[1] + s), side_b.s2 = lanes_at(c.size_b[2] + s);
+        const typename G::V3 init{lanes_at(c.init[0] + s), lanes_at(c.init[1] + s), lanes_at(c.init[2] + s)};
+        typename G::V3 w, a, b;
+        G::minkowski(side_a, side_b, R, t, G::neg(init), 0u, w, a, b);
+        store_at(chunk.first[0] + s, w.x), store_at(chunk.first[1] + s, w.y), store_at(chunk.first[2] + s, w.z);
+      }
     }
     /// fill_chunk()'s values of pairs[first .. end) into slots [0, end - first) of `chunk` (end - first <= N), Wd
     /// slots per register (the last register's lanes past `end` repeat the last pair). mark(s, bits): the valid
@@ -259,6 +294,7 @@ template <class T> struct WideGjkPairs {
       side(L.A, c.size_a, c.shape_a, s, l);
       side(L.B, c.size_b, c.shape_b, s, l);
       G::reset_search(L, l, Vec3<T>(c.init[0][s], c.init[1][s], c.init[2][s]));
+      if constexpr (Given) G::set_lane(L.first_w, l, Vec3<T>(c.first[0][s], c.first[1][s], c.first[2][s]));
       if (rim) {
         G::set_lane(L.rim_a, l, Vec3<T>(c.rim[0][s], c.rim[1][s], c.rim[2][s]));
         G::set_lane(L.rim_b, l, Vec3<T>(c.rim[3][s], c.rim[4][s], c.rim[5][s]));
@@ -324,6 +360,9 @@ template <class T> struct WideGjkPairs {
       const typename G::V3 init{expand_load<T>(zero, take, c.init[0] + s), expand_load<T>(zero, take, c.init[1] + s),
                                 expand_load<T>(zero, take, c.init[2] + s)};
       G::reset_search_lanes(L, take, init);
+      if constexpr (Given)
+        L.first_w = {expand_load<T>(L.first_w.x, take, c.first[0] + s), expand_load<T>(L.first_w.y, take, c.first[1] + s),
+                     expand_load<T>(L.first_w.z, take, c.first[2] + s)};
       L.momentum = select(G::lanes_of(take), G::splat_mask(momentum), L.momentum);
       L.tolerance = expand_load<T>(L.tolerance, take, c.tolerance + s);
       L.touch = expand_load<T>(L.touch, take, c.floor + s);  // gjk_limits(): touch = floor
@@ -459,6 +498,17 @@ template <class T> struct WideGjkPairs {
     }
   };
 
+  using Source = SourceOf<false>;
+  /// Whether a run's first support points are computed at set-up (SourceOf<true>): boolean runs whose types'
+  /// support reads only the side's sizes. Not hulls: a hull's support needs its rows, which only a lane's refill
+  /// loads. Not distance / witness: their lanes run more passes per pair, so fewer fresh lanes share start()'s
+  /// W-wide support, and the set-up would have to give A's and B's points too (witness double, callgrind AVX2,
+  /// instructions a pair, with points given: box-cylinder 1930 -> 1942, cone-cone 1432 -> 1464).
+  static bool gives_first(ShapeType a, ShapeType b, const QueryOptions& options) {
+    const auto primitive = [](ShapeType t) { return t != ShapeType::convex && t != ShapeType::triangle; };
+    return options.level == QueryLevel::boolean && primitive(a) && primitive(b);
+  }
+
   /// Whether a group goes to run_certified() (boolean double queries of the types certified_pays() names) rather
   /// than run_plain(). The entry points (simd/isa_body.inl) put run_certified() in a translation unit of its own
   /// (it still instantiates run_plain() for the pairs it refuses; kernels/CMakeLists.txt: which copy is linked).
@@ -477,6 +527,12 @@ template <class T> struct WideGjkPairs {
     L.B.type = type_b;
     typename G::Rows rows;
     rows.attach(L.A, L.B);
+    if (gives_first(type_a, type_b, options)) {
+      SourceOf<true> source{in, options, type_a, type_b, pairs, n, out, fallback};
+      source.start_run(L);
+      G::drive_boolean(L, source, options.solver);
+      return source.fallbacks;
+    }
     Source source{in, options, type_a, type_b, pairs, n, out, fallback};
     source.start_run(L);
     if (options.level == QueryLevel::boolean) G::drive_boolean(L, source, options.solver);  // start_run: all boolean
@@ -519,10 +575,12 @@ template <class T> struct WideGjkPairs {
     std::uint8_t kind[kBlock], count[kBlock];
     std::int32_t iterations[kBlock];
     float direction[3][kBlock], vertex[4][3][kBlock];
+    float first[3][kBlock];  // the float pass's first support point of each survivor (float_first_points())
   };
 
   typedef T unaligned_real __attribute__((vector_size(sizeof(T) * W), aligned(alignof(T))));
   static typename G::real lanes_at(const T* p) { return *reinterpret_cast<const unaligned_real*>(p); }
+  static void store_at(T* p, const typename G::real& v) { *reinterpret_cast<unaligned_real*>(p) = v; }
 
   /// Writes a certified run's own answers for the lanes `bits` of the register at slot s: converged, collide
   /// (`collide` lanes), the direction d (in A's frame) mapped to the world as LanePair::put_world() maps it (the
@@ -577,6 +635,41 @@ template <class T> struct WideGjkPairs {
     return survivors;
   }
 
+  /// The float pass's first support point of the gate's survivors of a block, F::W slots per register (float
+  /// lanes): FloatFeed::load()'s float values of R, t, the sizes and the first direction (each double rounded
+  /// once, the direction's zero test and its x axis), then start()'s F::minkowski(-d_prev) on them: the same
+  /// operations per lane as the float loop's start(), so the same bits, W lanes for all the block's survivors
+  /// instead of one W-wide support per loop pass for the ~1-2 lanes refilled since the last. Registers without
+  /// a survivor are skipped; lanes past the slots fill_slots() wrote compute on stale values, never loaded.
+  static void float_first_points(Block& c, std::size_t count, typename WideGjk<float>::Side& A,
+                                 typename WideGjk<float>::Side& B) {
+    using F = WideGjk<float>;
+    constexpr int FW = F::W;
+    static_assert(kBlock % std::size_t(FW) == 0 && (FW <= 64 && 64 % FW == 0), "whole registers, inside a word");
+    typedef double doubles __attribute__((vector_size(sizeof(double) * FW), aligned(alignof(double))));
+    // (A macro's job, no lambda: a vector of 2 W doubles returned by value is an ABI warning in the SSE2 unit.)
+#define BATCHCOL_NARROW(p) __builtin_convertvector(*reinterpret_cast<const doubles*>(p), typename F::real)
+    for (std::size_t s = 0; s < count; s += std::size_t(FW)) {
+      if ((c.alive[s / 64] >> (s % 64) & (~std::uint64_t(0) >> (64 - FW))) == 0) continue;
+      typename F::real R[9], t[3];
+      for (int e = 0; e < 9; ++e) R[e] = BATCHCOL_NARROW(c.R[e] + s);
+      for (int i = 0; i < 3; ++i) t[i] = BATCHCOL_NARROW(c.t[i] + s);
+      A.s0 = BATCHCOL_NARROW(c.size_a[0] + s), A.s1 = BATCHCOL_NARROW(c.size_a[1] + s), A.s2 = BATCHCOL_NARROW(c.size_a[2] + s);
+      B.s0 = BATCHCOL_NARROW(c.size_b[0] + s), B.s1 = BATCHCOL_NARROW(c.size_b[1] + s), B.s2 = BATCHCOL_NARROW(c.size_b[2] + s);
+      typename F::V3 init{BATCHCOL_NARROW(c.init[0] + s), BATCHCOL_NARROW(c.init[1] + s), BATCHCOL_NARROW(c.init[2] + s)};
+      const typename F::real zero = F::splat(0.0f), one = F::splat(1.0f);
+      const typename F::mask nonzero = F::norm2(init) > zero;  // FloatFeed::load()'s test, (x x + y y) + z z
+      init = {F::blend(nonzero, init.x, one), F::blend(nonzero, init.y, zero), F::blend(nonzero, init.z, zero)};
+      typename F::V3 w, a, b;
+      F::minkowski(A, B, R, t, F::neg(init), 0u, w, a, b);
+      typedef float floats __attribute__((vector_size(sizeof(float) * FW), aligned(alignof(float))));
+      *reinterpret_cast<floats*>(c.first[0] + s) = w.x;
+      *reinterpret_cast<floats*>(c.first[1] + s) = w.y;
+      *reinterpret_cast<floats*>(c.first[2] + s) = w.z;
+    }
+#undef BATCHCOL_NARROW
+  }
+
   /// The float pass's pairs (WideGjk<float>'s Source): the gate's survivors of a block, each lane's float setup
   /// converted from the block's double one, answers kept in the block by slot. The float setup's values are the
   /// float fill_slots()'s bits: R, t, the sizes, the inflations and the scale are computed in double there too and
@@ -585,6 +678,7 @@ template <class T> struct WideGjkPairs {
   /// (certified_pays()), rounds to the float one. So the float pass has solve_pair<float>'s answers.
   struct FloatFeed {
     using F = WideGjk<float>;
+    static constexpr bool gives_first = true;  // float_first_points()
     Block& c;
     std::size_t count;
     float tolerance, margin;
@@ -597,6 +691,7 @@ template <class T> struct WideGjkPairs {
       if (next == count) return false;
       const std::size_t s = c.list[next++];
       L.pair[l] = std::int64_t(s);
+      F::set_lane(L.first_w, l, Vec3<float>(c.first[0][s], c.first[1][s], c.first[2][s]));
       for (int e = 0; e < 9; ++e) L.R[e][l] = float(c.R[e][s]);
       for (int i = 0; i < 3; ++i) L.t[i][l] = float(c.t[i][s]);
       L.A.s0[l] = float(c.size_a[0][s]), L.A.s1[l] = float(c.size_a[1][s]), L.A.s2[l] = float(c.size_a[2][s]);
@@ -808,6 +903,9 @@ template <class T> struct WideGjkPairs {
     L.relative = F::splat(float(options.relative_tolerance));
     L.normalize = F::truth(!(type_a == ShapeType::ellipsoid && type_b == ShapeType::ellipsoid));  // start_run()
     L.boolean_only = F::truth(true);
+    typename F::Side side_a, side_b;
+    side_a.type = type_a;
+    side_b.type = type_b;
     FloatFeed feed{block,
                    0,
                    float(options.tolerance),
@@ -824,6 +922,7 @@ template <class T> struct WideGjkPairs {
       // No gate when the budget allows no iteration: the double GJK would end at its budget, undecided.
       const std::size_t survivors = gate(block, count, options.max_iterations >= 1, check, out);
       if (survivors == 0) continue;
+      float_first_points(block, count, side_a, side_b);
       feed.count = survivors;
       feed.next = 0;
       F::drive_boolean_directions(L, feed, options.solver);

@@ -35,7 +35,8 @@ struct Scene {
 
 /// Every plain convex type (two of each, one inflated), pairs near each other (separated, touching-close and
 /// overlapping), and a few invalid pairs of every kind.
-Scene gjk_scene(std::size_t pairs, std::uint64_t seed) {
+/// `concentric`: every concentric-th pair has B's centre at A's (zero first direction: the x axis instead).
+Scene gjk_scene(std::size_t pairs, std::uint64_t seed, std::size_t concentric = 0) {
   Rng rng(seed);
   Scene s;
   for (ShapeType t : {ShapeType::sphere, ShapeType::capsule, ShapeType::box, ShapeType::cylinder, ShapeType::cone,
@@ -49,6 +50,7 @@ Scene gjk_scene(std::size_t pairs, std::uint64_t seed) {
     Pose pa{testing::random_vector(rng) * 3.0, testing::random_rotation(rng)};
     Pose pb{pa.translation + testing::random_unit_vector(rng) * testing::uniform(rng, 0.0, 0.6),
             testing::random_rotation(rng)};
+    if (concentric != 0 && i % concentric == 3) pb.translation = pa.translation;
     std::uint32_t ia = a;
     switch (i % 97) {  // invalid pairs, scattered
       case 5: pa.rotation.coeffs()[1] = kNan; break;
@@ -225,6 +227,28 @@ template <class T> void expect_reference_bits(Precision precision) {
 TEST(ExecutorGjkPairs, EveryPairHasTheScalarReferenceBitsInDouble) { expect_reference_bits<double>(Precision::float64); }
 
 TEST(ExecutorGjkPairs, EveryPairHasTheScalarReferenceBitsInFloat) { expect_reference_bits<float>(Precision::float32); }
+
+/// Boolean runs of primitives take their first support point from the set-up (first_points(), and the certified
+/// float pass's float_first_points()), along the set-up's first direction, the x axis where the centres' offset is
+/// zero (start_lane()'s rule): pairs whose centres coincide keep the reference's bits, both precisions, every solver.
+TEST(ExecutorGjkPairs, ConcentricBooleanPairsHaveTheScalarReferenceBits) {
+  for (Precision precision : {Precision::float64, Precision::float32}) {
+    const Scene s = gjk_scene(3000, 13, 5);
+    for (Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
+      QueryOptions o;
+      o.level = QueryLevel::boolean;
+      o.solver = solver;
+      o.precision = precision;
+      o.closed_forms = false;
+      o.threads = 2;
+      PairResults got;
+      collide(s.shapes, s.batch, o, got);
+      const std::string what = std::string(to_string(solver)) + (precision == Precision::float64 ? " double" : " float");
+      if (precision == Precision::float64) testing::expect_same_results(reference<double>(s, o, got), got, what);
+      else testing::expect_same_results(reference<float>(s, o, got), got, what);
+    }
+  }
+}
 
 /// One shape-pair type straight through kernels::simd::gjk_pairs: many chunks of 64 pairs with lanes refilled
 /// across chunk boundaries, small hulls (SIMD vertex scan) mixed with large ones (per-lane hill climbing with
