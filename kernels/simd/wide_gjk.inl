@@ -1322,8 +1322,11 @@ template <class T> struct WideGjk {
   struct LoadsLanes<S, std::void_t<decltype(std::declval<S&>().load_lanes(std::declval<Lanes&>(), 0u))>>
       : std::true_type {};
 
+  // noinline: its callers stay small and the loop keeps its own register allocation whatever they are. Once
+  // project() lost its face rounds, GCC inlined the boolean float loop into run_plain() and spilled more in it
+  // (overlap box-cylinder boolean float 782 -> 799 loop instructions per pair, callgrind AVX2).
   template <bool Boolean, bool Dirs = false, class Source>
-  static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
+  __attribute__((noinline)) static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
     // refilled together (done() reads and load() writes only its own lane, so the answers are the same).
     // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512).
