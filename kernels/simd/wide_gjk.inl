@@ -503,27 +503,6 @@ template <class T> struct WideGjk {
 
   static real det3(const V3& a, const V3& b, const V3& c) { return dot(a, cross(b, c)); }
 
-  /// Face m of tetrahedron p[0..2], s that keeps s (vertex 3), per lane (m = 0: old vertices 1, 2; m = 1: 0, 2;
-  /// m = 2: 0, 1), given the lanes where m is 0 and where it is 2; i and j get the old vertices' input indices.
-  AI static Face face_keeping_3(const V3* p, const V3& s, const Plane* h, mask m0, mask m2, mask& i, mask& j) {
-    i = blend(m0, splat_mask(1), splat_mask(0));
-    j = blend(m2, splat_mask(1), splat_mask(2));
-    return face(pick(m0, p[1], p[0]), pick(m2, p[1], p[2]), s, pick(m0, h[0], pick(m2, h[2], h[1])));
-  }
-
-  /// Candidates visited in the reference's order, lane by lane: each round every lane takes its lowest-numbered
-  /// remaining candidate (`taken[m]` says which), so the number of rounds is the largest candidate count of one
-  /// lane (usually 1), not the number of distinct candidates over the lanes.
-  template <int M> static mask next_round(mask (&remaining)[M], mask (&taken)[M]) {
-    mask round = splat_mask(0);  // lanes that took a candidate this round
-    for (int m = 0; m < M; ++m) {
-      taken[m] = remaining[m] & ~round;
-      round |= remaining[m];
-      remaining[m] &= ~taken[m];
-    }
-    return round;
-  }
-
   /// GJK's projection step on every live lane at once: the reference's project_origin(p, count + 1) with p[count]
   /// = s the new support point (segment(), triangle() or tetrahedron() by the lane's size), the same operations
   /// per lane. The three sizes share their work, since a register's lanes are usually at different sizes (they
@@ -542,8 +521,8 @@ template <class T> struct WideGjk {
     if (!any(three | four)) return to_proj(edge(p[0], s, splat_mask(0), newest));
     // Tetrahedron lanes (tetrahedron()): the origin inside, else the faces keeping vertex 3 that it sees (cand[m]:
     // face m omits vertex m), and the visible face whose plane is farthest from the origin (the reference's rule,
-    // same arithmetic): where the origin's projection lies inside that face, it is the answer, in one face instead
-    // of one round per visible face (on smooth shapes the origin sees all three new faces of a flat tent).
+    // same arithmetic): where the origin's projection lies inside that face, it is the answer; else an edge to s is
+    // (below), so one face() serves every lane (on smooth shapes the origin sees all three new faces of a flat tent).
     // The planes of the faces keeping s (face m omits old vertex m): n_m = (p_I - s) x (p_J - s). Face 2 (p0 p1 s)
     // is also the triangle lanes' face; the tetrahedron lanes need all three. Their <s, n_m> are the signed
     // volumes V[0], -V[1], V[2] (the triple product <s, (p_I - s) x (p_J - s)> = <s, p_I x p_J>), so three of the
@@ -572,8 +551,8 @@ template <class T> struct WideGjk {
       }
       first_0 = have_first & (choice == splat_mask(0)), first_2 = have_first & (choice == splat_mask(2));
     }
-    // One face: the triangle lanes' p0 p1 s (triangle()), the tetrahedron lanes' first face (face_keeping_3()'s
-    // vertices and indices).
+    // One face: the triangle lanes' p0 p1 s (triangle()), the tetrahedron lanes' first face (face m holds old
+    // vertices 1 2, 0 2 or 0 1 for m = 0, 1, 2).
     const mask fi = blend(first_0, splat_mask(1), splat_mask(0));
     const mask fj = blend(three, splat_mask(1), blend(first_2, splat_mask(1), splat_mask(2)));
     // Computed whatever the lanes (only segment lanes is rare): no branch, and no default value to write first.
@@ -590,47 +569,31 @@ template <class T> struct WideGjk {
     E[0] = edge(p[0], s, splat_mask(0), newest), En[0] = norm2(E[0].x);
     E[1] = E[0], En[1] = En[0], E[2] = E[0], En[2] = En[0];
     if (any(tri_edges | rest)) E[1] = edge(p[1], s, splat_mask(1), newest), En[1] = norm2(E[1].x);
-    // The tetrahedron lanes whose first face was not the answer: the closest of every visible face's answer.
+    // The tetrahedron lanes whose first face was not the answer: their answer is an edge to s, the closest of the
+    // edges k-3 of the visible faces (the reference's tetrahedron() says why no other face's interior can be
+    // closer). Those are the edges the faces' own triangle() calls chose between, so no other face() is computed.
     real best_n2 = splat(std::numeric_limits<T>::infinity());
-    Face bf;  // the best face's x and weights (use, via_i, via_j unused)
-    bf.x = {zero, zero, zero};
-    for (int m = 0; m < 3; ++m) bf.lambda[m] = zero;
-    bf.use = bf.via_i = bf.via_j = splat_mask(0);
-    mask bi = splat_mask(0), bj = splat_mask(0), best_edge = splat_mask(0), best_use = splat_mask(0);
-    mask have = splat_mask(0);
+    mask best_edge = splat_mask(0), have = splat_mask(0);
     if (any(rest)) {
       E[2] = edge(p[2], s, splat_mask(2), newest), En[2] = norm2(E[2].x);
-      mask remaining[3], taken[3];
-      for (int m = 0; m < 3; ++m) remaining[m] = cand[m] & ~first_ok;
-      for (;;) {
-        const mask round = next_round(remaining, taken);
-        if (!any(round)) break;
-        // Face m's old vertices: m = 0 -> (1, 2), 1 -> (0, 2), 2 -> (0, 1).
-        mask i, j;
-        const Face g = face_keeping_3(p, s, h, taken[0], taken[2], i, j);
-        const real ni = blend(taken[0], En[1], En[0]), nj = blend(taken[2], En[1], En[2]);
-        const mask to_j = takes_j(g, ni, nj);
-        const real n2 = blend(g.use, norm2(g.x), blend(to_j, nj, ni));
-        const mask take = round & (~have | (n2 < best_n2));
-        best_n2 = blend(take, n2, best_n2);
-        best_use = blend(take, g.use, best_use);
-        best_edge = blend(take, blend(to_j, j, i), best_edge);
-        bf.x = pick(take, g.x, bf.x);
-        for (int m = 0; m < 3; ++m) bf.lambda[m] = blend(take, g.lambda[m], bf.lambda[m]);
-        bi = blend(take, i, bi), bj = blend(take, j, bj);
-        have |= round;
+      // Edge k belongs to the visible faces that hold old vertex k: face m holds every old vertex but m. Visited
+      // in order, the first of equal ones kept.
+      const mask holds[3] = {cand[1] | cand[2], cand[0] | cand[2], cand[0] | cand[1]};
+      for (int k = 0; k < 3; ++k) {
+        const mask on = rest & holds[k];
+        const mask take = on & (~have | (En[k] < best_n2));
+        best_n2 = blend(take, En[k], best_n2);
+        best_edge = blend(take, splat_mask(k), best_edge);
+        have |= on;
       }
     }
-    // The answer: a face (the triangle lanes' face, the first face, the best face) or an edge (the segment, the
-    // triangle lanes' closer edge, the best face's edge).
+    // The answer: a face (the triangle lanes' face, the first face) or an edge (the segment, the triangle lanes'
+    // closer edge, the tetrahedron lanes' closest visible edge).
     const mask from_best = rest;
     Edge e = pick(three & takes_j(f, En[0], En[1]), E[1], E[0]);
     for (int k = 1; k < 3; ++k) e = pick(from_best & (best_edge == splat_mask(k)), E[k], e);
-    const mask use_face = (three & f.use) | first_ok | (from_best & best_use);
-    Face a = f;
-    a.x = pick(from_best, bf.x, f.x);
-    for (int m = 0; m < 3; ++m) a.lambda[m] = blend(from_best, bf.lambda[m], f.lambda[m]);
-    Proj r = pick(use_face, face_proj(a, blend(from_best, bi, fi), blend(from_best, bj, fj), newest), to_proj(e));
+    const mask use_face = (three & f.use) | first_ok;
+    Proj r = pick(use_face, face_proj(f, fi, fj, newest), to_proj(e));
     if (any(four)) {
       // No visible face: no candidate (x infinite, count 0); the origin inside: the whole tetrahedron.
       const mask none = from_best & ~have;
@@ -1376,8 +1339,11 @@ template <class T> struct WideGjk {
   template <class S, class = void> struct GivesFirst : std::false_type {};
   template <class S> struct GivesFirst<S, std::void_t<decltype(S::gives_first)>> : std::bool_constant<S::gives_first> {};
 
+  // noinline: its callers stay small and the loop keeps its own register allocation whatever they are. Once
+  // project() lost its face rounds, GCC inlined the boolean float loop into run_plain() and spilled more in it
+  // (overlap box-cylinder boolean float 782 -> 799 loop instructions per pair, callgrind AVX2).
   template <bool Boolean, bool Dirs = false, class Source>
-  static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
+  __attribute__((noinline)) static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
     // refilled together (done() reads and load() writes only its own lane, so the answers are the same).
     // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512).

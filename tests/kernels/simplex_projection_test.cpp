@@ -101,6 +101,21 @@ TEST(SimplexProjection, OldFaceClosestGivesNoCandidate) {
   EXPECT_NEAR(s.x.norm(), 1.0, 1e-15);
 }
 
+TEST(SimplexProjection, FirstFaceMissedGivesTheClosestVisibleEdge) {
+  // The origin sees faces 0 (p1 p2 p3) and 2 (p0 p1 p3), face 2's plane the farther (squared distances 0.059 and
+  // 0.191): face 2 is the first face and the origin's projection falls outside it. The answer is then the closest
+  // of the visible faces' edges k-3, the first of equal ones: vertex p0 (edge 0-3), as far as vertex p1 (edge 1-3,
+  // face 0's own answer), its mirror image (x -> -x). Before, every visible face was solved again in order and
+  // face 0's p1 won the tie.
+  const std::vector<Eigen::Vector3d> p = {
+      {-0.375, -0.25, -0.375}, {0.375, -0.25, -0.375}, {1.875, -1.25, -0.125}, {0.0, 1.0, -1.75}};
+  const auto r = project_origin(p.data(), 4);
+  EXPECT_FALSE(r.contains_origin);
+  EXPECT_EQ(r.count, 1);
+  EXPECT_EQ(r.index[0], 0);
+  EXPECT_EQ(r.x, p[0]);
+}
+
 TEST(SimplexProjection, DegenerateSimplicesGiveFiniteConvexCombinations) {
   const Eigen::Vector3d a(1, 1, 1), b(2, 2, 2), c(3, 3, 3), d(1, 1, 1);
   const std::vector<std::vector<Eigen::Vector3d>> cases = {

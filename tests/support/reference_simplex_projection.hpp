@@ -7,7 +7,7 @@
 // As in GJK's classic Voronoi-region form, only sub-simplices that keep the newest vertex are candidates: 2 edges per
 // triangle, and per tetrahedron the faces through the newest vertex that the origin sees (at most 3), visited in a
 // fixed order. The SIMD kernel (kernels/simd/wide_gjk.inl) runs the triangle on all lanes at once and the
-// tetrahedron in one round per visible face, with the same arithmetic.
+// tetrahedron's one face and three edges on all lanes at once, with the same arithmetic.
 #pragma once
 
 #include "kernels/math.hpp"
@@ -148,14 +148,21 @@ template <class T> SimplexProjection<T> tetrahedron(const Vec3<T>* p) {
     const SimplexProjection<T> f = triangle(p, old[first][0], old[first][1], 3);
     if (f.count == 3) return f;
   }
-  // Its projection fell outside it: the closest of every visible face's answer.
+  // Its projection fell outside it: the closest point is on an edge k-3 of a visible face. No other visible face's
+  // interior can hold it: that face's plane would then be as far from the origin as the closest point (it supports
+  // the tetrahedron), and no visible plane is farther than the closest point, so the first face would be that face
+  // or one at the same distance, whose projection is the same point (inside it, up to rounding on an edge, where
+  // the edge answers it). Each face's own answer (triangle()) is the closest point of one of its two edges k-3
+  // (in exact arithmetic the closest point of the face), so the closest of all those edges is at least as close
+  // as any face's answer, without a triangle() per face: edge k belongs to the visible faces that hold old vertex
+  // k (face m holds every old vertex but m), visited in order, the first of equal ones kept.
   SimplexProjection<T> best;
   best.x = Vec3<T>::Constant(std::numeric_limits<T>::infinity());
   bool have = false;
-  for (int m = 0; m < 3; ++m) {
-    if (!candidate(m)) continue;
-    const SimplexProjection<T> f = triangle(p, old[m][0], old[m][1], 3);
-    best = have ? closer(best, f) : f;
+  for (int k = 0; k < 3; ++k) {
+    if (!candidate((k + 1) % 3) && !candidate((k + 2) % 3)) continue;
+    const SimplexProjection<T> e = segment(p, k, 3);
+    best = have ? closer(best, e) : e;
     have = true;
   }
   return best;
