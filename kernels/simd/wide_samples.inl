@@ -186,7 +186,9 @@ struct WideSamples {
   template <int L> static void store_noise(fv e, fv o, double* dst, bool both) {
     const fv& src = L % 2 == 0 ? e : o;
     const f4 v = __builtin_shufflevector(src, src, 4 * (L / 2), 4 * (L / 2) + 1, 4 * (L / 2) + 2, 4 * (L / 2) + 3);
-    const d4 d = __builtin_convertvector(v, d4);
+    // vcvtps2pd ymm, xmm (every SIMD set here has AVX): GCC's own conversion went through two 2-lane conversions,
+    // a stack copy and an insert.
+    const d4 d = (d4)_mm256_cvtps_pd((__m128)v);
     if (both) std::memcpy(dst, &d, sizeof d);
     else std::memcpy(dst, &d, sizeof d / 2);
   }
