@@ -99,58 +99,62 @@ template <int N> void gaussian_vector(std::uint64_t seed, std::uint64_t pair, st
   for (int k = 0; k < N; k += 2) rng.gaussian_pair(z[k], z[k + 1]);
 }
 
-/// log_unit() and sincos_turn() with shorter series for support_noise_pair(): log to s^11 (relative error below
-/// z^6 / 13 = 5e-11 at |s| <= 0.172), sin to x^11 and cos to x^12 (below 1e-11 at |x| <= pi/4). Noise needs the
-/// normal distribution, not the last bits of its deviates: 5e-11 is far below any sampling error.
-inline double log_unit_short(double u) {
-  std::uint64_t bits;
+/// support_noise_pair()'s float Box-Muller pieces, each a fixed sequence of IEEE float operations (the build has
+/// -ffp-contract=off, so no FMA fuses them on any set) that kernels/simd/wide_samples.inl repeats lane by lane,
+/// 2 W lanes a register: float halves the lanes' width, and every integer <-> float conversion here is a native
+/// 32-bit one on AVX2 (64-bit lanes had none).
+///
+/// -2 log(u) for u = (h + 1) 2^-31 (h < 2^31): u = 2^k m with m in [sqrt(1/2), sqrt(2)) by integer steps on u's
+/// bits (the bits minus sqrt(1/2)'s, shifted, are k), log m = 2 atanh(s), s = (m - 1) / (m + 1), |s| <= 0.1716,
+/// by its series to s^9 (remainder below s^11 / 11 < 2e-9 of the sum; float rounding, ~1e-7, dominates).
+/// Never negative: for k = 0, m < 1 and s < 0 exactly; for k < 0, |2 s p| <= log sqrt(2) < ln 2.
+inline float minus_two_log_unit_f(std::uint32_t h) {
+  const float u = (static_cast<float>(static_cast<std::int32_t>(h)) + 1.0f) * 0x1.0p-31f;
+  std::int32_t bits;
   std::memcpy(&bits, &u, sizeof bits);
-  int k = static_cast<int>(bits >> 52) - 1023;
-  bits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
-  double m;
+  const std::int32_t k = (bits - 0x3F3504F3) >> 23;  // arithmetic shift (C++20 defines it; GCC always has)
+  bits -= static_cast<std::int32_t>(static_cast<std::uint32_t>(k) << 23);
+  float m;
   std::memcpy(&m, &bits, sizeof m);
-  if (m > 1.4142135623730951) {
-    m *= 0.5;
-    ++k;
-  }
-  const double s = (m - 1.0) / (m + 1.0), z = s * s;
-  const double p = (((((1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z + 1.0 / 3.0) * z + 1.0;
-  return k * 0.6931471805599453 + 2.0 * s * p;
-}
-inline void sincos_turn_short(double u, double& sin, double& cos) {
-  const int q = static_cast<int>(4.0 * u + 0.5);
-  const double x = 6.283185307179586 * (u - 0.25 * q), z = x * x;
-  const double sx =
-      x * (((((-1.0 / 39916800.0 * z + 1.0 / 362880.0) * z - 1.0 / 5040.0) * z + 1.0 / 120.0) * z - 1.0 / 6.0) * z +
-           1.0);
-  const double cx = ((((((1.0 / 479001600.0) * z - 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z +
-                      1.0 / 24.0) * z - 0.5) * z + 1.0;
-  switch (q & 3) {
-    case 0: sin = sx, cos = cx; break;
-    case 1: sin = cx, cos = -sx; break;
-    case 2: sin = -sx, cos = -cx; break;
-    default: sin = -cx, cos = sx; break;
-  }
+  const float s = (m - 1.0f) / (m + 1.0f), z = s * s;
+  const float p = (((1.0f / 9.0f * z + 1.0f / 7.0f) * z + 1.0f / 5.0f) * z + 1.0f / 3.0f) * z + 1.0f;
+  return static_cast<float>(k) * static_cast<float>(-2.0 * 0.6931471805599453) - (4.0f * s) * p;
 }
 
-/// smoothed1's support noise (engine/src/derivatives.cpp; kernels::simd::draw_support_noise() draws it W pairs per
-/// register with these bits): normals 2j and 2j + 1 of a pair with key splitmix64(splitmix64(seed) ^ pair) are
-/// one Box-Muller transform of the j-th output x of the SplitMix64 sequence started at the key, its high 32 bits
-/// the radius' uniform (hi + 1) 2^-32 in (0, 1] and its low 32 bits the angle's lo 2^-32 in [0, 1). One 64-bit
-/// mix per two normals where gaussian_vector<4> paid two mixes of key set-up per lane and one per uniform (with
-/// AVX2's emulated 64-bit products, those mixes were most of the draw), and only the 3 normals a side uses per
-/// draw instead of 4: issue 18's M = 4 budget. 32-bit uniforms cut the radius at sqrt(64 ln 2) = 6.66 (a
-/// normal's two-sided tail beyond it has probability 3e-11) and quantise the angle to 2^-32 of a turn: far below
-/// the estimator's sampling error at any M the API takes.
+/// sin and cos of the angle a 2^-32 turn: the nearest quarter turn q (the top 2 bits of a + 2^29) is removed in
+/// integers, exactly, the rest r (a's low 30 bits as a signed number, |r| <= 2^29, x = 2 pi r 2^-32 with
+/// |x| <= pi/4) goes through Taylor series to x^9 (sin, remainder below 2e-9) and x^8 (cos, below 3e-8), and the
+/// quadrant is a swap and two sign flips.
+inline void sincos_turn_f(std::uint32_t a, float& sin, float& cos) {
+  const std::uint32_t q = (a + 0x20000000u) >> 30;
+  const std::int32_t r = static_cast<std::int32_t>(a - (q << 30));
+  const float x = static_cast<float>(r) * static_cast<float>(6.283185307179586 * 0x1.0p-32), z = x * x;
+  const float sx = x * ((((1.0f / 362880.0f * z - 1.0f / 5040.0f) * z + 1.0f / 120.0f) * z - 1.0f / 6.0f) * z + 1.0f);
+  const float cx = (((1.0f / 40320.0f * z - 1.0f / 720.0f) * z + 1.0f / 24.0f) * z - 0.5f) * z + 1.0f;
+  const bool swap = (q & 1u) != 0;
+  sin = swap ? cx : sx;
+  cos = swap ? sx : cx;
+  if (q & 2u) sin = -sin;              // q = 2, 3: sin(x + pi) = -sin x
+  if ((q + 1u) & 2u) cos = -cos;       // q = 1, 2: cos(x + pi/2) = -sin x, cos(x + pi) = -cos x
+}
+
+/// smoothed1's support noise (engine/src/derivatives.cpp; kernels::simd::draw_support_noise() draws it 2 W
+/// transforms per register with these bits): normals 2j and 2j + 1 of a pair with key splitmix64(splitmix64(seed)
+/// ^ pair) are one Box-Muller transform of the j-th output x of the SplitMix64 sequence started at the key, its
+/// high 32 bits h the radius' uniform ((h >> 1) + 1) 2^-31 in (0, 1] (rounded to float above 2^24: only near
+/// u = 1, where log is flat) and its low 32 bits the angle in 2^-32 turns, in float (branch sm4; sm3 did the same
+/// transform in double with series to 5e-11: other output bits since, the same distribution). One 64-bit mix per
+/// two normals, and only the 3 normals a side uses per draw: issue 18's M = 4 budget. The 31-bit uniform cuts the
+/// radius at sqrt(62 ln 2) = 6.56 (a normal pair's radius exceeds it with probability 2^-31 = 5e-10), the angle is
+/// quantised to 2^-32 of a turn, and the float series and roundings are within ~1e-7 relative: far below the
+/// estimator's sampling error at any M the API takes (tests/kernels/wide_samples_test.cpp checks the moments).
 inline void support_noise_pair(std::uint64_t key, std::uint64_t j, double& g0, double& g1) {
   const std::uint64_t x = splitmix64(key + j * 0x9E3779B97F4A7C15ull);
-  const double u_radius = (static_cast<double>(x >> 32) + 1.0) * 0x1.0p-32;
-  const double u_angle = static_cast<double>(x & 0xFFFFFFFFull) * 0x1.0p-32;
-  const double radius = std::sqrt(-2.0 * log_unit_short(u_radius));
-  double s, c;
-  sincos_turn_short(u_angle, s, c);
-  g0 = radius * c;
-  g1 = radius * s;
+  const float radius = std::sqrt(minus_two_log_unit_f(static_cast<std::uint32_t>(x >> 33)));
+  float s, c;
+  sincos_turn_f(static_cast<std::uint32_t>(x), s, c);
+  g0 = static_cast<double>(radius * c);
+  g1 = static_cast<double>(radius * s);
 }
 
 }  // namespace batchcol::detail

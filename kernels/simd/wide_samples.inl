@@ -104,32 +104,6 @@ struct WideSamples {
     cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
   }
 
-  /// counter_rng.hpp's log_unit_short and sincos_turn_short (support_noise()'s), lane by lane.
-  static real log_unit_short(real u) {
-    const u64 bits = (u64)u;
-    mask k = mask((bits >> 52)) - 1023;
-    const u64 mbits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
-    real m = (real)mbits;
-    const mask big = m > 1.4142135623730951;
-    m = select(big, m * 0.5, m);
-    k = select(big, k + 1, k);
-    const real s = (m - 1.0) / (m + 1.0), z = s * s;
-    const real p = (((((1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) * z + 1.0 / 3.0) * z + 1.0;
-    return exact_small(k) * 0.6931471805599453 + 2.0 * s * p;
-  }
-  static void sincos_turn_short(real u, real& sin, real& cos) {
-    mask q;
-    real qd;
-    quarter_turn(u, q, qd);
-    const real x = 6.283185307179586 * (u - 0.25 * qd), z = x * x;
-    const real sx =
-        x * (((((-1.0 / 39916800.0 * z + 1.0 / 362880.0) * z - 1.0 / 5040.0) * z + 1.0 / 120.0) * z - 1.0 / 6.0) * z +
-             1.0);
-    const real cx = ((((((1.0 / 479001600.0) * z - 1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z +
-                      1.0 / 24.0) * z - 0.5) * z + 1.0;
-    rotate_quarters(q, sx, cx, sin, cos);
-  }
-
   /// gaussian_vector<N>(seed, pair, k, stream) for k = k0 .. k0 + W - 1, lane by lane (key: splitmix(splitmix(seed)
   /// ^ pair), as SamplePlan::key).
   template <int N> static void gaussians(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, real* z) {
@@ -168,29 +142,101 @@ struct WideSamples {
     }
   }
 
+  /// support_noise()'s float lanes: 2 W of them in a register (lane 2l + i: pair l's transform j + i).
+  typedef float fv __attribute__((vector_size(sizeof(real))));
+  typedef std::int32_t iv __attribute__((vector_size(sizeof(real))));
+  typedef std::uint32_t uv __attribute__((vector_size(sizeof(real))));
+  static fv fsqrt(fv a) {
+#if BATCHCOL_SIMD_BYTES == 32
+    return _mm256_sqrt_ps(a);
+#elif BATCHCOL_SIMD_BYTES == 64
+    return _mm512_sqrt_ps(a);
+#else
+    for (int l = 0; l < 2 * W; ++l) a[l] = std::sqrt(a[l]);
+    return a;
+#endif
+  }
+  /// counter_rng.hpp's minus_two_log_unit_f(h), lane by lane (the same float operations in the same order).
+  static fv minus_two_log_unit_f(uv h) {
+    const fv u = (__builtin_convertvector((iv)h, fv) + 1.0f) * 0x1.0p-31f;
+    iv bits = (iv)u;
+    const iv k = (bits - 0x3F3504F3) >> 23;  // arithmetic: the floor of the exponent offset
+    bits -= (iv)((uv)k << 23);
+    const fv m = (fv)bits;
+    const fv s = (m - 1.0f) / (m + 1.0f), z = s * s;
+    const fv p = (((1.0f / 9.0f * z + 1.0f / 7.0f) * z + 1.0f / 5.0f) * z + 1.0f / 3.0f) * z + 1.0f;
+    return __builtin_convertvector(k, fv) * static_cast<float>(-2.0 * 0.6931471805599453) - (4.0f * s) * p;
+  }
+  /// counter_rng.hpp's sincos_turn_f(a), lane by lane; its conditional negations are sign-bit flips.
+  static void sincos_turn_f(uv a, fv& sin, fv& cos) {
+    const uv q = (a + 0x20000000u) >> 30;
+    const iv r = (iv)(a - (q << 30));
+    const fv x = __builtin_convertvector(r, fv) * static_cast<float>(6.283185307179586 * 0x1.0p-32), z = x * x;
+    const fv sx = x * ((((1.0f / 362880.0f * z - 1.0f / 5040.0f) * z + 1.0f / 120.0f) * z - 1.0f / 6.0f) * z + 1.0f);
+    const fv cx = (((1.0f / 40320.0f * z - 1.0f / 720.0f) * z + 1.0f / 24.0f) * z - 0.5f) * z + 1.0f;
+    const iv swap = (iv)(q << 31) >> 31;  // all ones for odd q
+    sin = (fv)((uv)select(swap, cx, sx) ^ ((q & 2u) << 30));
+    cos = (fv)((uv)select(swap, sx, cx) ^ (((q + 1u) & 2u) << 30));
+  }
+  typedef float f4 __attribute__((vector_size(16)));
+  typedef double d4 __attribute__((vector_size(32)));
+  /// Pair L's normals of transforms j and j + 1 (lanes 2L, 2L + 1 of g0 and g1) as 4 doubles to dst (one 32-byte
+  /// store), or only transform j's 2 when j + 1 is past the last. e and o: g0 and g1 interleaved within each
+  /// 16 bytes (unpcklps / unpckhps), so that their 16-byte parts are pair 0, 2, 4, ... and 1, 3, 5, ...'s blocks.
+  template <int L> static void store_noise(fv e, fv o, double* dst, bool both) {
+    const fv& src = L % 2 == 0 ? e : o;
+    const f4 v = __builtin_shufflevector(src, src, 4 * (L / 2), 4 * (L / 2) + 1, 4 * (L / 2) + 2, 4 * (L / 2) + 3);
+    // vcvtps2pd ymm, xmm (every SIMD set here has AVX): GCC's own conversion went through two 2-lane conversions,
+    // a stack copy and an insert.
+    const d4 d = (d4)_mm256_cvtps_pd((__m128)v);
+    if (both) std::memcpy(dst, &d, sizeof d);
+    else std::memcpy(dst, &d, sizeof d / 2);
+  }
+  template <int L> static void store_noise_lanes(fv e, fv o, double* out, std::size_t per_pair, int lanes,
+                                                 bool both) {
+    if constexpr (L < W) {
+      if (L >= lanes) return;
+      store_noise<L>(e, o, out + std::size_t(L) * per_pair, both);
+      store_noise_lanes<L + 1>(e, o, out, per_pair, lanes, both);
+    }
+  }
+  static void store_noise_all(fv g0, fv g1, double* out, std::size_t per_pair, int lanes, bool both) {
+#if BATCHCOL_SIMD_BYTES == 32
+    const fv e = __builtin_shufflevector(g0, g1, 0, 8, 1, 9, 4, 12, 5, 13);
+    const fv o = __builtin_shufflevector(g0, g1, 2, 10, 3, 11, 6, 14, 7, 15);
+    store_noise_lanes<0>(e, o, out, per_pair, lanes, both);
+#elif BATCHCOL_SIMD_BYTES == 64
+    const fv e = __builtin_shufflevector(g0, g1, 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29);
+    const fv o = __builtin_shufflevector(g0, g1, 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31);
+    store_noise_lanes<0>(e, o, out, per_pair, lanes, both);
+#else
+    (void)per_pair, (void)lanes;
+    const d4 d = __builtin_convertvector(__builtin_shufflevector(g0, g1, 0, 2, 1, 3), d4);
+    if (both) std::memcpy(out, &d, sizeof d);
+    else std::memcpy(out, &d, sizeof d / 2);
+#endif
+  }
+
   /// engine/src/counter_rng.hpp's support_noise_pair(keys[p], j) for every j < 3 draws of pairs p < `pairs` into
   /// z[6 draws p + 2 j], z[6 draws p + 2 j + 1] (smoothed1's noise of a store block's pairs), W pairs per register:
   /// the lanes are pairs, so their keys are one load and each j one 64-bit mix per lane (no per-lane key set-up).
-  /// The 32-bit halves convert exactly through the 2^52 exponent trick on every set.
+  /// Two mixes (j, j + 1) fill one float register of 2 W transforms: their 32-bit halves interleave in place
+  /// (lane 2l + i: transform j + i of pair l), and pair l's 4 normals are one 32-byte store.
   static void support_noise(const std::uint64_t* keys, std::size_t pairs, std::size_t draws, double* z) {
     const std::size_t per_pair = 6 * draws, transforms = 3 * draws;
-    const u64 low32 = u64{} + 0xFFFFFFFFull, exponent = u64{} + 0x4330000000000000ull;
     for (std::size_t p0 = 0; p0 < pairs; p0 += W) {
       const int lanes = int(std::min<std::size_t>(W, pairs - p0));
       u64 key{};
       for (int l = 0; l < W; ++l) key[l] = keys[p0 + std::size_t(std::min(l, lanes - 1))];  // padding: unstored
       double* const out = z + p0 * per_pair;
-      for (std::size_t j = 0; j < transforms; ++j) {
-        const u64 x = splitmix(key + j * 0x9E3779B97F4A7C15ull);
-        const real hi = (real)((x >> 32) | exponent) - 0x1.0p52, lo = (real)((x & low32) | exponent) - 0x1.0p52;
-        const real radius = wsqrt<double>(-2.0 * log_unit_short((hi + 1.0) * 0x1.0p-32));
-        real s, c;
-        sincos_turn_short(lo * 0x1.0p-32, s, c);
-        const real g0 = radius * c, g1 = radius * s;
-        for (int l = 0; l < lanes; ++l) {
-          const double two[2] = {g0[l], g1[l]};
-          std::memcpy(out + std::size_t(l) * per_pair + 2 * j, two, sizeof two);
-        }
+      for (std::size_t j = 0; j < transforms; j += 2) {
+        const u64 xa = splitmix(key + j * 0x9E3779B97F4A7C15ull), xb = splitmix(key + (j + 1) * 0x9E3779B97F4A7C15ull);
+        const uv hi = (uv)((xa >> 33) | ((xb >> 1) & 0x7FFFFFFF00000000ull));  // the top 31 bits of each
+        const uv lo = (uv)((xa & 0xFFFFFFFFull) | (xb << 32));
+        const fv radius = fsqrt(minus_two_log_unit_f(hi));
+        fv s, c;
+        sincos_turn_f(lo, s, c);
+        store_noise_all(radius * c, radius * s, out + 2 * j, per_pair, lanes, j + 1 < transforms);
       }
     }
   }

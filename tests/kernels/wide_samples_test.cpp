@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -212,6 +213,29 @@ TEST(WideSamples, SupportNoiseIsStandardNormal) {
   EXPECT_NEAR(cross / (n / 2), 0.0, 6.0 / std::sqrt(n / 2));
   const double p3 = 0.0026997960632601866;
   EXPECT_NEAR(tail / n, p3, 6.0 * std::sqrt(p3 * (1 - p3) / n));
+}
+
+TEST(WideSamples, SupportNoiseFloatPiecesFollowLibm) {
+  // support_noise_pair()'s float -2 log(u) and sin/cos of a 2^-32 turn against libm in double, over the radius
+  // uniform's extremes (h = 0: u = 2^-31, the largest radius; h = 2^31 - 1: u = 1) and 2^20 mixed inputs. Bounds:
+  // a few float roundings (2^-24 = 6e-8 each) of the result, the series' remainders being below 3e-8.
+  std::uint64_t state = 11;
+  double worst_log = 0, worst_trig = 0;
+  for (int i = 0; i < (1 << 20) + 2; ++i) {
+    state = detail::splitmix64(state);
+    const std::uint32_t h = i == 0 ? 0u : i == 1 ? 0x7FFFFFFFu : std::uint32_t(state >> 33), a = std::uint32_t(state);
+    const float u = (static_cast<float>(static_cast<std::int32_t>(h)) + 1.0f) * 0x1.0p-31f;  // the uniform exactly
+    const double want = -2.0 * std::log(double(u)), got = detail::minus_two_log_unit_f(h);
+    ASSERT_GE(got, 0.0) << h;
+    worst_log = std::max(worst_log, std::abs(got - want) / std::max(want, 1e-30));
+    float s, c;
+    detail::sincos_turn_f(a, s, c);
+    const double angle = 6.283185307179586 * double(a) * 0x1.0p-32;
+    worst_trig = std::max({worst_trig, std::abs(s - std::sin(angle)), std::abs(c - std::cos(angle))});
+  }
+  EXPECT_LT(worst_log, 5e-7);
+  EXPECT_LT(worst_trig, 5e-7);
+  std::printf("worst relative -2 log error %.3g, worst sin/cos error %.3g\n", worst_log, worst_trig);
 }
 
 TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
