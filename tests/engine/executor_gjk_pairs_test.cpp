@@ -203,19 +203,25 @@ PairResults reference(const Scene& s, const QueryOptions& o, const PairResults& 
   return r;
 }
 
+/// The options of the bitwise tests below: 2 threads, so that the work is split across tiles.
+QueryOptions bits_options(QueryLevel level, Solver solver, Precision precision, bool closed_forms) {
+  QueryOptions o;
+  o.level = level;
+  o.solver = solver;
+  o.precision = precision;
+  o.closed_forms = closed_forms;
+  o.threads = 2;
+  return o;
+}
+
 template <class T> void expect_reference_bits(Precision precision) {
   const Scene s = gjk_scene(6000, precision == Precision::float64 ? 11 : 12);
   for (bool closed_forms : {false, true})
     for (QueryLevel level : {QueryLevel::boolean, QueryLevel::distance, QueryLevel::witness})
       for (Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
-        QueryOptions o;
-        o.level = level;
-        o.solver = solver;
-        o.precision = precision;
-        // Off: every pair goes through GJK. On: the closed-form type pairs (sphere-box included) must still be
-        // routed to their closed forms, and the rest to GJK.
-        o.closed_forms = closed_forms;
-        o.threads = 2;
+        // closed_forms off: every pair goes through GJK. On: the closed-form type pairs (sphere-box included) must
+        // still be routed to their closed forms, and the rest to GJK.
+        const QueryOptions o = bits_options(level, solver, precision, closed_forms);
         PairResults got;
         collide(s.shapes, s.batch, o, got);
         testing::expect_same_results(reference<T>(s, o, got), got,
@@ -235,12 +241,7 @@ TEST(ExecutorGjkPairs, ConcentricBooleanPairsHaveTheScalarReferenceBits) {
   for (Precision precision : {Precision::float64, Precision::float32}) {
     const Scene s = gjk_scene(3000, 13, 5);
     for (Solver solver : {Solver::gjk, Solver::nesterov, Solver::polyak}) {
-      QueryOptions o;
-      o.level = QueryLevel::boolean;
-      o.solver = solver;
-      o.precision = precision;
-      o.closed_forms = false;
-      o.threads = 2;
+      const QueryOptions o = bits_options(QueryLevel::boolean, solver, precision, false);
       PairResults got;
       collide(s.shapes, s.batch, o, got);
       const std::string what = std::string(to_string(solver)) + (precision == Precision::float64 ? " double" : " float");
