@@ -45,15 +45,12 @@ struct Smoothed1Lanes {
 /// symmetric PSD; the caller's projection onto that cone removes sampling noise that could make the
 /// implicit-function matrix singular, a bias that vanishes as M grows. z[c][k] (c < 3, k < (M + 1) / 2; z[3] is not
 /// read): the noise of antithetic pair k (the caller draws it: kernels::simd::draw_support_noise() for both sides
-/// of 8 pairs at a time, counter_rng.hpp's support_noise_pair()). `view`: the
-/// shape's plain record (ShapeTableAccess::view()). `isa` (resolved): AVX2 and AVX-512 scan small hulls four
-/// directions per AVX2 register and take the ellipsoid sample differences, the hull differences and the sample sums
-/// in AVX2 registers (at M = 4, scanned hulls and ellipsoids without inflation: all in registers),
-/// with the same bits as the baseline set.
-Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
-                                          const double* const* z, InstructionSet isa = InstructionSet::scalar);
-/// The same for shape `shape` of `shapes` (the bits of the view's call): the M = 4 AVX2 path reads the table's
-/// type, inflation, radii and hull arrays instead of a ShapeView built per side (smoothed1's per-pair calls).
+/// of 8 pairs at a time, counter_rng.hpp's support_noise_pair()). The shape: shape `shape` of `shapes`; the
+/// M = 4 AVX2 path reads the table's type, inflation, radii and hull arrays, the others its plain record
+/// (ShapeTableAccess::view()), not a ShapeView built per side for every call. `isa` (resolved): AVX2 and AVX-512
+/// scan small hulls four directions per AVX2 register and take the ellipsoid sample differences, the hull
+/// differences and the sample sums in AVX2 registers (at M = 4, scanned hulls and ellipsoids without inflation: all
+/// in registers), with the same bits as the baseline set.
 Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
                                           double e, int samples, const double* const* z, InstructionSet isa);
 

@@ -378,20 +378,9 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
 
 }  // namespace
 
-Eigen::Matrix3d smoothed_support_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e, int samples,
-                                          const double* const* z, InstructionSet isa) {
-  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
-  Eigen::Matrix3d S;
-  if (estimate4_case(wide, samples, view.type, view.inflation, view.hull))
-    estimate4_avx2(view.type, view.size, view.hull, u.data(), e, z, S.data());
-  else
-    S = general_estimate(view, u, e, samples, z, wide);
-  return S;
-}
-
 Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
                                           double e, int samples, const double* const* z, InstructionSet isa) {
-  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;
+  const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
   const ShapeType type = ShapeTableAccess::types(shapes)[shape];
   const HullView* hull = &ShapeTableAccess::hulls(shapes)[shape];
   Eigen::Matrix3d S;
