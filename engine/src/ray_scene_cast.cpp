@@ -77,7 +77,51 @@ double box_entry(const BvhBox& b, const RayContext& r, double t_far) {
 class Caster {
  public:
   Caster(const RaySceneIndex::State& s, const RayOptions& o, int isa)
-      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse(isa)), isa_(isa) {}
+      : s_(s), gjk_{o.tolerance, o.max_iterations}, wide_(select_wide_traverse(isa)),
+        packet_(select_wide_packet_traverse(isa)), isa_(isa) {}
+
+  // True when the closest hit of a ray does not depend on the order in which its leaves are visited, nor on how
+  // many: every shape has an exact kernel whose hit parameter and status do not depend on the limit it is tested
+  // with (finish(): the limit only accepts or rejects), so the answer is the least (t, slot) over the objects the
+  // ray hits, whichever superset of the leaves the pruning allows is tested. Not hulls (the walk starts from the
+  // limit-clipped ball) nor the GJK ray cast of inflated shapes (its iterations and status depend on the limit).
+  bool order_free() const {
+    if (s_.wide.nodes().empty()) return false;
+    for (const kr::RayShape<double>& shape : s_.prepared.shapes) {
+      const ShapeType type = shape.core.type;
+      if (type == ShapeType::convex) return false;
+      if (shape.inflation > 0.0 && type != ShapeType::sphere && type != ShapeType::capsule &&
+          type != ShapeType::halfspace)
+        return false;
+    }
+    return true;
+  }
+
+  // Closest hits of n rays of one direction octant (wide_ok) through the packet traversal: the halfspaces first, as
+  // closest_or_any(), then the tree; for order_free() scenes only (the same answers as one ray at a time).
+  void closest_packet(const RayContext* r, unsigned n, Hit* best, bool* found, bool* capped) const {
+    double limit[kWidePacketLanes];
+    float lim[kWidePacketLanes];
+    const WideRay* wide[kWidePacketLanes];
+    Hit h;
+    for (unsigned l = 0; l < n; ++l) {
+      limit[l] = r[l].t_max;
+      for (const RayObject& obj : s_.halfspaces)
+        if (test(obj, r[l], limit[l], h, capped[l]) && (!found[l] || before(h, best[l])))
+          best[l] = h, found[l] = true, limit[l] = best[l].t;
+      lim[l] = wide_limit(limit[l]);
+      wide[l] = r[l].wide;
+    }
+    auto leaf = [&](unsigned l, std::uint32_t k, float& fl) {
+      if (test(s_.leaves[k].object, r[l], limit[l], h, capped[l]) && (!found[l] || before(h, best[l]))) {
+        best[l] = h, found[l] = true, limit[l] = best[l].t;
+        fl = wide_limit(limit[l]);
+      }
+    };
+    using Leaf = decltype(leaf);
+    packet_(s_.wide.nodes().data(), wide, n, lim,
+            [](void* c, unsigned l, std::uint32_t k, float& fl) { (*static_cast<Leaf*>(c))(l, k, fl); }, &leaf);
+  }
 
   // The traversal's per-tree settings in the setup's rays: leaves whose ball the ray misses are skipped without a
   // call, and on trees larger than the L2 pushed nodes are prefetched.
@@ -238,6 +282,7 @@ class Caster {
   const RaySceneIndex::State& s_;
   kr::RayGjkSettings gjk_;
   WideTraverse wide_;
+  WidePacketTraverse packet_;
   int isa_;  // RayOptions::isa (ray_isa_index()): the hulls' clipping loop follows it as the traversal does
 };
 
@@ -352,6 +397,86 @@ class RayOrder {
   CastResult* results_;
 };
 
+// The ordered cast of closest hits in packets (Caster::closest_packet): each group of kWidePacketLanes rays in cast
+// order (neighbours in origin and direction: ray_order_keys.hpp) splits by direction octant; octants of two or more
+// rays go through the tree together, single rays and rays outside the float test's range one at a time. Groups lie
+// inside the fixed chunks, and each ray's answer is its own (order_free()): the same bits for any thread count.
+// Why: in this order neighbouring rays cross many of the same nodes. Counted on 100k mixed objects x 1M rays (1
+// thread): 29.6 node tests a ray; distinct nodes over aligned groups of 2 / 8 / 32 / 64 rays 23.2 / 14.1 / 8.8 / 6.9
+// a ray (sharing 1.28x / 2.10x / 3.38x / 4.29x). A packet loads and pops each node once for its rays and overlaps
+// the rays' tests (independent work) where the one-ray loop runs one dependent node step after another.
+void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) {
+  constexpr std::size_t kGroup = kWidePacketLanes;
+  const std::size_t n = order.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+    const WideRayRecord* group[kGroup];
+    WideRay wide[kGroup];
+    std::uint8_t status[kGroup];
+    RayContext ctx[kGroup], packet[kGroup];
+    Hit best[kGroup];
+    bool found[kGroup], capped[kGroup];
+    unsigned lane_of[kGroup];
+    for (std::size_t c = range.begin(); c != range.end(); ++c) {
+      const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
+      for (std::size_t k = begin; k < end; k += kGroup) {
+        const std::size_t m = std::min(kGroup, end - k);
+        for (std::size_t l = 0; l < m && k + kGroup + l < end; ++l) order.prefetch(k + kGroup + l);
+        for (std::size_t l = 0; l < m; ++l) group[l] = &order.ray(k + l);
+        for (std::size_t s = 0; s < m; s += kWideRaySetupLanes)
+          setup(group + s, std::min(kWideRaySetupLanes, m - s), wide + s, status + s);
+        caster.prepare(wide, m);
+        std::uint32_t wide_lanes = 0;
+        for (std::size_t l = 0; l < m; ++l) {
+          found[l] = false, capped[l] = false;
+          if (status[l] == kWideRayInvalid) continue;
+          const PackedRay& p = *group[l];
+          RayContext& r = ctx[l];
+          r.o = Vec3<double>(p.o[0], p.o[1], p.o[2]);
+          r.d = Vec3<double>(p.d[0], p.d[1], p.d[2]);
+          r.t_max = p.t_max;
+          r.d2 = r.d.squaredNorm();
+          r.wide_ok = status[l] == kWideRaySupported;
+          r.wide = &wide[l];
+          if (r.wide_ok)
+            wide_lanes |= 1u << l;
+          else
+            caster.closest_or_any(r, false, best[l], found[l], capped[l]);
+        }
+        while (wide_lanes != 0) {
+          const std::uint32_t octant = wide[__builtin_ctz(wide_lanes)].octant;
+          unsigned count = 0;
+          for (std::uint32_t b = wide_lanes; b != 0; b &= b - 1) {
+            const unsigned l = unsigned(__builtin_ctz(b));
+            if (wide[l].octant != octant) continue;
+            lane_of[count] = l, packet[count] = ctx[l], ++count;
+            wide_lanes &= ~(1u << l);
+          }
+          if (count == 1) {
+            const unsigned l = lane_of[0];
+            caster.closest_or_any(ctx[l], false, best[l], found[l], capped[l]);
+            continue;
+          }
+          Hit pb[kWidePacketLanes];
+          bool pf[kWidePacketLanes] = {}, pc[kWidePacketLanes] = {};
+          caster.closest_packet(packet, count, pb, pf, pc);
+          for (unsigned j = 0; j < count; ++j) {
+            const unsigned l = lane_of[j];
+            best[l] = pb[j], found[l] = pf[j], capped[l] = pc[j];
+          }
+        }
+        for (std::size_t l = 0; l < m; ++l) {
+          CastResult& res = order.result(k + l);
+          res.found = found[l];
+          if (found[l]) res.best = best[l];
+          res.status = status[l] == kWideRayInvalid ? RayStatus::invalid_input
+                       : capped[l]                 ? RayStatus::max_iterations
+                                                   : RayStatus::ok;
+        }
+      }
+    }
+  });
+}
+
 }  // namespace
 
 void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayResults& out) const {
@@ -383,7 +508,13 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
     detail::run_with_threads(options.threads, [&] {
       RayOrder order(rays, state_->wide.nodes()[0], isa, arena);
       const bool any = options.query == RayQuery::any;
+      const bool packets = !any && caster.order_free();
       const WideRecordSetup setup = select_wide_record_setup(isa);
+      if (packets) {
+        cast_packets(order, caster, setup);
+        order.scatter(out);
+        return;
+      }
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
         const WideRayRecord* group[kWideRaySetupLanes];  // the next 8 records in cast order
         WideRay wide[kWideRaySetupLanes];

@@ -19,7 +19,13 @@ namespace wide_avx512 {
 #define BATCHCOL_WIDE_CMP(a, b, op) std::uint32_t(_mm512_cmp_ps_mask(__m512(a), __m512(b), op))
 #define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
 #define BATCHCOL_WIDE_ILT(a, b) std::uint32_t(_mm512_cmplt_epi32_mask(__m512i(a), __m512i(b)))
+#define BATCHCOL_WIDE_LE8(a, b) std::uint32_t(_mm256_cmp_ps_mask(__m256(a), __m256(b), _CMP_LE_OQ))
 #include "ray_wide_traverse.inl"
+#include "ray_wide_packet.inl"
+#undef BATCHCOL_WIDE_VLANES
+#undef BATCHCOL_WIDE_LE
+#undef BATCHCOL_WIDE_ILT
+#undef BATCHCOL_WIDE_LE8
 #undef BATCHCOL_WIDE_CMP
 }  // namespace wide_avx512
 #pragma GCC pop_options
@@ -32,7 +38,13 @@ namespace wide_avx2 {
 #define BATCHCOL_WIDE_LE(a, b) BATCHCOL_WIDE_CMP(a, b, _CMP_LE_OQ)
 #define BATCHCOL_WIDE_ILT(a, b) \
   std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(__m256i(b), __m256i(a)))))
+#define BATCHCOL_WIDE_LE8(a, b) BATCHCOL_WIDE_LE(a, b)
 #include "ray_wide_traverse.inl"
+#include "ray_wide_packet.inl"
+#undef BATCHCOL_WIDE_VLANES
+#undef BATCHCOL_WIDE_LE
+#undef BATCHCOL_WIDE_ILT
+#undef BATCHCOL_WIDE_LE8
 #undef BATCHCOL_WIDE_CMP
 #define BATCHCOL_SETUP_SQRT(v) D(_mm256_sqrt_pd(__m256d(v)))
 #include "ray_wide_setup.inl"
@@ -49,7 +61,13 @@ template <class Mask> inline std::uint32_t lane_bits(Mask m) {
 #define BATCHCOL_WIDE_VLANES 8
 #define BATCHCOL_WIDE_LE(a, b) lane_bits((a) <= (b))
 #define BATCHCOL_WIDE_ILT(a, b) lane_bits((a) < (b))
+#define BATCHCOL_WIDE_LE8(a, b) lane_bits((a) <= (b))
 #include "ray_wide_traverse.inl"
+#include "ray_wide_packet.inl"
+#undef BATCHCOL_WIDE_VLANES
+#undef BATCHCOL_WIDE_LE
+#undef BATCHCOL_WIDE_ILT
+#undef BATCHCOL_WIDE_LE8
 template <class V> inline V sqrt_lanes(V v) {
   for (int l = 0; l < 4; ++l) v[l] = __builtin_sqrt(v[l]);
   return v;
@@ -129,6 +147,21 @@ WideTraverse wide_traverse_for(int isa) {
                  : nullptr;
     default: return nullptr;
   }
+}
+
+WidePacketTraverse wide_packet_traverse_for(int isa) {
+  switch (isa) {
+    case 0: return &wide_baseline::traverse_packet;
+    case 1: return wide_traverse_for(1) ? &wide_avx2::traverse_packet : nullptr;
+    case 2: return wide_traverse_for(2) ? &wide_avx512::traverse_packet : nullptr;
+    default: return nullptr;
+  }
+}
+
+WidePacketTraverse select_wide_packet_traverse(int isa) {
+  for (; isa > 0; --isa)
+    if (WidePacketTraverse f = wide_packet_traverse_for(isa)) return f;
+  return wide_packet_traverse_for(0);
 }
 
 WideRaySetup wide_ray_setup_for(int isa) {

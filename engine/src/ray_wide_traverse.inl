@@ -2,6 +2,7 @@
 // `#pragma GCC target` region and a namespace of its own. Expects BATCHCOL_WIDE_VLANES (the lanes of one vector:
 // 16 or 8) and BATCHCOL_WIDE_LE(a, b) / BATCHCOL_WIDE_ILT(a, b): the lane bits of float a <= b and of signed 32-bit
 // a < b (the comparison straight to a mask: on AVX-512 a vector compare, a vector mask and its bits cost three steps).
+// The includer undefines them after ray_wide_packet.inl, which uses them too.
 
 namespace {
 
@@ -230,7 +231,3 @@ void traverse(const WideNode* nodes, const WideRay& r, float limit, WideLeafVisi
     default: return traverse_octant<7>(nodes, r, limit, visit, context);
   }
 }
-
-#undef BATCHCOL_WIDE_VLANES
-#undef BATCHCOL_WIDE_LE
-#undef BATCHCOL_WIDE_ILT

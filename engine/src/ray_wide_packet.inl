@@ -1,0 +1,178 @@
+// The packet traversal of the wide BVH (ray_wide_traverse.hpp: WidePacketTraverse), included after
+// ray_wide_traverse.inl in each instruction set's namespace (it uses that file's vector types and helpers), with
+// BATCHCOL_WIDE_LE8(a, b): the lane bits of a <= b for 8 floats.
+// Up to kWidePacketLanes rays of one direction octant walk the tree together: a node is popped once for the packet and
+// tested for each of its active rays (the same float slab test as the one-ray loop, ray by ray, so each ray's hit
+// children and entries are that loop's bits); the children any active ray reaches are visited nearest first by the
+// smallest entry over the rays reaching them (ties to the lower slot), each with the mask of the rays that reach it
+// and that smallest entry; a popped entry keeps the rays whose limit is not below it (a ray whose own entry is beyond
+// its limit may test the node once more and reach nothing, or test a leaf whose hit its limit then rejects).
+// A ray may visit leaves in another order than alone, and more of them (its limit falls later); its closest hit is
+// the same as long as an object's hit does not depend on the limit it is tested with (the caller's condition).
+
+namespace {
+
+typedef float V8 __attribute__((vector_size(32)));
+
+struct PacketEntry {
+  std::uint32_t ref;
+  std::uint32_t mask;  // bit l: lane l still follows this entry
+  float t;             // the smallest entry parameter over those lanes
+};
+
+template <int kOctant>
+void traverse_packet_octant(const WideNode* nodes, const WideRay* const* rays, unsigned n, float* limits,
+                            WidePacketVisit visit, void* context) {
+  constexpr bool neg_x = (kOctant & 1) != 0, neg_y = (kOctant & 2) != 0, neg_z = (kOctant & 4) != 0;
+  constexpr std::size_t near_x = neg_x ? offsetof(WideNode, hi_x) : offsetof(WideNode, lo_x);
+  constexpr std::size_t near_y = neg_y ? offsetof(WideNode, hi_y) : offsetof(WideNode, lo_y);
+  constexpr std::size_t near_z = neg_z ? offsetof(WideNode, hi_z) : offsetof(WideNode, lo_z);
+  constexpr std::size_t far_x = neg_x ? offsetof(WideNode, lo_x) : offsetof(WideNode, hi_x);
+  constexpr std::size_t far_y = neg_y ? offsetof(WideNode, lo_y) : offsetof(WideNode, hi_y);
+  constexpr std::size_t far_z = neg_z ? offsetof(WideNode, lo_z) : offsetof(WideNode, hi_z);
+  const WideRay& r0 = *rays[0];  // balls and prefetch are the tree's, the same in every lane
+  // Each lane's slab constants side by side (one broadcast load each in the node test).
+  struct LaneConstants {
+    float on[3], of[3], ni[3];
+  };
+  LaneConstants c[kWidePacketLanes];
+  for (unsigned l = 0; l < n; ++l)
+    for (int k = 0; k < 3; ++k)
+      c[l].on[k] = rays[l]->o_near[k], c[l].of[k] = rays[l]->o_far[k], c[l].ni[k] = -rays[l]->inv[k];
+  float zero_scalar = 0.0f;
+  __asm__("" : "+x"(zero_scalar));  // as in the one-ray loop: one ordered max, not a compare and a mask
+  const V zero = splat(zero_scalar), scale = splat(kFarScale), slack = splat(kFarSlack);
+  const V inf = splat(__builtin_inff());
+  alignas(64) float lim[kWidePacketLanes];
+  for (unsigned l = 0; l < kWidePacketLanes; ++l) lim[l] = l < n ? limits[l] : -1.0f;
+  PacketEntry stack[64 * (kWideArity - 1) + 2];
+  int top = 0;
+  // The current entry: its reference and lanes (the root: every lane). Lanes >= n never pass the pop's test.
+  std::uint32_t ref = 0, mask = n >= 32 ? ~0u : (1u << n) - 1u;
+  const auto pop = [&] {
+    for (;;) {
+      if (top == 0) return false;
+      const PacketEntry& p = stack[--top];
+      const float t = p.t;
+      const V8 tv = {t, t, t, t, t, t, t, t};
+      std::uint32_t m = 0;
+      for (unsigned h = 0; h < kWidePacketLanes / 8; ++h) {
+        V8 l;
+        __builtin_memcpy(&l, lim + 8 * h, sizeof l);
+        m |= BATCHCOL_WIDE_LE8(tv, l) << (8 * h);
+      }
+      m &= p.mask;
+      if (m != 0) {
+        ref = p.ref, mask = m;
+        return true;
+      }
+    }
+  };
+  for (;;) {
+    if (ref & kLeafBit) {
+      const std::uint32_t leaf = ref & ~kLeafBit;
+      const float* ball = r0.balls != nullptr ? r0.balls + std::size_t(r0.ball_stride) * leaf : nullptr;
+      for (std::uint32_t b = mask; b != 0; b &= b - 1) {
+        const unsigned l = unsigned(__builtin_ctz(b));
+        if (ball != nullptr && ball_misses(ball, *rays[l])) continue;
+        visit(context, l, leaf, limits[l]);
+        lim[l] = limits[l];
+      }
+      if (!pop()) return;
+      continue;
+    }
+    const WideNode* node = nodes + ref;
+    V key[kParts];  // per slot, the smallest entry over the lanes reaching it (+inf: none)
+    VI lanes[kParts];  // per slot, bit l: lane l reaches it
+    for (int p = 0; p < kParts; ++p) key[p] = inf, lanes[p] = splat_int(0);
+    std::uint32_t reached = 0;
+    for (std::uint32_t b = mask; b != 0; b &= b - 1) {
+      const unsigned l = unsigned(__builtin_ctz(b));
+      const LaneConstants& r = c[l];
+      const V lim_v = splat(lim[l]);
+      std::uint32_t bits = 0;
+      for (int p = 0; p < kParts; ++p) {
+        const std::size_t at = sizeof(V) * std::size_t(p);
+        const V nix = splat(r.ni[0]), niy = splat(r.ni[1]), niz = splat(r.ni[2]);
+        V a = zero;
+        a = max_into((splat(r.on[0]) - load_at(node, near_x + at)) * nix, a);
+        a = max_into((splat(r.on[1]) - load_at(node, near_y + at)) * niy, a);
+        a = max_into((splat(r.on[2]) - load_at(node, near_z + at)) * niz, a);
+        V f = lim_v;
+        f = min_into((splat(r.of[0]) - load_at(node, far_x + at)) * nix, f);
+        f = min_into((splat(r.of[1]) - load_at(node, far_y + at)) * niy, f);
+        f = min_into((splat(r.of[2]) - load_at(node, far_z + at)) * niz, f);
+        f = f * scale + slack;
+        const auto hit = a <= f;
+        key[p] = (hit & (a < key[p])) ? a : key[p];
+        lanes[p] |= hit & splat_int(std::int32_t(1u << l));
+        bits |= BATCHCOL_WIDE_LE(a, f) << (kVLanes * p);
+      }
+      reached |= bits;
+    }
+    if (reached == 0) {
+      if (!pop()) return;
+      continue;
+    }
+    const auto slot_key = [&key](std::size_t k) {
+      float t;
+      __builtin_memcpy(&t, reinterpret_cast<const char*>(key) + sizeof(float) * k, sizeof t);
+      return t;
+    };
+    const auto slot_lanes = [&lanes](std::size_t k) {
+      std::uint32_t m;
+      __builtin_memcpy(&m, reinterpret_cast<const char*>(lanes) + sizeof(std::uint32_t) * k, sizeof m);
+      return m;
+    };
+    // Slot k as a stack entry: its child, lanes and their smallest entry.
+    const auto write = [&](PacketEntry& e, std::size_t k) {
+      e.ref = node->child[k];
+      e.mask = slot_lanes(k);
+      e.t = slot_key(k);
+      if (r0.prefetch) prefetch_child(nodes, e.ref, r0);
+    };
+    if ((reached & (reached - 1)) == 0) {  // one slot: next, with the lanes that reach it
+      const int k = __builtin_ctz(reached);
+      ref = node->child[k], mask = slot_lanes(std::size_t(k));
+      continue;
+    }
+    // Ranks by key, ties to the lower slot, as the one-ray loop's rank (keys are +0, positive or +inf).
+    const int count = __builtin_popcount(reached);
+    PacketEntry* const base = stack + top + count - 1;
+    VI key_bits[kParts];
+    __builtin_memcpy(key_bits, key, sizeof key_bits);
+    std::size_t first = 0;
+    for (std::uint64_t b = reached; b != 0; b &= b - 1) {
+      const std::size_t k = std::size_t(__builtin_ctzll(b));
+      std::int32_t t_bits;
+      const float t = slot_key(k);
+      __builtin_memcpy(&t_bits, &t, sizeof t_bits);
+      const VI tk = splat_int(t_bits);
+      std::uint32_t nearer = 0;
+      for (int p = 0; p < kParts; ++p)
+        nearer |= BATCHCOL_WIDE_ILT(key_bits[p] - load_int(kLowerOnes.row[k] + kVLanes * p), tk) << (kVLanes * p);
+      const std::ptrdiff_t rank = __builtin_popcountll(std::uint64_t(reached & nearer));
+      if (rank == 0)
+        first = k;
+      else
+        write(base[-rank], k);
+    }
+    top += count - 1;
+    ref = node->child[first], mask = slot_lanes(first);
+  }
+}
+}  // namespace
+
+void traverse_packet(const WideNode* nodes, const WideRay* const* rays, unsigned n, float* limits,
+                     WidePacketVisit visit, void* context) {
+  switch (rays[0]->octant) {
+    case 0: return traverse_packet_octant<0>(nodes, rays, n, limits, visit, context);
+    case 1: return traverse_packet_octant<1>(nodes, rays, n, limits, visit, context);
+    case 2: return traverse_packet_octant<2>(nodes, rays, n, limits, visit, context);
+    case 3: return traverse_packet_octant<3>(nodes, rays, n, limits, visit, context);
+    case 4: return traverse_packet_octant<4>(nodes, rays, n, limits, visit, context);
+    case 5: return traverse_packet_octant<5>(nodes, rays, n, limits, visit, context);
+    case 6: return traverse_packet_octant<6>(nodes, rays, n, limits, visit, context);
+    default: return traverse_packet_octant<7>(nodes, rays, n, limits, visit, context);
+  }
+}
