@@ -5,6 +5,7 @@
 #include <immintrin.h>  // the lanes' square roots (SSE2 here; AVX2 / AVX-512 under their target pragmas)
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <type_traits>
@@ -72,6 +73,15 @@ using V = double __attribute__((vector_size(16)));
 template <std::size_t kLanes> bool whole_block(std::size_t count, const std::size_t* column) {
   if (count != kLanes) return false;
   for (std::size_t l = 0; l < kLanes; ++l)
+    if (column[l] != l) return false;
+  return true;
+}
+
+// Lanes 0 .. count - 1 go to columns 0 .. count - 1 (1 <= count): a block AVX-512 runs in one register, with a lane
+// mask when count < kLanes.
+inline bool in_order(std::size_t count, const std::size_t* column) {
+  if (count == 0) return false;
+  for (std::size_t l = 0; l < count; ++l)
     if (column[l] != l) return false;
   return true;
 }
@@ -147,6 +157,61 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 }
 }  // namespace
 #include "derivative_lanes.inl"
+namespace {
+// A block of `count` pairs to columns 0 .. count - 1 of out[e] + at, one register whatever the count: fewer than
+// kLanes pairs (a task range's first and last blocks, StoreBlock's line alignment) with a lane mask, whole blocks
+// with plain stores, or in whole lines with non-temporal stores (StreamRows; e is a constant in each store after
+// unrolling, so a row's test is one bit test of a register). The lanes' arithmetic does not depend on the store:
+// the same bits.
+template <class Block> void store_block(std::size_t count, StreamRows* stream, double* const* out, std::size_t at,
+                                        const Block& block) {
+  if (count < 8) {
+    const __mmask8 mask = static_cast<__mmask8>((1u << count) - 1);
+    block([out, at, mask](int e, const V8& v) { _mm512_mask_storeu_pd(out[e] + at, mask, (__m512d)v); });
+  } else if (stream) {
+    const std::uint64_t low = stream->whole[0], high = stream->whole[1];
+    const bool carried = stream->carried;
+    StreamRows& rows = *stream;
+    block([out, at, low, high, carried, &rows](int e, const V8& v) {
+      if ((e < 64 ? low >> e : high >> (e - 64)) & 1) return _mm512_stream_pd(out[e] + at, (__m512d)v);
+      // Lane j of the line: carry lane j + 8 - shift for j < shift, this block's lane j - shift after.
+      const std::int64_t shift = rows.shift[e];
+      const __m512i index = _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
+      const __m512d line = _mm512_permutex2var_pd(_mm512_load_pd(rows.carry[e]), index, (__m512d)v);
+      double* const start = out[e] + at - shift;
+      if (carried) _mm512_stream_pd(start, line);
+      else _mm512_mask_storeu_pd(start, static_cast<__mmask8>(0xFFu << shift), line);
+      _mm512_store_pd(rows.carry[e], (__m512d)v);
+    });
+  } else {
+    block([out, at](int e, const V8& v) { store_lanes(out[e], at, v); });
+  }
+}
+void flush_carry(StreamRows& rows, double* const* out, std::size_t at) {
+  for (int e = 0; e < StoreEntries; ++e) {
+    const std::int64_t shift = rows.shift[e];
+    if (shift == 0) continue;
+    // The line after the block's: its first `shift` lanes are the block's last.
+    const __m512i index = _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
+    const __m512d carry = _mm512_load_pd(rows.carry[e]);
+    _mm512_mask_storeu_pd(out[e] + at + 8 - shift, static_cast<__mmask8>((1u << shift) - 1),
+                          _mm512_permutex2var_pd(carry, index, carry));
+  }
+  rows.carried = false;
+}
+template <bool kNormalB, bool kCurved, bool kGiven>
+void smooth_to(const SmoothLanes& s, std::size_t count, StreamRows* stream, double* const* out,
+               std::size_t at) {
+  store_block(count, stream, out, at, [&s](const auto& store) {
+    smooth_block<V8, kNormalB, kCurved, kGiven>(s, store);
+  });
+}
+void polytope_to(const PolytopeLanes& lanes, std::size_t count, StreamRows* stream, double* const* out,
+                 std::size_t at) {
+  store_block(count, stream, out, at, [&lanes](const auto& store) { polytope_block<V8>(lanes, store); });
+}
+}  // namespace
+void flush_stream_carry(StreamRows& rows, double* const* out, std::size_t at) { flush_carry(rows, out, at); }
 }  // namespace lanes_avx512
 #pragma GCC pop_options
 #pragma GCC push_options
@@ -175,8 +240,22 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 }
 }  // namespace
 #include "derivative_lanes.inl"
+namespace {
+// A whole block to columns 0 .. kLanes - 1 of out[e] + at.
+template <bool kNormalB, bool kCurved, bool kGiven>
+void smooth_to(const SmoothLanes& s, double* const* out, std::size_t at) {
+  smooth_block<V8, kNormalB, kCurved, kGiven>(s, [out, at](int e, const V8& v) { store_lanes(out[e], at, v); });
+}
+void polytope_to(const PolytopeLanes& lanes, double* const* out, std::size_t at) {
+  polytope_block<V8>(lanes, [out, at](int e, const V8& v) { store_lanes(out[e], at, v); });
+}
+}  // namespace
 }  // namespace lanes_avx2
 #pragma GCC pop_options
+
+void flush_stream_carry(StreamRows& rows, double* const* out, std::size_t at) {
+  lanes_avx512::flush_stream_carry(rows, out, at);
+}
 
 // Separated pairs without flats (the smooth common case, every ellipsoid pair): M0 = sd I + H_a + H_b >= sd I is
 // symmetric positive definite, so K is its explicit inverse (cofactors over the determinant, which is >= sd^3 > 0).
@@ -185,35 +264,36 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 //   I - sd K),   dn/dxi_a = -(I - n n^T) y;
 // the twist of b by the rigid-motion identity (as write_from_twist_a()); the lanes' arithmetic is in
 // derivative_lanes.inl. Here: which set's lanes run a block (the wide ones only for a whole block on AVX2 / AVX-512).
-void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa, std::size_t at) const {
+void SmoothLanes::solve(double* const* out, bool normal_b_only, InstructionSet isa, std::size_t at,
+                        StreamRows* stream) const {
   if (normal_b_only) {
-    if (!curved) solve_lanes<true, false, true>(out, isa, at);
-    else if (given) solve_lanes<true, true, true>(out, isa, at);
-    else solve_lanes<true, true, false>(out, isa, at);
+    if (!curved) solve_lanes<true, false, true>(out, isa, at, stream);
+    else if (given) solve_lanes<true, true, true>(out, isa, at, stream);
+    else solve_lanes<true, true, false>(out, isa, at, stream);
   } else {
-    if (!curved) solve_lanes<false, false, true>(out, isa, at);
-    else if (given) solve_lanes<false, true, true>(out, isa, at);
-    else solve_lanes<false, true, false>(out, isa, at);
+    if (!curved) solve_lanes<false, false, true>(out, isa, at, stream);
+    else if (given) solve_lanes<false, true, true>(out, isa, at, stream);
+    else solve_lanes<false, true, false>(out, isa, at, stream);
   }
 }
 
 template <bool kNormalB, bool kCurved, bool kGiven>
-void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa, std::size_t at) const {
-  if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
-    return lanes_avx512::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out, at);
+void SmoothLanes::solve_lanes(double* const* out, InstructionSet isa, std::size_t at, StreamRows* stream) const {
+  if (isa == InstructionSet::avx512 && in_order(count, column))
+    return lanes_avx512::smooth_to<kNormalB, kCurved, kGiven>(*this, count, stream, out, at);
   if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
-    return lanes_avx2::smooth_block<V8, kNormalB, kCurved, kGiven>(*this, out, at);
+    return lanes_avx2::smooth_to<kNormalB, kCurved, kGiven>(*this, out, at);
   run_lanes<kLanes>(count, column, out, at, [&](std::size_t l, const auto& put) {
     lanes_base::smooth_lanes<kNormalB, kCurved, kGiven, V>(*this, l, put);
   });
 }
 
 
-void PolytopeLanes::solve(double* const* out, InstructionSet isa, std::size_t at) const {
-  if (isa == InstructionSet::avx512 && whole_block<kLanes>(count, column))
-    return lanes_avx512::polytope_block<V8>(*this, out, at);
+void PolytopeLanes::solve(double* const* out, InstructionSet isa, std::size_t at, StreamRows* stream) const {
+  if (isa == InstructionSet::avx512 && in_order(count, column))
+    return lanes_avx512::polytope_to(*this, count, stream, out, at);
   if (isa == InstructionSet::avx2 && whole_block<kLanes>(count, column))
-    return lanes_avx2::polytope_block<V8>(*this, out, at);
+    return lanes_avx2::polytope_to(*this, out, at);
   run_lanes<kLanes>(count, column, out, at,
                     [&](std::size_t l, const auto& put) { lanes_base::polytope_lanes<V>(*this, l, put); });
 }

@@ -32,6 +32,7 @@
 #include <Eigen/Geometry>  // cross() in distance_gradients()
 
 #include <cstddef>
+#include <cstdint>
 
 namespace batchcol::detail {
 
@@ -91,6 +92,25 @@ static_assert(store_at::distance_a == 0 && store_at::distance_b == 6 && store_at
               store_at::witness_b_b == store_at::witness_b_a + 18 && store_at::normal_a == store_at::witness_b_b + 18 &&
               store_at::normal_b == store_at::normal_a + 18);
 
+/// How AVX-512 writes whole blocks of a large output (StoreBlock): every row in whole 64-byte lines with
+/// non-temporal stores, which write a line without first reading it and keep the output from evicting the cache.
+/// A block starts a line of the rows whose bit is set in `whole` (8 pairs: one aligned store). Another row's line
+/// starts shift[e] pairs before the block (1..7: the arrays are separate allocations): the block completes that
+/// line with the last shift[e] entries of the previous block, kept in carry[e], and keeps its own in carry[e]
+/// for the next line; `carried` says that carry holds the block just before (contiguous, this task range's),
+/// otherwise only the block's own part of the line is stored (a masked, regular store). The last block's carried
+/// entries are stored by flush_stream_carry().
+struct StreamRows {
+  std::uint64_t whole[2] = {0, 0};
+  std::int64_t shift[StoreEntries] = {};
+  alignas(64) double carry[StoreEntries][8];
+  bool carried = false;
+};
+
+/// Stores the carried entries of the whole block that started at pair `at` (masked regular stores) and clears
+/// `carried`.
+void flush_stream_carry(StreamRows& rows, double* const* out, std::size_t at);
+
 /// A sphere's or an ellipsoid's support-map Jacobian left to SmoothLanes to compute (world_support_jacobian()'s
 /// formula): the shape's rotation as the pose's quaternion (x, y, z, w, not normalised: the lanes normalise it and
 /// build the matrix as Eigen's normalized().toRotationMatrix() does, eight poses per register instead of one), its
@@ -139,14 +159,17 @@ struct SmoothLanes {
   /// normal_b_only: only normal_wrt_b's 18 entries (the other rows of `out` are left as they were).
   /// isa: a whole block (count == kLanes, columns 0, 1, 2, ...) runs in one 8-lane register of that set (AVX-512,
   /// AVX2); the same bits on every set.
+  /// AVX-512 also runs a block of fewer lanes in one register when its columns are 0 .. count - 1 (masked stores).
   /// at: added to every out[e] (out[e] + at is column 0): StoreBlock passes the output arrays' rows of pair 0 once
   /// computed and the block's first pair, instead of building 120 row pointers per flush.
+  /// stream (null: none): AVX-512 writes a whole block in whole 64-byte lines with non-temporal stores
+  /// (StreamRows).
   void solve(double* const* out, bool normal_b_only = false, InstructionSet isa = InstructionSet::scalar,
-             std::size_t at = 0) const;
+             std::size_t at = 0, StreamRows* stream = nullptr) const;
 
  private:
   template <bool kNormalB, bool kCurved, bool kGiven>
-  void solve_lanes(double* const* out, InstructionSet isa, std::size_t at) const;
+  void solve_lanes(double* const* out, InstructionSet isa, std::size_t at, StreamRows* stream) const;
   /// add() and add_given()'s common steps: the next lane's column and geometry (returns the lane); +0 in every
   /// lane's H0 (the lanes added before the first given side); a side with a given H0 (R = radii2 = round = 0).
   std::size_t take_lane(std::size_t column, const PairGeometry& g);
@@ -175,7 +198,8 @@ struct PolytopeLanes {
   /// edges): the general path decides. Defined in derivative_polytope_add.hpp, inlined into its caller.
   inline bool add(std::size_t column, const PairGeometry& g);
   /// As SmoothLanes::solve().
-  void solve(double* const* out, InstructionSet isa = InstructionSet::scalar, std::size_t at = 0) const;
+  void solve(double* const* out, InstructionSet isa = InstructionSet::scalar, std::size_t at = 0,
+             StreamRows* stream = nullptr) const;
 };
 
 /// True when the pair can take PolytopeLanes (no curvature, separated, at most two flats).

@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace batchcol::detail {
 
@@ -52,14 +53,21 @@ class StoreBlock {
  public:
   static constexpr int kEntries = StoreEntries;
   static constexpr std::size_t kStride = SmoothLanes::kLanes;  // slot entries are kStride doubles apart
+  /// Outputs of at least this many bytes (2 MiB: ~2200 pairs) are written with non-temporal stores on AVX-512.
+  static constexpr std::size_t kStreamBytes = std::size_t(2) << 20;
   explicit StoreBlock(DerivativeResults& d) : d(d) {}
   StoreBlock(const StoreBlock&) = delete;
   StoreBlock& operator=(const StoreBlock&) = delete;
-  ~StoreBlock() { flush(); }
+  ~StoreBlock() {
+    flush();
+    if (!stream_) return;
+    if (stream_rows_.carried) flush_stream_carry(stream_rows_, rows_, last_at_);
+    __builtin_ia32_sfence();  // the non-temporal stores are weakly ordered: visible before the task ends
+  }
   /// The slot of pair i (entry e at slot[e * kStride]); every entry must be written before the next call.
   double* slot(std::size_t i) {
-    // (An empty block flushes as a no-op and then starts at i.)
-    if (count_ == kStride || i != first_ + count_) flush(), first_ = i;
+    // (An empty block flushes as a no-op and then starts at i; limit_ is 0 until the first block.)
+    if (count_ == limit_ || i != first_ + count_) start(i);
     return &buf_[0][count_++];
   }
   void add(std::size_t i, const PairJacobians& J);
@@ -105,6 +113,16 @@ class StoreBlock {
   // whose count did not move, and the lanes' `+ first_` costs 15 (callgrind, AVX2).
   double* rows_[kEntries];
   bool have_rows_ = false;
+  // AVX-512 (aligned_): blocks end where the next 64-byte line of most output rows starts (phase_: their offset
+  // in a line at pair 0, in doubles), so that a whole block stores whole lines of those rows, the others through
+  // StreamRows' carry. Large outputs (stream_) are written in whole lines with non-temporal stores (start()).
+  bool aligned_ = false, stream_ = false;
+  std::size_t phase_ = 0;
+  std::size_t limit_ = 0;    // the pairs of the current block (up to kStride)
+  std::size_t last_at_ = 0;  // the first pair of the last streamed block (stream_rows_.carried)
+  StreamRows stream_rows_;
+  /// Flushes, starts a block at pair i (the first call sets rows_, aligned_, phase_ and the stream rows).
+  void start(std::size_t i);
   SmoothLanes smooth_{};  // value-initialised: an unused register half is computed (not written) on initialised numbers
   PolytopeLanes polytope_{};
   Smoothed1Lanes smoothed1_{};  // smoothed1: the pending curvatures of smooth_'s lanes

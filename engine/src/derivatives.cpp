@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -76,16 +77,52 @@ void entry_rows(DerivativeResults& d, std::size_t first, double** rows) {
     for (int k = 0, count = a < 2 ? 6 : 18; k < count; ++k) rows[e++] = arrays[a] + k * n + first;
 }
 
+void StoreBlock::start(std::size_t i) {
+  flush();
+  first_ = i;
+  const auto phase = [](const double* p) { return reinterpret_cast<std::uintptr_t>(p) % 64 / sizeof(double); };
+  if (!have_rows_) {
+    entry_rows(d, 0, rows_), have_rows_ = true;
+    if (isa == InstructionSet::avx512) {
+      // The arrays are separate allocations (offsets in a line vary with the allocator's state): the most common
+      // phase of the 120 rows.
+      std::size_t rows_at[kStride] = {};
+      for (int e = 0; e < kEntries; ++e) ++rows_at[phase(rows_[e])];
+      phase_ = static_cast<std::size_t>(std::max_element(rows_at, rows_at + kStride) - rows_at);
+      aligned_ = true;
+      // Non-temporal stores for outputs beyond a core's L2 (1-2 MB on current x86 server cores): their lines would
+      // leave the cache before a caller reads them, and a regular store first reads each line it misses.
+      stream_ = !normal_b_only && d.status.size() * kEntries * sizeof(double) >= kStreamBytes;
+      if (stream_)
+        for (int e = 0; e < kEntries; ++e) {
+          // Row e's line starts `shift` pairs before a block (a multiple of 8 doubles: rows of doubles).
+          const std::size_t shift = (phase(rows_[e]) + kStride - phase_) % kStride;
+          stream_rows_.shift[e] = static_cast<std::int64_t>(shift);
+          if (shift == 0) stream_rows_.whole[e / 64] |= std::uint64_t(1) << (e % 64);
+        }
+    }
+  }
+  // A whole block when pair i's entries start a line in the phase_ rows.
+  limit_ = aligned_ ? kStride - (phase_ + i) % kStride : kStride;
+}
+
 void StoreBlock::flush() {
   if (count_ == 0) return;
-  if (!have_rows_) entry_rows(d, 0, rows_), have_rows_ = true;
   double* const* const rows = rows_;
   const std::size_t at = first_;
   if (smoothed1_.pending != 0) smoothed1_.finish(smooth_, isa), smoothed1_.clear();
-  if (smooth_.count == kStride) {  // a whole block of smooth pairs (every ellipsoid pair): straight to the arrays
-    smooth_.solve(rows, normal_b_only, isa, at);
-  } else if (polytope_.count == kStride) {  // or of polytope pairs (hulls)
-    polytope_.solve(rows, isa, at);
+  // A block of smooth pairs only (every ellipsoid pair) straight to the arrays, or of polytope pairs only (hulls):
+  // whole blocks on every set, the others (a task range's first and last) in AVX-512's masked registers.
+  const bool smooth = smooth_.count == count_, polytope = !smooth && polytope_.count == count_;
+  // A whole lane block of a large output is streamed; the previous streamed block's carried entries are stored
+  // first unless this block continues its lines.
+  const bool streamed = stream_ && count_ == kStride && (smooth || polytope);
+  if (stream_rows_.carried && !(streamed && at == last_at_ + kStride)) flush_stream_carry(stream_rows_, rows, last_at_);
+  StreamRows* const stream = streamed ? &stream_rows_ : nullptr;
+  if (smooth) {
+    smooth_.solve(rows, normal_b_only, isa, at, stream);
+  } else if (polytope) {
+    polytope_.solve(rows, isa, at, stream);
   } else {
     if (smooth_.count > 0 || polytope_.count > 0) {
       double* buffer_rows[kEntries];
@@ -101,6 +138,7 @@ void StoreBlock::flush() {
       for (int k = first; k < end; ++k) std::copy_n(buf_[k], count_, rows[k] + at);
     }
   }
+  if (streamed) stream_rows_.carried = true, last_at_ = at;
   smooth_.clear();
   polytope_.clear();
   count_ = 0;
