@@ -189,10 +189,11 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
 // u + e z_1, u - e z_1, as the direction loop), the scan or the ellipsoid formula on them, the pairs' differences,
 // the two draws' sums and the estimate, each with the general path's operations in its order (the same bits). The
 // general path's buffers, loops and calls were ~580 instructions a side with its scan (callgrind AVX2, convex8).
-// The shape by its type, radii (ellipsoid) and hull (convex) rather than a ShapeView: the table's caller passes
-// them from ShapeTableAccess's arrays without building a view (~45 instructions a side, callgrind AVX2).
-__attribute__((noinline)) void estimate4_avx2(ShapeType type, const double* radii, const HullView* hull,
-                                              const double* u, double e, const double* const* z, double* S) {
+// The shape by its table index: its type, radii (ellipsoid) and hull (convex) read here from ShapeTableAccess's
+// arrays, so that the caller passes six arguments in registers and keeps no frame (a ShapeView built per side was
+// ~45 instructions; the caller's frame and radii copy ~45 a call, callgrind AVX2).
+__attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uint32_t shape, const double* u,
+                                              double e, const double* const* z, double* S) {
   const __m256d ev = _mm256_set1_pd(e);
   __m256d d[3];
   for (int c = 0; c < 3; ++c) {
@@ -206,28 +207,40 @@ __attribute__((noinline)) void estimate4_avx2(ShapeType type, const double* radi
     return _mm256_blend_pd(_mm256_setr_pd(z[0][k], z[1][k], z[2][k], z[2][k]), zero, 0x8);
   };
   const __m256d z0 = noise(0), z1 = noise(1);
-  __m256d s[3];
-  if (type == ShapeType::convex) {
-    const double* v = hull->vertices;
-    double at[4];
-    _mm256_storeu_pd(at, scan4_avx2(v, hull->vertex_count, d[0], d[1], d[2]));
-    const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
-    const auto point = [&](int j) { return _mm256_maskload_pd(v + 3 * static_cast<std::size_t>(at[j]), three); };
-    const __m256d q0 = _mm256_sub_pd(point(0), point(1)), q1 = _mm256_sub_pd(point(2), point(3));  // x y z 0
-    const __m256d b0[3] = {_mm256_permute4x64_pd(q0, 0x00), _mm256_permute4x64_pd(q0, 0x55),
-                           _mm256_permute4x64_pd(q0, 0xAA)};
-    const __m256d b1[3] = {_mm256_permute4x64_pd(q1, 0x00), _mm256_permute4x64_pd(q1, 0x55),
-                           _mm256_permute4x64_pd(q1, 0xAA)};
-    for (int r = 0; r < 3; ++r)
-      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(b0[r], z0)), _mm256_mul_pd(b1[r], z1));
+  // q[c]: lanes 0 and 2 hold coordinate c of S(d_0) - S(d_1) and S(d_2) - S(d_3).
+  __m256d q[3];
+  if (ShapeTableAccess::types(shapes)[shape] == ShapeType::convex) {
+    // scan4_avx2()'s first maximum with the vertex's coordinates blended along instead of its number: the same
+    // comparisons pick the same vertex, whose coordinates are copied exactly, so the same differences; no index
+    // conversions, masked loads or transposes after the scan (~40 instructions a side fewer, callgrind AVX2).
+    const HullView& hull = ShapeTableAccess::hulls(shapes)[shape];
+    const double* p = hull.vertices;
+    const double* const end = p + 3 * std::size_t(hull.vertex_count);
+    const auto dot = [&](__m256d x, __m256d y, __m256d w) {
+      return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, d[0]), _mm256_mul_pd(y, d[1])), _mm256_mul_pd(w, d[2]));
+    };
+    __m256d fx = _mm256_broadcast_sd(p), fy = _mm256_broadcast_sd(p + 1), fz = _mm256_broadcast_sd(p + 2);
+    __m256d best = dot(fx, fy, fz);
+    for (p += 3; p < end; p += 3) {
+      const __m256d x = _mm256_broadcast_sd(p), y = _mm256_broadcast_sd(p + 1), w = _mm256_broadcast_sd(p + 2);
+      const __m256d di = dot(x, y, w);
+      const __m256d above = _mm256_cmp_pd(di, best, _CMP_GT_OQ);
+      best = _mm256_max_pd(di, best);
+      fx = _mm256_blendv_pd(fx, x, above), fy = _mm256_blendv_pd(fy, y, above), fz = _mm256_blendv_pd(fz, w, above);
+    }
+    q[0] = _mm256_sub_pd(fx, _mm256_permute_pd(fx, 0x5));
+    q[1] = _mm256_sub_pd(fy, _mm256_permute_pd(fy, 0x5));
+    q[2] = _mm256_sub_pd(fz, _mm256_permute_pd(fz, 0x5));
   } else {
-    const __m256d r3[3] = {_mm256_set1_pd(radii[0]), _mm256_set1_pd(radii[1]), _mm256_set1_pd(radii[2])};
-    __m256d q[3];
+    const __m256d r3[3] = {_mm256_set1_pd(ShapeTableAccess::sizes(shapes, 0)[shape]),
+                           _mm256_set1_pd(ShapeTableAccess::sizes(shapes, 1)[shape]),
+                           _mm256_set1_pd(ShapeTableAccess::sizes(shapes, 2)[shape])};
     ellipsoid_differences4(r3, d, q);
-    for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
-      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0x00), z0)),
-                           _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0xAA), z1));
   }
+  __m256d s[3];
+  for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
+    s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0x00), z0)),
+                         _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0xAA), z1));
   sums_to_estimate_avx2(s, 4.0 * e, S);
 }
 
@@ -376,6 +389,15 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
   return (0.5 * (H + H.transpose())).eval();
 }
 
+// Every path but estimate4_avx2()'s, out of line with the ShapeView it builds: its frame (six saved registers, the
+// view on the stack) was ~70 instructions a call of smoothed_support_estimate() on the M = 4 path as well.
+__attribute__((noinline)) void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape,
+                                                   const Eigen::Vector3d& u, double e, int samples,
+                                                   const double* const* z, bool wide, double* S) {
+  const Eigen::Matrix3d H = general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide);
+  std::memcpy(S, H.data(), sizeof(double) * 9);
+}
+
 }  // namespace
 
 Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
@@ -384,13 +406,10 @@ Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_
   const ShapeType type = ShapeTableAccess::types(shapes)[shape];
   const HullView* hull = &ShapeTableAccess::hulls(shapes)[shape];
   Eigen::Matrix3d S;
-  if (estimate4_case(wide, samples, type, ShapeTableAccess::inflations(shapes)[shape], hull)) {
-    const double radii[3] = {ShapeTableAccess::sizes(shapes, 0)[shape], ShapeTableAccess::sizes(shapes, 1)[shape],
-                             ShapeTableAccess::sizes(shapes, 2)[shape]};
-    estimate4_avx2(type, radii, hull, u.data(), e, z, S.data());
-  } else {
-    S = general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide);
-  }
+  if (estimate4_case(wide, samples, type, ShapeTableAccess::inflations(shapes)[shape], hull))
+    estimate4_avx2(shapes, shape, u.data(), e, z, S.data());
+  else
+    general_estimate_of(shapes, shape, u, e, samples, z, wide, S.data());
   return S;
 }
 
