@@ -75,6 +75,19 @@ void scan_hull_sse2(const double* v, std::uint32_t count, const double* const* d
   }
 }
 
+bool scanned_hull(const HullView& hull) { return !kernels::hull_climbs(hull) && hull.vertex_count > 0; }
+bool scanned_hull(const ShapeView& view) {
+  return view.type == ShapeType::convex && view.hull && scanned_hull(*view.hull);
+}
+// estimate4_avx2()'s shapes: no inflation, an ellipsoid or a scanned hull.
+inline bool estimate4_case(ShapeType type, double inflation, const HullView& hull) {
+  return inflation == 0.0 && (type == ShapeType::ellipsoid || (type == ShapeType::convex && scanned_hull(hull)));
+}
+// Every other shape's estimate (general_estimate() on the table's ShapeView) into S, defined below.
+void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u, double e,
+                         int samples, const double* const* z, bool wide, double* S);
+
+
 #pragma GCC push_options
 #pragma GCC target("avx2")
 // scan_hull_sse2() with four directions in one AVX2 register: the same products, sums, comparisons (_CMP_GT_OQ is
@@ -192,8 +205,16 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
 // The shape by its table index: its type, radii (ellipsoid) and hull (convex) read here from ShapeTableAccess's
 // arrays, so that the caller passes six arguments in registers and keeps no frame (a ShapeView built per side was
 // ~45 instructions; the caller's frame and radii copy ~45 a call, callgrind AVX2).
-__attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uint32_t shape, const double* u,
-                                              double e, const double* const* z, double* S) {
+__attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uint32_t shape,
+                                              const Eigen::Vector3d& u_vector, double e, const double* const* z,
+                                              double* S) {
+  // The shape test here rather than in smoothed_support_estimate(), whose frame then held the arguments for the
+  // general path (~25 instructions a call, callgrind AVX2): other shapes go on from here.
+  const ShapeType type = ShapeTableAccess::types(shapes)[shape];
+  const HullView& hull = ShapeTableAccess::hulls(shapes)[shape];
+  if (!estimate4_case(type, ShapeTableAccess::inflations(shapes)[shape], hull))
+    return general_estimate_of(shapes, shape, u_vector, e, 4, z, true, S);
+  const double* u = u_vector.data();
   // Coordinate c's two draws (z_c0, z_c1) one 16-byte load, in both halves of a register (M = 4 reads z[c][0 .. 1]
   // only): (z_c0, z_c0, z_c1, z_c1) for the directions and, by unpacks, the draws' rows (z_0k, z_1k, z_2k, 0) with
   // the same values as element loads (~15 instructions a side fewer than the loads and inserts, callgrind AVX2).
@@ -211,11 +232,10 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uin
   const __m256d z1 = _mm256_blend_pd(_mm256_unpackhi_pd(b[0], b[1]), _mm256_unpackhi_pd(b[2], zero), 0xC);
   // q[c]: lanes 0 and 2 hold coordinate c of S(d_0) - S(d_1) and S(d_2) - S(d_3).
   __m256d q[3];
-  if (ShapeTableAccess::types(shapes)[shape] == ShapeType::convex) {
+  if (type == ShapeType::convex) {
     // scan4_avx2()'s first maximum with the vertex's coordinates blended along instead of its number: the same
     // comparisons pick the same vertex, whose coordinates are copied exactly, so the same differences; no index
     // conversions, masked loads or transposes after the scan (~40 instructions a side fewer, callgrind AVX2).
-    const HullView& hull = ShapeTableAccess::hulls(shapes)[shape];
     const double* p = hull.vertices;
     const double* const end = p + 3 * std::size_t(hull.vertex_count);
     const auto dot = [&](__m256d x, __m256d y, __m256d w) {
@@ -247,16 +267,6 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uin
 }
 
 #pragma GCC pop_options
-
-bool scanned_hull(const HullView& hull) { return !kernels::hull_climbs(hull) && hull.vertex_count > 0; }
-bool scanned_hull(const ShapeView& view) {
-  return view.type == ShapeType::convex && view.hull && scanned_hull(*view.hull);
-}
-// estimate4_avx2()'s cases: M = 4, no inflation, an ellipsoid or a scanned hull.
-bool estimate4_case(bool wide, int samples, ShapeType type, double inflation, const HullView* hull) {
-  return wide && samples == 4 && inflation == 0.0 &&
-         (type == ShapeType::ellipsoid || (type == ShapeType::convex && hull && scanned_hull(*hull)));
-}
 
 // smoothed_support_estimate() on every path but estimate4_avx2()'s. Out of line: its frame and register saves
 // cost the M = 4 path ~67 instructions a side when they were the caller's (callgrind AVX2).
@@ -405,13 +415,9 @@ __attribute__((noinline)) void general_estimate_of(const ShapeTable& shapes, std
 Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
                                           double e, int samples, const double* const* z, InstructionSet isa) {
   const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
-  const ShapeType type = ShapeTableAccess::types(shapes)[shape];
-  const HullView* hull = &ShapeTableAccess::hulls(shapes)[shape];
   Eigen::Matrix3d S;
-  if (estimate4_case(wide, samples, type, ShapeTableAccess::inflations(shapes)[shape], hull))
-    estimate4_avx2(shapes, shape, u.data(), e, z, S.data());
-  else
-    general_estimate_of(shapes, shape, u, e, samples, z, wide, S.data());
+  if (wide && samples == 4) estimate4_avx2(shapes, shape, u, e, z, S.data());  // or its general path
+  else general_estimate_of(shapes, shape, u, e, samples, z, wide, S.data());
   return S;
 }
 
