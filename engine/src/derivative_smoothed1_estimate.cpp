@@ -268,10 +268,12 @@ __attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uin
 
 #pragma GCC pop_options
 
-// smoothed_support_estimate() on every path but estimate4_avx2()'s. Out of line: its frame and register saves
-// cost the M = 4 path ~67 instructions a side when they were the caller's (callgrind AVX2).
-__attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e,
-                                                           int samples, const double* const* z, bool wide) {
+// smoothed_support_estimate() on every path but estimate4_avx2()'s, into S (column-major, as Matrix3d::data()).
+// Inlined into general_estimate_of(), which is out of line: its frame and register saves cost the M = 4 path ~67
+// instructions a side when they were the caller's (callgrind AVX2).
+inline __attribute__((always_inline)) void general_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e,
+                                                            int samples, const double* const* z, bool wide,
+                                                            double* S) {
   const bool scanned = scanned_hull(view);
   const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
@@ -377,9 +379,8 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
   // Each entry s_rc adds q_kr z_ck draw after draw.
   double sum[3][4];
   if (wide) {
-    Eigen::Matrix3d S;
-    sample_sums_avx2(q, z, draws, static_cast<double>(samples) * e, S.data());
-    return S;
+    sample_sums_avx2(q, z, draws, static_cast<double>(samples) * e, S);
+    return;
   } else {
     // Row r's three entries in one SSE2 pair and a scalar.
     V2 s01[3] = {}, s2v = {};
@@ -398,16 +399,17 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
-  return (0.5 * (H + H.transpose())).eval();
+  Eigen::Map<Eigen::Matrix3d> out(S);
+  out = 0.5 * (H + H.transpose());
 }
 
 // Every path but estimate4_avx2()'s, out of line with the ShapeView it builds: its frame (six saved registers, the
-// view on the stack) was ~70 instructions a call of smoothed_support_estimate() on the M = 4 path as well.
+// view on the stack) was ~70 instructions a call of smoothed_support_estimate() on the M = 4 path as well. It writes
+// S itself: a returned Matrix3d copied to S was ~14 instructions a call (convex8 M = 16, callgrind AVX2).
 __attribute__((noinline)) void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape,
                                                    const Eigen::Vector3d& u, double e, int samples,
                                                    const double* const* z, bool wide, double* S) {
-  const Eigen::Matrix3d H = general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide);
-  std::memcpy(S, H.data(), sizeof(double) * 9);
+  general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide, S);
 }
 
 }  // namespace
