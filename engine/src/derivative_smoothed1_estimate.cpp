@@ -87,7 +87,6 @@ inline bool estimate4_case(ShapeType type, double inflation, const HullView& hul
 void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u, double e,
                          int samples, const double* const* z, bool wide, double* S);
 
-
 #pragma GCC push_options
 #pragma GCC target("avx2")
 // scan_hull_sse2() with four directions in one AVX2 register: the same products, sums, comparisons (_CMP_GT_OQ is
@@ -203,7 +202,7 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
 // the two draws' sums and the estimate, each with the general path's operations in its order (the same bits). The
 // general path's buffers, loops and calls were ~580 instructions a side with its scan (callgrind AVX2, convex8).
 // The shape by its table index: its type, radii (ellipsoid) and hull (convex) read here from ShapeTableAccess's
-// arrays, so that the caller passes six arguments in registers and keeps no frame (a ShapeView built per side was
+// arrays, so that the caller passes six arguments in registers and saves one register (a ShapeView built per side was
 // ~45 instructions; the caller's frame and radii copy ~45 a call, callgrind AVX2).
 __attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uint32_t shape,
                                               const Eigen::Vector3d& u_vector, double e, const double* const* z,
