@@ -157,4 +157,15 @@ inline void support_noise_pair(std::uint64_t key, std::uint64_t j, double& g0, d
   g1 = static_cast<double>(radius * s);
 }
 
+/// smoothed0's noise of antithetic pair k of a pair with key splitmix64(splitmix64(seed) ^ pair) (engine/src/
+/// derivative_smoothed0.cpp; kernels::simd::build_samples() draws it W antithetic pairs a register with these
+/// bits): z = (z_v, z_w) in R^6 are support_noise_pair()'s transforms 3k, 3k + 1, 3k + 2 of the key's sequence,
+/// the same stream as smoothed1's draw k. Until branch dv2 smoothed0 drew gaussian_vector<6>(seed, pair, k, 0):
+/// 8 64-bit mixes a draw (2 for the key set-up; AVX2 emulates their multiplies) and double log / sin / cos series
+/// to 1e-17, against 3 mixes and float series here; other output bits since, the same distribution (radius cut at
+/// 6.56 sigma, ~1e-7 relative roundings: support_noise_pair()'s note).
+inline void sample_noise(std::uint64_t key, std::uint64_t k, double* z) {
+  for (std::uint64_t t = 0; t < 3; ++t) support_noise_pair(key, 3 * k + t, z[2 * t], z[2 * t + 1]);
+}
+
 }  // namespace batchcol::detail

@@ -303,7 +303,7 @@ void sample_arrays(Block& b, std::size_t slot, std::size_t evens, kernels::simd:
 }
 
 /// Writes samples j0 .. j0 + count of plan p (j0 even) at block slot `slot`: the first samples of the antithetic
-/// pairs (2k: z drawn from the key (seed, pair, k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
+/// pairs (2k: z = sample_noise(key of (seed, pair), k) in A's frame) at slot .. slot + evens, their copies (2k+1: -z,
 /// the transposed rotation) after them, so that build_samples() writes whole registers.
 void build(const Context& c, const PairPlan& p, std::size_t j0, std::size_t count, Block& b, std::size_t slot) {
   const std::size_t evens = (count + 1) / 2, odds = count / 2;

@@ -75,6 +75,18 @@ void scan_hull_sse2(const double* v, std::uint32_t count, const double* const* d
   }
 }
 
+bool scanned_hull(const HullView& hull) { return !kernels::hull_climbs(hull) && hull.vertex_count > 0; }
+bool scanned_hull(const ShapeView& view) {
+  return view.type == ShapeType::convex && view.hull && scanned_hull(*view.hull);
+}
+// estimate4_avx2()'s shapes: no inflation, an ellipsoid or a scanned hull.
+inline bool estimate4_case(ShapeType type, double inflation, const HullView& hull) {
+  return inflation == 0.0 && (type == ShapeType::ellipsoid || (type == ShapeType::convex && scanned_hull(hull)));
+}
+// Every other shape's estimate (general_estimate() on the table's ShapeView) into S, defined below.
+void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u, double e,
+                         int samples, const double* const* z, bool wide, double* S);
+
 #pragma GCC push_options
 #pragma GCC target("avx2")
 // scan_hull_sse2() with four directions in one AVX2 register: the same products, sums, comparisons (_CMP_GT_OQ is
@@ -189,64 +201,78 @@ __attribute__((noinline)) void sample_sums_avx2(const double* q, const double* c
 // u + e z_1, u - e z_1, as the direction loop), the scan or the ellipsoid formula on them, the pairs' differences,
 // the two draws' sums and the estimate, each with the general path's operations in its order (the same bits). The
 // general path's buffers, loops and calls were ~580 instructions a side with its scan (callgrind AVX2, convex8).
-// The shape by its type, radii (ellipsoid) and hull (convex) rather than a ShapeView: the table's caller passes
-// them from ShapeTableAccess's arrays without building a view (~45 instructions a side, callgrind AVX2).
-__attribute__((noinline)) void estimate4_avx2(ShapeType type, const double* radii, const HullView* hull,
-                                              const double* u, double e, const double* const* z, double* S) {
+// The shape by its table index: its type, radii (ellipsoid) and hull (convex) read here from ShapeTableAccess's
+// arrays, so that the caller passes six arguments in registers and saves one register (a ShapeView built per side was
+// ~45 instructions; the caller's frame and radii copy ~45 a call, callgrind AVX2).
+__attribute__((noinline)) void estimate4_avx2(const ShapeTable& shapes, std::uint32_t shape,
+                                              const Eigen::Vector3d& u_vector, double e, const double* const* z,
+                                              double* S) {
+  // The shape test here rather than in smoothed_support_estimate(), whose frame then held the arguments for the
+  // general path (~25 instructions a call, callgrind AVX2): other shapes go on from here.
+  const ShapeType type = ShapeTableAccess::types(shapes)[shape];
+  const HullView& hull = ShapeTableAccess::hulls(shapes)[shape];
+  if (!estimate4_case(type, ShapeTableAccess::inflations(shapes)[shape], hull))
+    return general_estimate_of(shapes, shape, u_vector, e, 4, z, true, S);
+  const double* u = u_vector.data();
+  // Coordinate c's two draws (z_c0, z_c1) one 16-byte load, in both halves of a register (M = 4 reads z[c][0 .. 1]
+  // only): (z_c0, z_c0, z_c1, z_c1) for the directions and, by unpacks, the draws' rows (z_0k, z_1k, z_2k, 0) with
+  // the same values as element loads (~15 instructions a side fewer than the loads and inserts, callgrind AVX2).
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d b[3] = {_mm256_broadcast_pd(reinterpret_cast<const __m128d*>(z[0])),
+                        _mm256_broadcast_pd(reinterpret_cast<const __m128d*>(z[1])),
+                        _mm256_broadcast_pd(reinterpret_cast<const __m128d*>(z[2]))};  // z_c0 z_c1 z_c0 z_c1
   const __m256d ev = _mm256_set1_pd(e);
   __m256d d[3];
   for (int c = 0; c < 3; ++c) {
-    const __m256d uv = _mm256_set1_pd(u[c]), ez = _mm256_mul_pd(ev, _mm256_setr_pd(z[c][0], z[c][0], z[c][1], z[c][1]));
+    const __m256d uv = _mm256_set1_pd(u[c]), ez = _mm256_mul_pd(ev, _mm256_permute_pd(b[c], 0xC));
     d[c] = _mm256_blend_pd(_mm256_add_pd(uv, ez), _mm256_sub_pd(uv, ez), 0xA);
   }
-  const __m256d zero = _mm256_setzero_pd();
-  // Draw k's noise (z_0k, z_1k, z_2k, 0), lane 3 zeroed by a blend: GCC built setr(.., 0.0) with a vmovq form
-  // valgrind 3.19 does not decode (its callgrind counts are how this path is measured).
-  const auto noise = [&](int k) {
-    return _mm256_blend_pd(_mm256_setr_pd(z[0][k], z[1][k], z[2][k], z[2][k]), zero, 0x8);
-  };
-  const __m256d z0 = noise(0), z1 = noise(1);
-  __m256d s[3];
+  const __m256d z0 = _mm256_blend_pd(_mm256_unpacklo_pd(b[0], b[1]), _mm256_unpacklo_pd(b[2], zero), 0xC);
+  const __m256d z1 = _mm256_blend_pd(_mm256_unpackhi_pd(b[0], b[1]), _mm256_unpackhi_pd(b[2], zero), 0xC);
+  // q[c]: lanes 0 and 2 hold coordinate c of S(d_0) - S(d_1) and S(d_2) - S(d_3).
+  __m256d q[3];
   if (type == ShapeType::convex) {
-    const double* v = hull->vertices;
-    double at[4];
-    _mm256_storeu_pd(at, scan4_avx2(v, hull->vertex_count, d[0], d[1], d[2]));
-    const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
-    const auto point = [&](int j) { return _mm256_maskload_pd(v + 3 * static_cast<std::size_t>(at[j]), three); };
-    const __m256d q0 = _mm256_sub_pd(point(0), point(1)), q1 = _mm256_sub_pd(point(2), point(3));  // x y z 0
-    const __m256d b0[3] = {_mm256_permute4x64_pd(q0, 0x00), _mm256_permute4x64_pd(q0, 0x55),
-                           _mm256_permute4x64_pd(q0, 0xAA)};
-    const __m256d b1[3] = {_mm256_permute4x64_pd(q1, 0x00), _mm256_permute4x64_pd(q1, 0x55),
-                           _mm256_permute4x64_pd(q1, 0xAA)};
-    for (int r = 0; r < 3; ++r)
-      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(b0[r], z0)), _mm256_mul_pd(b1[r], z1));
+    // scan4_avx2()'s first maximum with the vertex's coordinates blended along instead of its number: the same
+    // comparisons pick the same vertex, whose coordinates are copied exactly, so the same differences; no index
+    // conversions, masked loads or transposes after the scan (~40 instructions a side fewer, callgrind AVX2).
+    const double* p = hull.vertices;
+    const double* const end = p + 3 * std::size_t(hull.vertex_count);
+    const auto dot = [&](__m256d x, __m256d y, __m256d w) {
+      return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, d[0]), _mm256_mul_pd(y, d[1])), _mm256_mul_pd(w, d[2]));
+    };
+    __m256d fx = _mm256_broadcast_sd(p), fy = _mm256_broadcast_sd(p + 1), fz = _mm256_broadcast_sd(p + 2);
+    __m256d best = dot(fx, fy, fz);
+    for (p += 3; p < end; p += 3) {
+      const __m256d x = _mm256_broadcast_sd(p), y = _mm256_broadcast_sd(p + 1), w = _mm256_broadcast_sd(p + 2);
+      const __m256d di = dot(x, y, w);
+      const __m256d above = _mm256_cmp_pd(di, best, _CMP_GT_OQ);
+      best = _mm256_max_pd(di, best);
+      fx = _mm256_blendv_pd(fx, x, above), fy = _mm256_blendv_pd(fy, y, above), fz = _mm256_blendv_pd(fz, w, above);
+    }
+    q[0] = _mm256_sub_pd(fx, _mm256_permute_pd(fx, 0x5));
+    q[1] = _mm256_sub_pd(fy, _mm256_permute_pd(fy, 0x5));
+    q[2] = _mm256_sub_pd(fz, _mm256_permute_pd(fz, 0x5));
   } else {
-    const __m256d r3[3] = {_mm256_set1_pd(radii[0]), _mm256_set1_pd(radii[1]), _mm256_set1_pd(radii[2])};
-    __m256d q[3];
+    const __m256d r3[3] = {_mm256_set1_pd(ShapeTableAccess::sizes(shapes, 0)[shape]),
+                           _mm256_set1_pd(ShapeTableAccess::sizes(shapes, 1)[shape]),
+                           _mm256_set1_pd(ShapeTableAccess::sizes(shapes, 2)[shape])};
     ellipsoid_differences4(r3, d, q);
-    for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
-      s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0x00), z0)),
-                           _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0xAA), z1));
   }
+  __m256d s[3];
+  for (int r = 0; r < 3; ++r)  // lanes 0 and 2: q_0r, q_1r
+    s[r] = _mm256_add_pd(_mm256_add_pd(zero, _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0x00), z0)),
+                         _mm256_mul_pd(_mm256_permute4x64_pd(q[r], 0xAA), z1));
   sums_to_estimate_avx2(s, 4.0 * e, S);
 }
 
 #pragma GCC pop_options
 
-bool scanned_hull(const HullView& hull) { return !kernels::hull_climbs(hull) && hull.vertex_count > 0; }
-bool scanned_hull(const ShapeView& view) {
-  return view.type == ShapeType::convex && view.hull && scanned_hull(*view.hull);
-}
-// estimate4_avx2()'s cases: M = 4, no inflation, an ellipsoid or a scanned hull.
-bool estimate4_case(bool wide, int samples, ShapeType type, double inflation, const HullView* hull) {
-  return wide && samples == 4 && inflation == 0.0 &&
-         (type == ShapeType::ellipsoid || (type == ShapeType::convex && hull && scanned_hull(*hull)));
-}
-
-// smoothed_support_estimate() on every path but estimate4_avx2()'s. Out of line: its frame and register saves
-// cost the M = 4 path ~67 instructions a side when they were the caller's (callgrind AVX2).
-__attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e,
-                                                           int samples, const double* const* z, bool wide) {
+// smoothed_support_estimate() on every path but estimate4_avx2()'s, into S (column-major, as Matrix3d::data()).
+// Inlined into general_estimate_of(), which is out of line: its frame and register saves cost the M = 4 path ~67
+// instructions a side when they were the caller's (callgrind AVX2).
+inline __attribute__((always_inline)) void general_estimate(const ShapeView& view, const Eigen::Vector3d& u, double e,
+                                                            int samples, const double* const* z, bool wide,
+                                                            double* S) {
   const bool scanned = scanned_hull(view);
   const auto core = kernels::make_core<double>(view);
   kernels::SupportHint hint;
@@ -352,9 +378,8 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
   // Each entry s_rc adds q_kr z_ck draw after draw.
   double sum[3][4];
   if (wide) {
-    Eigen::Matrix3d S;
-    sample_sums_avx2(q, z, draws, static_cast<double>(samples) * e, S.data());
-    return S;
+    sample_sums_avx2(q, z, draws, static_cast<double>(samples) * e, S);
+    return;
   } else {
     // Row r's three entries in one SSE2 pair and a scalar.
     V2 s01[3] = {}, s2v = {};
@@ -373,7 +398,17 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
   Eigen::Matrix3d H;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) H(r, c) = sum[r][c] / (static_cast<double>(samples) * e);
-  return (0.5 * (H + H.transpose())).eval();
+  Eigen::Map<Eigen::Matrix3d> out(S);
+  out = 0.5 * (H + H.transpose());
+}
+
+// Every path but estimate4_avx2()'s, out of line with the ShapeView it builds: its frame (six saved registers, the
+// view on the stack) was ~70 instructions a call of smoothed_support_estimate() on the M = 4 path as well. It writes
+// S itself: a returned Matrix3d copied to S was ~14 instructions a call (convex8 M = 16, callgrind AVX2).
+__attribute__((noinline)) void general_estimate_of(const ShapeTable& shapes, std::uint32_t shape,
+                                                   const Eigen::Vector3d& u, double e, int samples,
+                                                   const double* const* z, bool wide, double* S) {
+  general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide, S);
 }
 
 }  // namespace
@@ -381,16 +416,9 @@ __attribute__((noinline)) Eigen::Matrix3d general_estimate(const ShapeView& view
 Eigen::Matrix3d smoothed_support_estimate(const ShapeTable& shapes, std::uint32_t shape, const Eigen::Vector3d& u,
                                           double e, int samples, const double* const* z, InstructionSet isa) {
   const bool wide = isa == InstructionSet::avx2 || isa == InstructionSet::avx512;  // the AVX2 forms (the same bits)
-  const ShapeType type = ShapeTableAccess::types(shapes)[shape];
-  const HullView* hull = &ShapeTableAccess::hulls(shapes)[shape];
   Eigen::Matrix3d S;
-  if (estimate4_case(wide, samples, type, ShapeTableAccess::inflations(shapes)[shape], hull)) {
-    const double radii[3] = {ShapeTableAccess::sizes(shapes, 0)[shape], ShapeTableAccess::sizes(shapes, 1)[shape],
-                             ShapeTableAccess::sizes(shapes, 2)[shape]};
-    estimate4_avx2(type, radii, hull, u.data(), e, z, S.data());
-  } else {
-    S = general_estimate(ShapeTableAccess::view(shapes, shape), u, e, samples, z, wide);
-  }
+  if (wide && samples == 4) estimate4_avx2(shapes, shape, u, e, z, S.data());  // or its general path
+  else general_estimate_of(shapes, shape, u, e, samples, z, wide, S.data());
   return S;
 }
 

@@ -1,9 +1,9 @@
 // The smoothed0 derivatives' perturbed samples, W antithetic pairs of samples per register (engine/src/
-// derivative_smoothed0.cpp): the counter-based Gaussian draws (engine/src/counter_rng.hpp's generator, lane by
-// lane: SplitMix64 keyed by (seed, pair, k), Box-Muller through its log_unit and sincos_turn series) and B's
+// derivative_smoothed0.cpp): the counter-based Gaussian draws (engine/src/counter_rng.hpp's sample_noise(), lane
+// by lane: the pair key's SplitMix64 outputs 3k .. 3k + 2, each one float Box-Muller transform) and B's
 // perturbed pose in A's frame, E R0 and t0 + s_t z for sample 2k, E^T R0 and t0 - s_t z for its antithetic copy
 // 2k+1. Every lane does the scalar code's operations in its order (no FMA contraction), so every instruction set
-// gives the bits of engine/src/counter_rng.hpp's gaussian_vector<6> and of the scalar build (tested in
+// gives the bits of engine/src/counter_rng.hpp's sample_noise() and of the scalar build (tested in
 // tests/kernels/wide_samples_test.cpp). In scalar code the drawing and the building were a third of a sample's work.
 //
 // No include guard: included once per instruction set by isa_body.inl.
@@ -230,96 +230,145 @@ struct WideSamples {
       for (int l = 0; l < W; ++l) key[l] = keys[p0 + std::size_t(std::min(l, lanes - 1))];  // padding: unstored
       double* const out = z + p0 * per_pair;
       for (std::size_t j = 0; j < transforms; j += 2) {
-        const u64 xa = splitmix(key + j * 0x9E3779B97F4A7C15ull), xb = splitmix(key + (j + 1) * 0x9E3779B97F4A7C15ull);
-        const uv hi = (uv)((xa >> 33) | ((xb >> 1) & 0x7FFFFFFF00000000ull));  // the top 31 bits of each
-        const uv lo = (uv)((xa & 0xFFFFFFFFull) | (xb << 32));
-        const fv radius = fsqrt(minus_two_log_unit_f(hi));
-        fv s, c;
-        sincos_turn_f(lo, s, c);
-        store_noise_all(radius * c, radius * s, out + 2 * j, per_pair, lanes, j + 1 < transforms);
+        fv g0, g1;
+        box_muller_f(splitmix(key + j * 0x9E3779B97F4A7C15ull), splitmix(key + (j + 1) * 0x9E3779B97F4A7C15ull), g0,
+                     g1);
+        store_noise_all(g0, g1, out + 2 * j, per_pair, lanes, j + 1 < transforms);
       }
     }
   }
+  /// support_noise_pair()'s transform of the mixes xa (lane l) and xb (lane l) into float lanes 2l (xa's) and
+  /// 2l + 1 (xb's): g0 = radius cos, g1 = radius sin. The 32-bit halves interleave in place (little endian).
+  __attribute__((always_inline)) static void box_muller_f(u64 xa, u64 xb, fv& g0, fv& g1) {
+    const uv hi = (uv)((xa >> 33) | ((xb >> 1) & 0x7FFFFFFF00000000ull));  // the top 31 bits of each
+    const uv lo = (uv)((xa & 0xFFFFFFFFull) | (xb << 32));
+    const fv radius = fsqrt(minus_two_log_unit_f(hi));
+    fv s, c;
+    sincos_turn_f(lo, s, c);
+    g0 = radius * c;
+    g1 = radius * s;
+  }
+  /// Float lanes 2l (I = 0) or 2l + 1 (I = 1) of v as W doubles (exact conversions).
+  template <int I> static real float_lanes(fv v) {
+#if BATCHCOL_SIMD_BYTES == 32
+    return (real)_mm256_cvtps_pd((__m128)__builtin_shufflevector(v, v, I, 2 + I, 4 + I, 6 + I));
+#elif BATCHCOL_SIMD_BYTES == 64
+    return (real)_mm512_cvtps_pd(
+        (__m256)__builtin_shufflevector(v, v, I, 2 + I, 4 + I, 6 + I, 8 + I, 10 + I, 12 + I, 14 + I));
+#else
+    real r;
+    r[0] = double(v[I]);
+    return r;
+#endif
+  }
+  /// counter_rng.hpp's sample_noise(key, k, z) lane by lane, lane l's start = key + 3 k 0x9E3779B97F4A7C15 (the
+  /// SplitMix64 state before its transform 3k): transforms 3k and 3k + 1 share a float register, 3k + 2 fills
+  /// half of one. 3 64-bit mixes a lane instead of gaussian_vector<6>'s 8 (2 for the key set-up, 6 uniforms).
+  static void sample_noise(u64 start, real (&z)[6]) {
+    constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ull;
+    const u64 x0 = splitmix(start), x1 = splitmix(start + kGolden), x2 = splitmix(start + 2 * kGolden);
+    fv g0, g1;
+    box_muller_f(x0, x1, g0, g1);
+    z[0] = float_lanes<0>(g0), z[1] = float_lanes<0>(g1), z[2] = float_lanes<1>(g0), z[3] = float_lanes<1>(g1);
+    box_muller_f(x2, x2, g0, g1);
+    z[4] = float_lanes<0>(g0), z[5] = float_lanes<0>(g1);
+  }
+  /// The start state of sample_noise() for antithetic pair k of a pair with key `key`.
+  static std::uint64_t noise_start(std::uint64_t key, std::uint64_t k) { return key + 3 * k * 0x9E3779B97F4A7C15ull; }
 
   typedef double v4 __attribute__((vector_size(32)));
   typedef double v4u __attribute__((vector_size(32), aligned(8)));  // an unaligned load of 4 doubles
 
-  /// One pass of accumulate() over the valid samples idx[0 .. m): the sums of noise columns fa and fa + 1, and with
-  /// kMean the values' sums. 3 + 3 (+ 3) accumulators, g0, d and the broadcast fit AVX2's 16 registers: with all
-  /// 21 accumulators in one loop GCC kept them on the stack (~130 instructions per sample, ~75 in three passes).
-  template <bool kMean>
-  static void pass(const double* values, const std::uint32_t* idx, int m, const double* const* z, int fa,
-                   double* mean_sums, double (*G_sums)[12], const v4* g0) {
+  /// One term of the noise sums: (row `plus` minus row `minus`) times noise z[.][zk]. An antithetic pair whose two
+  /// samples are valid is one term, plus its first sample, minus its copy, z the first's; a valid sample without
+  /// its valid copy is (itself minus g0) times its own z.
+  struct Term {
+    const double* plus;
+    const double* minus;
+    std::uint32_t zk;
+  };
+  /// One pass of accumulate() over the terms t[0 .. m): the sums of noise columns F .. F + 2. 9 accumulators, the
+  /// difference and the broadcast fit AVX2's 16 registers.
+  template <int F>
+  static void pass(const Term* t, int m, const double* const* z, double (*G_sums)[12]) {
     // Named vectors, not arrays: GCC kept memcpy-initialised arrays on the stack.
-    v4 a0, a1, a2, b0, b1, b2, m0 = {}, m1 = {}, m2 = {};
-    std::memcpy(&a0, G_sums[fa], 32), std::memcpy(&a1, G_sums[fa] + 4, 32), std::memcpy(&a2, G_sums[fa] + 8, 32);
-    std::memcpy(&b0, G_sums[fa + 1], 32), std::memcpy(&b1, G_sums[fa + 1] + 4, 32);
-    std::memcpy(&b2, G_sums[fa + 1] + 8, 32);
-    if constexpr (kMean)
-      std::memcpy(&m0, mean_sums, 32), std::memcpy(&m1, mean_sums + 4, 32), std::memcpy(&m2, mean_sums + 8, 32);
-    const double *za = z[fa], *zb = z[fa + 1];
-    const v4 g00 = g0[0], g01 = g0[1], g02 = g0[2];
+    v4 a0, a1, a2, b0, b1, b2, c0, c1, c2;
+    std::memcpy(&a0, G_sums[F], 32), std::memcpy(&a1, G_sums[F] + 4, 32), std::memcpy(&a2, G_sums[F] + 8, 32);
+    std::memcpy(&b0, G_sums[F + 1], 32), std::memcpy(&b1, G_sums[F + 1] + 4, 32);
+    std::memcpy(&b2, G_sums[F + 1] + 8, 32);
+    std::memcpy(&c0, G_sums[F + 2], 32), std::memcpy(&c1, G_sums[F + 2] + 4, 32);
+    std::memcpy(&c2, G_sums[F + 2] + 8, 32);
+    const double *za = z[F], *zb = z[F + 1], *zc = z[F + 2];
     for (int i = 0; i < m; ++i) {
-      const std::uint32_t k = idx[i];
-      const v4u* row = reinterpret_cast<const v4u*>(values + 12 * std::size_t(k));
-      const v4 v0 = row[0], v1 = row[1], v2 = row[2];
-      if constexpr (kMean) m0 += v0, m1 += v1, m2 += v2;
-      const v4 d0 = v0 - g00, d1 = v1 - g01, d2 = v2 - g02;
-      const double a = za[k], b = zb[k];
+      const v4u* p = reinterpret_cast<const v4u*>(t[i].plus);
+      const v4u* q = reinterpret_cast<const v4u*>(t[i].minus);
+      const v4 d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
+      const std::uint32_t k = t[i].zk;
+      const double a = za[k], b = zb[k], c = zc[k];
       a0 += d0 * a, a1 += d1 * a, a2 += d2 * a;
       b0 += d0 * b, b1 += d1 * b, b2 += d2 * b;
+      c0 += d0 * c, c1 += d1 * c, c2 += d2 * c;
     }
-    std::memcpy(G_sums[fa], &a0, 32), std::memcpy(G_sums[fa] + 4, &a1, 32), std::memcpy(G_sums[fa] + 8, &a2, 32);
-    std::memcpy(G_sums[fa + 1], &b0, 32), std::memcpy(G_sums[fa + 1] + 4, &b1, 32);
-    std::memcpy(G_sums[fa + 1] + 8, &b2, 32);
-    if constexpr (kMean)
-      std::memcpy(mean_sums, &m0, 32), std::memcpy(mean_sums + 4, &m1, 32), std::memcpy(mean_sums + 8, &m2, 32);
+    std::memcpy(G_sums[F], &a0, 32), std::memcpy(G_sums[F] + 4, &a1, 32), std::memcpy(G_sums[F] + 8, &a2, 32);
+    std::memcpy(G_sums[F + 1], &b0, 32), std::memcpy(G_sums[F + 1] + 4, &b1, 32);
+    std::memcpy(G_sums[F + 1] + 8, &b2, 32);
+    std::memcpy(G_sums[F + 2], &c0, 32), std::memcpy(G_sums[F + 2] + 4, &c1, 32);
+    std::memcpy(G_sums[F + 2] + 8, &c2, 32);
   }
 
-  /// The valid samples among n0 .. n1 (sample n at n / 2 when even, evens + n / 2 when odd; converged, all values
-  /// finite) into idx, in sample order; returns their number.
-  __attribute__((always_inline)) static int valid_samples(const double* values, const Status* status,
-                                                          std::size_t n0, std::size_t n1, std::size_t evens,
-                                                          std::uint32_t* idx) {
-    int m = 0;
-    for (std::size_t n = n0; n < n1; ++n) {
-      const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
-      if (status[k] != Status::converged) continue;
-      const v4u* row = reinterpret_cast<const v4u*>(values + 12 * k);
-      const v4 v0 = row[0], v1 = row[1], v2 = row[2];
-      // x - x is 0 exactly when x is finite (NaN for inf and NaN): one lane compare for the 12 values (a lane
-      // of the sum is NaN, hence != 0, as soon as one of its terms is).
-      const v4 t = (v0 - v0) + (v1 - v1) + (v2 - v2);
-      const auto bad = t != 0.0;
-      bool any_bad = false;
-      for (int l = 0; l < 4; ++l) any_bad |= bad[l] != 0;
-      if (any_bad) continue;
-      idx[m++] = std::uint32_t(k);
-    }
-    return m;
+  /// Sample k converged with all values finite.
+  __attribute__((always_inline)) static bool valid_sample(const double* values, const Status* status,
+                                                          std::size_t k) {
+    if (status[k] != Status::converged) return false;
+    const v4u* row = reinterpret_cast<const v4u*>(values + 12 * k);
+    const v4 v0 = row[0], v1 = row[1], v2 = row[2];
+    // x - x is 0 exactly when x is finite (NaN for inf and NaN): one lane compare for the 12 values (a lane
+    // of the sum is NaN, hence != 0, as soon as one of its terms is).
+    const v4 t = (v0 - v0) + (v1 - v1) + (v2 - v2);
+    const auto bad = t != 0.0;
+    bool any_bad = false;
+    for (int l = 0; l < 4; ++l) any_bad |= bad[l] != 0;
+    return !any_bad;
   }
 
-  /// accumulate_samples() (wide_gjk.hpp): a row of 12 is three 4-lane vectors on every set; each entry's sums take
-  /// the valid samples in sample order, so the order of the passes over the columns does not change a bit.
-  /// A pair's samples usually fit one chunk (count <= kChunk: every M <= 256 with a whole pair in the block): that
-  /// case runs without the chunk loop, across which GCC kept the 21 sums in stack copies (loaded and stored around
-  /// the loop besides each pass's own loads and stores: ~200 instructions per call, a third of the call at M = 4,
-  /// callgrind AVX2).
+  /// accumulate_samples() (wide_gjk.hpp): a row of 12 is three 4-lane vectors on every set. The values' sums take
+  /// the valid samples in sample order; the noise sums take the antithetic pairs in order, a pair with both
+  /// samples valid as one term (v_2e - v_2e+1) z_2e (their copy's z is -z_2e exactly, so this is (v_2e - g0) z_2e +
+  /// (v_2e+1 - g0) z_2e+1 without g0, and half the multiply-adds), else its valid sample as (v - g0) z (branch
+  /// dv2; before, every valid sample's (v - g0) z one after the other: other rounding, the same estimator). A pair
+  /// never straddles two calls (blocks end on antithetic pairs), so a pair split over calls gives the same bits.
   static void accumulate(const double* values, const Status* status, const double* const* z, std::size_t count,
                          std::size_t evens, SampleSums& sums) {
-    v4 g0[3];
-    std::memcpy(g0, sums.g0, sizeof g0);
-    constexpr std::size_t kChunk = 256;
-    std::uint32_t idx[kChunk];
-    const auto chunk = [&](std::size_t n0, std::size_t n1) __attribute__((always_inline)) {
-      const int m = valid_samples(values, status, n0, n1, evens, idx);
-      pass<true>(values, idx, m, z, 0, sums.mean, sums.G, g0);
-      pass<false>(values, idx, m, z, 2, sums.mean, sums.G, g0);
-      pass<false>(values, idx, m, z, 4, sums.mean, sums.G, g0);
-      sums.valid += m;
-    };
-    if (count <= kChunk) return chunk(0, count);
-    for (std::size_t n0 = 0; n0 < count; n0 += kChunk) chunk(n0, std::min(count, n0 + kChunk));
+    constexpr std::size_t kChunk = 256;  // antithetic pairs per chunk
+    Term t[kChunk];
+    for (std::size_t e0 = 0; e0 < evens; e0 += kChunk) {
+      const std::size_t e1 = std::min(evens, e0 + kChunk);
+      v4 m0, m1, m2;
+      std::memcpy(&m0, sums.mean, 32), std::memcpy(&m1, sums.mean + 4, 32), std::memcpy(&m2, sums.mean + 8, 32);
+      int m = 0, valid = 0;
+      for (std::size_t e = e0; e < e1; ++e) {
+        const std::size_t ko = evens + e;
+        const bool ve = valid_sample(values, status, e), vo = 2 * e + 1 < count && valid_sample(values, status, ko);
+        const double* pe = values + 12 * e;
+        const double* po = values + 12 * ko;
+        if (ve) {
+          const v4u* row = reinterpret_cast<const v4u*>(pe);
+          m0 += row[0], m1 += row[1], m2 += row[2];
+        }
+        if (vo) {
+          const v4u* row = reinterpret_cast<const v4u*>(po);
+          m0 += row[0], m1 += row[1], m2 += row[2];
+        }
+        valid += int(ve) + int(vo);
+        if (ve && vo) t[m++] = {pe, po, std::uint32_t(e)};
+        else if (ve) t[m++] = {pe, sums.g0, std::uint32_t(e)};
+        else if (vo) t[m++] = {po, sums.g0, std::uint32_t(ko)};
+      }
+      std::memcpy(sums.mean, &m0, 32), std::memcpy(sums.mean + 4, &m1, 32), std::memcpy(sums.mean + 8, &m2, 32);
+      pass<0>(t, m, z, sums.G);
+      pass<3>(t, m, z, sums.G);
+      sums.valid += valid;
+    }
   }
 
   /// A register's plan values when its lanes belong to several pairs (small M: M / 2 < W): each field one vector,
@@ -429,8 +478,10 @@ struct WideSamples {
       if (q0 == q1) {  // one pair's samples (every register when count >= W, but for the last)
         const SamplePlan& p = *plans[q0];
         const std::size_t j0 = e0 - q0 * count, at = q0 * stride + j0;
-        // CounterRng(seed, pair, k, 0): p.key holds splitmix(splitmix(seed) ^ pair).
-        gaussians<6>(p.key, 0, a0 + j0, z);
+        // p.key holds splitmix(splitmix(seed) ^ pair).
+        u64 start{};
+        for (int l = 0; l < W; ++l) start[l] = noise_start(p.key, a0 + j0 + std::uint64_t(l));
+        sample_noise(start, z);
         const auto put = [at](double* dst, const real& v, int n) {
           if (n == W) std::memcpy(dst + at, &v, sizeof v);
           else for (int l = 0; l < n; ++l) dst[at + l] = v[l];
@@ -442,18 +493,17 @@ struct WideSamples {
       // lane's plan and are not stored), then each field from the lanes' plans.
       const SamplePlan* lane[W];
       std::size_t at[W];
-      u64 key{}, index{};
+      u64 start{};
       {
         std::size_t q = q0, j = e0 - q0 * count;
         for (int l = 0; l < W; ++l) {
           lane[l] = plans[q];
           at[l] = q * stride + j;
-          key[l] = plans[q]->key;
-          index[l] = a0 + j;
+          start[l] = noise_start(plans[q]->key, a0 + j);
           if (l + 1 < lanes && ++j == count) j = 0, ++q;
         }
       }
-      gaussians<6>(key, index, 0, z);
+      sample_noise(start, z);
       LanePlan lp;
       const auto field = [&](auto get) {
         real v;

@@ -1,8 +1,8 @@
 // The smoothed0 sample builder (kernels::simd::build_samples): its noise is engine/src/counter_rng.hpp's
-// gaussian_vector<6> bit for bit on every instruction set, antithetic copies are exact negations with the
+// sample_noise() bit for bit on every instruction set, antithetic copies are exact negations with the
 // transposed rotation, the poses are E R0 and t0 + s_t z with E the rotation exponential of s_w z_w, and the first
 // directions follow the plan. The smoothed1 draws (draw_gaussians4) are gaussian_vector<4> bit for bit, and the
-// smoothed0 reduction (accumulate_samples) is the scalar sample-order sums bit for bit, on every instruction set.
+// smoothed0 reduction (accumulate_samples) is the scalar antithetic-pair sums bit for bit, on every instruction set.
 #include "batchcol/batch.hpp"  // to_string(InstructionSet)
 #include "counter_rng.hpp"  // engine/src
 #include "kernels/simd/wide_gjk.hpp"
@@ -61,7 +61,7 @@ TEST(WideSamples, NoiseIsTheCounterGeneratorsAndPosesFollowThePlan) {
         kernels::simd::build_samples(isa, plans, 1, count, 5, count, odds, even.view, odd.view);
         for (std::size_t k = 0; k < count; ++k) {
           double z[6];
-          detail::gaussian_vector<6>(42, 9, 5 + k, 0, z);
+          detail::sample_noise(p.key, 5 + k, z);
           for (int e = 0; e < 6; ++e) ASSERT_TRUE(same(even.view.z[e][k], z[e])) << k << " " << e;
           const Eigen::Vector3d w = rotation * Eigen::Vector3d(z[3], z[4], z[5]);
           const Eigen::Matrix3d E = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
@@ -238,9 +238,10 @@ TEST(WideSamples, SupportNoiseFloatPiecesFollowLibm) {
   std::printf("worst relative -2 log error %.3g, worst sin/cos error %.3g\n", worst_log, worst_trig);
 }
 
-TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
+TEST(WideSamples, AccumulationIsTheAntitheticPairSums) {
   // 23 samples (an odd count: 12 firsts, 11 copies), values of all magnitudes, one non-converged sample and one
-  // with an infinite entry; the sums are taken in two calls (a pair split over blocks) and in one.
+  // with an infinite entry (each leaves its pair's other sample alone); the sums are taken in two calls (a pair
+  // split over blocks) and in one.
   const std::size_t count = 23, evens = 12;
   std::vector<double> values(12 * count, 0.0), zdata(6 * count);
   std::vector<Status> status(count, Status::converged);
@@ -259,20 +260,38 @@ TEST(WideSamples, AccumulationIsTheSampleOrderSums) {
   for (int f = 0; f < 6; ++f) z[f] = zdata.data() + f * count;
   double g0[10];
   for (double& g : g0) g = next();
-  // The reference: the scalar loop of the sums, sample by sample.
+  // The reference, antithetic pair by pair: the values' sums in sample order; a pair with both samples valid adds
+  // (v_first - v_copy) z_first, a valid sample alone (v - g0) z (the copy's z is -z_first in the engine; here
+  // unrelated numbers, so the copy's own z is seen to be used only when its first is invalid).
   double mean[10] = {}, G[6][10] = {};
-  int valid = 0;
-  for (std::size_t n = 0; n < count; ++n) {
-    const std::size_t k = n % 2 == 0 ? n / 2 : evens + n / 2;
+  int valid = 0, differ = 0;
+  const auto ok = [&](std::size_t k) {
     bool finite = status[k] == Status::converged;
     for (int e = 0; e < 10; ++e) finite = finite && std::isfinite(values[12 * k + e]);
-    if (!finite) continue;
-    for (int e = 0; e < 10; ++e) {
-      mean[e] += values[12 * k + e];
-      for (int f = 0; f < 6; ++f) G[f][e] += (values[12 * k + e] - g0[e]) * z[f][k];
-    }
-    ++valid;
+    return finite;
+  };
+  for (std::size_t e = 0; e < evens; ++e) {
+    const std::size_t ko = evens + e;
+    const bool ve = ok(e), vo = 2 * e + 1 < count && ok(ko);
+    for (std::size_t k : {e, ko})
+      if (k == e ? ve : vo)
+        for (int r = 0; r < 10; ++r) mean[r] += values[12 * k + r];
+    valid += int(ve) + int(vo);
+    for (int r = 0; r < 10; ++r)
+      for (int f = 0; f < 6; ++f) {
+        if (ve && vo) {
+          G[f][r] += (values[12 * e + r] - values[12 * ko + r]) * z[f][e];
+          // The former per-sample sum with the copy's z = -z_first rounds differently in most entries.
+          const double old = (values[12 * e + r] - g0[r]) * z[f][e] + (values[12 * ko + r] - g0[r]) * -z[f][e];
+          differ += old != (values[12 * e + r] - values[12 * ko + r]) * z[f][e];
+        } else if (ve) {
+          G[f][r] += (values[12 * e + r] - g0[r]) * z[f][e];
+        } else if (vo) {
+          G[f][r] += (values[12 * ko + r] - g0[r]) * z[f][ko];
+        }
+      }
   }
+  EXPECT_GT(differ, 0);
   EXPECT_EQ(valid, 21);
   for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
     if (!kernels::simd::cpu_has(isa)) continue;
