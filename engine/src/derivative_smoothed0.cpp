@@ -255,7 +255,7 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
       p.warm = warm_simplex(ha, hb, sp, p.g0, c.view.bounding_radii[c.batch.shape_a[i]] +
                                                    c.view.bounding_radii[c.batch.shape_b[i]]);
   }
-  sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // CounterRng's (seed, pair) half of the key
+  sp.key = splitmix64(splitmix64(c.o.seed) ^ i);  // the (seed, pair) key of counter_rng.hpp's sample_noise()
   sp.translation = p.s.translation;
   sp.rotation = p.s.rotation;
 }

@@ -32,7 +32,6 @@ namespace batchcol::kernels::simd {
                                 const SampleResults&, std::uint32_t*);                                             \
   void build_samples(const SamplePlan* const*, std::size_t, std::size_t, std::uint64_t, std::size_t, std::size_t, \
                      const SampleArrays&, const SampleArrays&);                                                    \
-  void draw_gaussians4(std::uint64_t, std::uint64_t, std::uint64_t, std::size_t, double* const*);                  \
   void draw_support_noise(const std::uint64_t*, std::size_t, std::size_t, double*);                               \
   void accumulate_samples(const double*, const Status*, const double* const*, std::size_t, std::size_t,            \
                           SampleSums&);                                                                            \
@@ -84,7 +83,6 @@ struct IsaKernels {
   decltype(&scalar::gjk_samples_double) gjk_samples_double;
   decltype(&scalar::gjk_samples_float) gjk_samples_float;
   decltype(&scalar::build_samples) build_samples;
-  decltype(&scalar::draw_gaussians4) draw_gaussians4;
   decltype(&scalar::accumulate_samples) accumulate_samples;
   decltype(&scalar::start_cells_double) start_cells_double;
   decltype(&scalar::start_cells_float) start_cells_float;
@@ -93,7 +91,7 @@ struct IsaKernels {
 #define BATCHCOL_ISA_TABLE(ns)                                                                               \
   IsaKernels { &ns::gjk_lanes_double, &ns::gjk_lanes_float, &ns::segment_pairs, &ns::box_pairs_boolean,      \
                &ns::point_solid_pairs, &ns::gjk_pairs_double, &ns::gjk_pairs_float, &ns::gjk_samples_double,   \
-               &ns::gjk_samples_float, &ns::build_samples, &ns::draw_gaussians4, &ns::accumulate_samples,      \
+               &ns::gjk_samples_float, &ns::build_samples, &ns::accumulate_samples,                           \
                &ns::start_cells_double, &ns::start_cells_float, &ns::draw_support_noise }
 // Indexed by InstructionSet: automatic (never passed once resolved; the scalar build, as any set would give the
 // same bits), scalar, avx2, avx512.
@@ -182,11 +180,6 @@ void build_samples(InstructionSet isa, const SamplePlan* const* plans, std::size
 void accumulate_samples(InstructionSet isa, const double* values, const Status* status, const double* const* z,
                         std::size_t count, std::size_t evens, SampleSums& sums) {
   kernels_of(isa).accumulate_samples(values, status, z, count, evens, sums);
-}
-
-void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream, std::uint64_t k0,
-                     std::size_t count, double* const* z) {
-  kernels_of(isa).draw_gaussians4(key, stream, k0, count, z);
 }
 
 void draw_support_noise(InstructionSet isa, const std::uint64_t* keys, std::size_t pairs, std::size_t draws,

@@ -88,9 +88,6 @@ void accumulate_samples(const double* values, const Status* status, const double
                         std::size_t evens, SampleSums& sums) {
   WideSamples::accumulate(values, status, z, count, evens, sums);
 }
-void draw_gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count, double* const* z) {
-  WideSamples::gaussians4(key, stream, k0, count, z);
-}
 void draw_support_noise(const std::uint64_t* keys, std::size_t pairs, std::size_t draws, double* z) {
   WideSamples::support_noise(keys, pairs, draws, z);
 }

@@ -123,7 +123,7 @@ struct SampleArrays {
   double* z[6] = {};
 };
 /// Antithetic pairs k = a0 .. a0 + count - 1 of each plan plans[q], q < pairs (kernels/simd/wide_samples.inl): z
-/// from the counter key (pair, k), sample 2k (E R0, t0 + s_t z, z) at index q stride + k - a0 of `even`, its
+/// = engine/src/counter_rng.hpp's sample_noise(key, k), sample 2k (E R0, t0 + s_t z, z) at index q stride + k - a0 of `even`, its
 /// antithetic copy (E^T R0, t0 - s_t z, -z) at the same index of `odd` for the first odd_count pairs (several
 /// plans: odd_count == count). Several plans share registers when count < W; the same bits on every instruction
 /// set, whatever a plan shares a register with.
@@ -132,23 +132,20 @@ void build_samples(InstructionSet isa, const SamplePlan* const* plans, std::size
                    const SampleArrays& odd);
 /// One pair's running sums of the smoothed0 estimator (engine/src/derivative_smoothed0.cpp), in A's frame: over the
 /// samples that entered (`valid` of them), the sum of their 10 values v (distance, witness a, witness b, normal) and
-/// the sums of (v - g0) z_f for the 6 noise coordinates f. Rows of 12 (two padding entries) for whole registers.
+/// the estimator's sums for the 6 noise coordinates f over the antithetic pairs: (v_2e - v_2e+1) z_2e,f when both
+/// samples entered, (v - g0) z_f for a lone one. Rows of 12 (two padding entries) for whole registers.
 struct SampleSums {
   double mean[12] = {};
   double G[6][12] = {};
   double g0[12] = {};  // the unperturbed answer; padding 0
   int valid = 0;
 };
-/// Adds `count` samples to `sums` in sample order (sample 2e at index e, 2e+1 at evens + e; each entry adds its
-/// samples one after the other, so a pair split over calls gives the same bits): sample k's values are
+/// Adds `count` samples to `sums` (sample 2e at index e, 2e+1 at evens + e): the values in sample order, the noise
+/// sums by antithetic pair in order (blocks end on antithetic pairs, so a pair split over calls gives the same bits): sample k's values are
 /// values[12 k .. 12 k + 9] (padding 0), its noise z[f][k]; a sample whose status is not converged or with a
 /// non-finite value adds nothing. The same bits on every set (elementwise IEEE operations, no contraction).
 void accumulate_samples(InstructionSet isa, const double* values, const Status* status, const double* const* z,
                         std::size_t count, std::size_t evens, SampleSums& sums);
-/// engine/src/counter_rng.hpp's gaussian_vector<4>(seed, pair, k, stream) for k = k0 .. k0 + count - 1 into
-/// z[0..3][k - k0], W draws per register (key = splitmix64(splitmix64(seed) ^ pair)). The same bits on every set.
-void draw_gaussians4(InstructionSet isa, std::uint64_t key, std::uint64_t stream, std::uint64_t k0,
-                     std::size_t count, double* const* z);
 /// engine/src/counter_rng.hpp's support_noise_pair(keys[p], j) for j < 3 draws into z[6 draws p + 2 j] and the
 /// next entry, pairs p < `pairs` (smoothed1's noise of a block of pairs, W pairs per register). The same bits on
 /// every set.

@@ -22,47 +22,8 @@ struct WideSamples {
   }
   static real splat(double v) { return real{} + v; }
 
-  /// x (at most 2^53) as a double, exactly. AVX-512DQ converts 64-bit lanes natively; AVX2 has no such instruction
-  /// and GCC converted lane by lane through scalar registers (a fifth of this file's instructions): there the 32-bit
-  /// halves go through the 2^52 exponent trick and hi 2^32 + lo is exact (at most 53 significant bits).
-  static real exact_u53(u64 x) {
-#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
-    return __builtin_convertvector(x, real);
-#else
-    const u64 hi = (x >> 32) | 0x4330000000000000ull, lo = (x & 0xFFFFFFFFull) | 0x4330000000000000ull;
-    return ((real)hi - 0x1.0p52) * 0x1.0p32 + ((real)lo - 0x1.0p52);
-#endif
-  }
-  /// A small signed lane integer (|k| < 2^51) as a double, exactly (the same trick).
-  static real exact_small(mask k) {
-#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
-    return __builtin_convertvector(k, real);
-#else
-    return (real)(k + 0x4338000000000000ll) - 0x1.8p52;
-#endif
-  }
-  /// CounterRng::uniform(): (next >> 11) + 1 times 2^-53, exact.
-  static real uniform(u64& state) {
-    state += 0x9E3779B97F4A7C15ull;
-    const u64 x = (splitmix(state) >> 11) + 1;
-    return exact_u53(x) * 0x1.0p-53;
-  }
-  /// counter_rng.hpp's log_unit, lane by lane.
-  static real log_unit(real u) {
-    const u64 bits = (u64)u;  // same-size vector casts keep the bits
-    mask k = mask((bits >> 52)) - 1023;
-    const u64 mbits = (bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
-    real m = (real)mbits;
-    const mask big = m > 1.4142135623730951;
-    m = select(big, m * 0.5, m);
-    k = select(big, k + 1, k);
-    const real s = (m - 1.0) / (m + 1.0), z = s * s;
-    const real p = (((((((((((1.0 / 23.0) * z + 1.0 / 21.0) * z + 1.0 / 19.0) * z + 1.0 / 17.0) * z + 1.0 / 15.0) *
-                            z + 1.0 / 13.0) * z + 1.0 / 11.0) * z + 1.0 / 9.0) * z + 1.0 / 7.0) * z + 1.0 / 5.0) *
-                      z + 1.0 / 3.0) * z + 1.0;
-    return exact_small(k) * 0.6931471805599453 + 2.0 * s * p;
-  }
-  /// counter_rng.hpp's sinc_cos_small.
+  /// sin(x) / x and cos(x) for |x| <= pi/4 by their Taylor series to x^16 (remainder below 5e-17): the samples'
+  /// rotations, the same bits on every set (plain IEEE operations, no contraction).
   static void sinc_cos_small(real x, real& sinc, real& cos) {
     const real z = x * x;
     sinc = ((((((((-1.0 / 355687428096000.0) * z + 1.0 / 1307674368000.0) * z - 1.0 / 6227020800.0) * z +
@@ -70,76 +31,6 @@ struct WideSamples {
     sinc = 1.0 - z * sinc;
     cos = (((((((1.0 / 20922789888000.0 * z - 1.0 / 87178291200.0) * z + 1.0 / 479001600.0) * z -
                  1.0 / 3628800.0) * z + 1.0 / 40320.0) * z - 1.0 / 720.0) * z + 1.0 / 24.0) * z - 0.5) * z + 1.0;
-  }
-  /// counter_rng.hpp's sincos_turn: the quarter turn q = int(4u + 0.5) removed exactly, then the series.
-  static void sincos_turn(real u, real& sin, real& cos) {
-    mask q;
-    real qd;
-    quarter_turn(u, q, qd);
-    const real x = 6.283185307179586 * (u - 0.25 * qd);
-    real sx, cx;
-    sinc_cos_small(x, sx, cx);
-    sx *= x;
-    rotate_quarters(q, sx, cx, sin, cos);
-  }
-  /// q = int(4u + 0.5) (u in [0, 1]: 0 .. 4), as the scalar code's truncation, and q as a double. Without
-  /// AVX-512DQ: rounded through the 1.5 2^52 trick, one less where that rounded up; the integer is then the sum's
-  /// low mantissa bits.
-  static void quarter_turn(real u, mask& q, real& qd) {
-#if defined(__AVX512DQ__) || BATCHCOL_SIMD_BYTES == 0
-    q = __builtin_convertvector(4.0 * u + 0.5, mask);
-    qd = __builtin_convertvector(q, real);
-#else
-    const real v = 4.0 * u + 0.5;
-    qd = (v + 0x1.8p52) - 0x1.8p52;
-    qd = select(qd > v, qd - 1.0, qd);
-    q = (mask)(qd + 0x1.8p52);
-#endif
-  }
-  /// sin and cos of x + q pi/2 from sx = sin x, cx = cos x.
-  static void rotate_quarters(mask q, real sx, real cx, real& sin, real& cos) {
-    const mask quarter = q & 3;
-    const mask q1 = quarter == 1, q2 = quarter == 2, q3 = quarter == 3;
-    sin = select(q1, cx, select(q2, -sx, select(q3, -cx, sx)));
-    cos = select(q1, -sx, select(q2, -cx, select(q3, sx, cx)));
-  }
-
-  /// gaussian_vector<N>(seed, pair, k, stream) for k = k0 .. k0 + W - 1, lane by lane (key: splitmix(splitmix(seed)
-  /// ^ pair), as SamplePlan::key).
-  template <int N> static void gaussians(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, real* z) {
-    u64 index{};
-    for (int l = 0; l < W; ++l) index[l] = k0 + std::uint64_t(l);
-    gaussians<N>(u64{} + key, index, stream, z);
-  }
-  /// The same with a key and an index per lane (lanes of different pairs).
-  template <int N> static void gaussians(u64 key, u64 index, std::uint64_t stream, real* z) {
-    gaussians<N>(key, index, u64{} + stream, z);
-  }
-  /// The same with a stream per lane too (the form the two above forward to).
-  template <int N> static void gaussians(u64 key, u64 index, u64 stream, real* z) {
-    u64 state = splitmix(splitmix(key ^ index) ^ stream);
-    for (int g = 0; g < N; g += 2) {
-      const real radius = wsqrt<double>(-2.0 * log_unit(uniform(state)));
-      real s, c;
-      sincos_turn(uniform(state), s, c);
-      z[g] = radius * c;
-      z[g + 1] = radius * s;
-    }
-  }
-
-  /// gaussian_vector<4>(seed, pair, k, stream) for k = k0 .. k0 + count - 1 into z[c][k - k0] (the smoothed1
-  /// support samples, engine/src/derivative_support.cpp: drawn W at a time instead of one libm-free scalar draw each).
-  static void gaussians4(std::uint64_t key, std::uint64_t stream, std::uint64_t k0, std::size_t count,
-                         double* const* z) {
-    for (std::size_t e0 = 0; e0 < count; e0 += W) {
-      real v[4];
-      gaussians<4>(key, stream, k0 + e0, v);
-      const std::size_t lanes = std::min<std::size_t>(W, count - e0);
-      for (int c = 0; c < 4; ++c) {
-        if (lanes == std::size_t(W)) std::memcpy(z[c] + e0, &v[c], sizeof v[c]);
-        else for (std::size_t l = 0; l < lanes; ++l) z[c][e0 + l] = v[c][l];
-      }
-    }
   }
 
   /// support_noise()'s float lanes: 2 W of them in a register (lane 2l + i: pair l's transform j + i).

@@ -1,7 +1,7 @@
 // The smoothed0 sample builder (kernels::simd::build_samples): its noise is engine/src/counter_rng.hpp's
 // sample_noise() bit for bit on every instruction set, antithetic copies are exact negations with the
 // transposed rotation, the poses are E R0 and t0 + s_t z with E the rotation exponential of s_w z_w, and the first
-// directions follow the plan. The smoothed1 draws (draw_gaussians4) are gaussian_vector<4> bit for bit, and the
+// directions follow the plan. The smoothed1 noise (draw_support_noise) is support_noise_pair() bit for bit, and the
 // smoothed0 reduction (accumulate_samples) is the scalar antithetic-pair sums bit for bit, on every instruction set.
 #include "batchcol/batch.hpp"  // to_string(InstructionSet)
 #include "counter_rng.hpp"  // engine/src
@@ -137,30 +137,6 @@ TEST(WideSamples, SeveralPairsPerRegisterGiveEachPairsOwnSamples) {
             ASSERT_TRUE(same(block.data[at], e1.data[alone])) << q << " " << a << " " << k;
             ASSERT_TRUE(same(block.data[at + count], o1.data[alone])) << q << " " << a << " " << k;
           }
-      }
-    }
-  }
-}
-
-TEST(WideSamples, SmoothedFirstOrderDrawsAreTheCounterGenerators) {
-  // Many keys and counts (partial registers), so that the uniforms' conversions and the quarter-turn rounding meet
-  // many values (AVX2 converts 64-bit lanes without a conversion instruction).
-  for (std::uint64_t pair : {0ull, 3ull, 1000003ull}) {
-    for (std::uint64_t stream : {1ull, 2ull}) {
-      const std::size_t count = 1000 + pair % 7;
-      const std::uint64_t key = detail::splitmix64(detail::splitmix64(77) ^ pair);
-      for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
-        if (!kernels::simd::cpu_has(isa)) continue;
-        SCOPED_TRACE(to_string(isa));
-        std::vector<double> buffer(4 * count, -7.0);
-        double* const z[4] = {buffer.data(), buffer.data() + count, buffer.data() + 2 * count,
-                              buffer.data() + 3 * count};
-        kernels::simd::draw_gaussians4(isa, key, stream, 11, count, z);
-        for (std::size_t k = 0; k < count; ++k) {
-          double r[4];
-          detail::gaussian_vector<4>(77, pair, 11 + k, stream, r);
-          for (int c = 0; c < 4; ++c) ASSERT_TRUE(same(z[c][k], r[c])) << pair << " " << k << " " << c;
-        }
       }
     }
   }
