@@ -397,13 +397,11 @@ template <class T> struct WideGjk {
   AI static Edge pick(mask m, const Edge& a, const Edge& b) {
     return {pick(m, a.x, b.x), blend(m, a.u, b.u), blend(m, a.kind, b.kind), blend(m, a.i, b.i), blend(m, a.j, b.j)};
   }
-  /// The segment from qi to qj (input indices i, j in each lane), given dq = qi - qj: the reference's segment(),
-  /// same results. It has t = qj - qi = -dq, and negation is exact (every product and sum of -dq's terms is the
-  /// negated one of t's, rounded alike), so |t|^2 = |dq|^2 and -<qi, t> = <qi, dq> bit for bit: project() shares
-  /// dq with the faces' normals, which take the same differences.
-  AI static Edge edge(const V3& qi, const V3& qj, const V3& dq, mask i, mask j) {
-    const real tt = norm2(dq);
-    const real u = dot(qi, dq) / tt;
+  /// The segment from qi to qj (input indices i, j in each lane): the reference's segment(), same operations.
+  AI static Edge edge(const V3& qi, const V3& qj, mask i, mask j) {
+    const V3 t = sub(qj, qi);
+    const real tt = norm2(t);
+    const real u = (-dot(qi, t)) / tt;
     const real zero = splat(T(0)), one = splat(T(1));
     const mask at_i = (tt == zero) | (u <= zero), at_j = ~at_i & (u >= one);
     const V3 inner = add(scale(one - u, qi), scale(u, qj));
@@ -436,10 +434,9 @@ template <class T> struct WideGjk {
     V3 n;
     real nn, sn, t;
   };
-  /// From the edges at qk, a = qi - qk and b = qj - qk (project() shares them between faces and edges).
-  static Plane plane(const V3& a, const V3& b, const V3& qk) {
+  static Plane plane(const V3& qi, const V3& qj, const V3& qk) {
     Plane h;
-    h.n = cross(a, b);
+    h.n = cross(sub(qi, qk), sub(qj, qk));
     h.nn = norm2(h.n);
     h.sn = dot(qk, h.n);
     h.t = h.sn / h.nn;
@@ -504,7 +501,7 @@ template <class T> struct WideGjk {
     const mask three = live & (count == splat_mask(2)), four = live & (count == splat_mask(3));
     const mask newest = splat_mask(3);  // s's index (see above)
     // Only segment lanes (the first iterations of a run, short pairs): the segment alone, as segment() did.
-    if (!any(three | four)) return to_proj(edge(p[0], s, sub(p[0], s), splat_mask(0), newest));
+    if (!any(three | four)) return to_proj(edge(p[0], s, splat_mask(0), newest));
     // Tetrahedron lanes (tetrahedron()): the origin inside, else the faces keeping vertex 3 that it sees (cand[m]:
     // face m omits vertex m), and the visible face whose plane is farthest from the origin (the reference's rule,
     // same arithmetic): where the origin's projection lies inside that face, it is the answer; else an edge to s is
@@ -513,19 +510,14 @@ template <class T> struct WideGjk {
     // is also the triangle lanes' face; the tetrahedron lanes need all three. Their <s, n_m> are the signed
     // volumes V[0], -V[1], V[2] (the triple product <s, (p_I - s) x (p_J - s)> = <s, p_I x p_J>), so three of the
     // four determinants are not computed again, and the face() call takes its plane from here.
-    // The differences p_k - s, each shared by two faces' normals and edge k (edge() says why the edge's bits are
-    // the same): 9 subtractions instead of 27 per tetrahedron lane register.
-    V3 dp[3];
-    dp[0] = sub(p[0], s), dp[1] = sub(p[1], s), dp[2] = dp[1];
     Plane h[3];
-    h[2] = plane(dp[0], dp[1], s);
+    h[2] = plane(p[0], p[1], s);
     h[0] = h[1] = h[2];
     real V[4] = {zero, zero, zero, zero}, total = zero;
     mask inside = splat_mask(0), have_first = splat_mask(0), first_0 = splat_mask(0), first_2 = splat_mask(0);
     mask cand[3] = {splat_mask(0), splat_mask(0), splat_mask(0)};
     if (any(four)) {
-      dp[2] = sub(p[2], s);
-      h[0] = plane(dp[1], dp[2], s), h[1] = plane(dp[0], dp[2], s);
+      h[0] = plane(p[1], p[2], s), h[1] = plane(p[0], p[2], s);
       V[0] = h[0].sn, V[1] = -h[1].sn, V[2] = h[2].sn, V[3] = -det3(p[0], p[1], p[2]);
       total = ((V[0] + V[1]) + V[2]) + V[3];
       inside = four & (total != zero);
@@ -557,16 +549,16 @@ template <class T> struct WideGjk {
     // it where no lane needs them (registers, not zeroed memory).
     Edge E[3];
     real En[3];
-    E[0] = edge(p[0], s, dp[0], splat_mask(0), newest), En[0] = norm2(E[0].x);
+    E[0] = edge(p[0], s, splat_mask(0), newest), En[0] = norm2(E[0].x);
     E[1] = E[0], En[1] = En[0], E[2] = E[0], En[2] = En[0];
-    if (any(tri_edges | rest)) E[1] = edge(p[1], s, dp[1], splat_mask(1), newest), En[1] = norm2(E[1].x);
+    if (any(tri_edges | rest)) E[1] = edge(p[1], s, splat_mask(1), newest), En[1] = norm2(E[1].x);
     // The tetrahedron lanes whose first face was not the answer: their answer is an edge to s, the closest of the
     // edges k-3 of the visible faces (the reference's tetrahedron() says why no other face's interior can be
     // closer). Those are the edges the faces' own triangle() calls chose between, so no other face() is computed.
     real best_n2 = splat(std::numeric_limits<T>::infinity());
     mask best_edge = splat_mask(0), have = splat_mask(0);
     if (any(rest)) {
-      E[2] = edge(p[2], s, dp[2], splat_mask(2), newest), En[2] = norm2(E[2].x);
+      E[2] = edge(p[2], s, splat_mask(2), newest), En[2] = norm2(E[2].x);
       // Edge k belongs to the visible faces that hold old vertex k: face m holds every old vertex but m. Visited
       // in order, the first of equal ones kept.
       const mask holds[3] = {cand[1] | cand[2], cand[0] | cand[2], cand[0] | cand[1]};
