@@ -419,16 +419,6 @@ template <class T> struct WideGjk {
     r.lambda[1] = blend(inner, e.u, zero);
     return r;
   }
-  static real coordinate(const V3& p, mask drop0, mask drop1, int which) {
-    // which 0: the first kept axis (drop + 1) % 3; which 1: the second (drop + 2) % 3.
-    if (which == 0) return blend(drop0, p.y, blend(drop1, p.z, p.x));
-    return blend(drop0, p.z, blend(drop1, p.x, p.y));
-  }
-
-  static real area(real au, real av, real bu, real bv, real cu, real cv) {
-    return (bu - au) * (cv - av) - (bv - av) * (cu - au);
-  }
-
   /// Triangle qi, qj, qk (qk newest), the reference's triangle() up to the choice of edge: the interior point and
   /// its weights, whether it is the answer (`use`), else which of the edges i-k, j-k are candidates.
   struct Face {
@@ -436,9 +426,10 @@ template <class T> struct WideGjk {
     real lambda[3];
     mask use, via_i, via_j;
   };
-  /// The face's normal comes from the caller: n = (qi - qk) x (qj - qk), nn = |n|^2, t = <qk, n> / nn (the
-  /// origin's projection on the plane is t n). project() computes them for every face keeping s anyway (the
-  /// tetrahedron's visibility rule and its signed volumes), so the face does not compute them again.
+  /// The face's normal comes from the caller: n = (qi - qk) x (qj - qk), nn = |n|^2, sn = <qk, n>, t = sn / nn
+  /// (the origin's projection on the plane is t n; the tetrahedron's farthest-face rule reads sn t). project()
+  /// computes them for every face keeping s anyway (the tetrahedron's visibility rule and its signed volumes), so
+  /// the face does not compute them again.
   struct Plane {
     V3 n;
     real nn, sn, t;
@@ -457,33 +448,25 @@ template <class T> struct WideGjk {
   AI static Face face(const V3& qi, const V3& qj, const V3& qk, const Plane& h) {
     const real zero = splat(T(0));
     const V3& n = h.n;
-    const real nn = h.nn;
-    const V3 p0 = scale(h.t, n);
-    const real ax = blend(n.x < zero, -n.x, n.x), ay = blend(n.y < zero, -n.y, n.y), az = blend(n.z < zero, -n.z, n.z);
-    const mask d1 = ay > ax;
-    const mask d2 = az > blend(d1, ay, ax);
-    const mask drop0 = ~d1 & ~d2, drop1 = d1 & ~d2;
-    // The four points in the kept coordinates (u, v), selected once.
-    const real u0 = coordinate(p0, drop0, drop1, 0), v0 = coordinate(p0, drop0, drop1, 1);
-    const real ui = coordinate(qi, drop0, drop1, 0), vi = coordinate(qi, drop0, drop1, 1);
-    const real uj = coordinate(qj, drop0, drop1, 0), vj = coordinate(qj, drop0, drop1, 1);
-    const real uk = coordinate(qk, drop0, drop1, 0), vk = coordinate(qk, drop0, drop1, 1);
-    const real C[3] = {area(u0, v0, uj, vj, uk, vk), area(ui, vi, u0, v0, uk, vk), area(ui, vi, uj, vj, u0, v0)};
-    const real total = area(ui, vi, uj, vj, uk, vk);
-    const mask inside = ~opposite_sign(C[0], total) & ~opposite_sign(C[1], total) & ~opposite_sign(C[2], total);
-    const real sum = (C[0] + C[1]) + C[2];
+    // The weights as the reference's triangle() computes them: triple products with r = qk - t n and the edges at
+    // qk, C_k = |n|^2 - C_i - C_j; the total is |n|^2 > 0, so a weight is of the wrong sign when negative.
+    const V3 r = sub(qk, scale(h.t, n));
+    const real Ci = dot(r, cross(n, sub(qj, qk))), Cj = dot(r, cross(sub(qi, qk), n));
+    const real C[3] = {Ci, Cj, (h.nn - Ci) - Cj};
+    const mask neg_i = C[0] < zero, neg_j = C[1] < zero;
+    const mask inside = ~neg_i & ~neg_j & ~(C[2] < zero);
     Face f;
     // One division and three products instead of three divisions (tests/support/reference_simplex_projection.hpp
     // alike): the loop is bound by its divisions and square roots on AVX-512 double (face_direction() says why);
-    // the weights move by at most an ulp or so, well inside the rounding of the areas themselves.
-    const real inv = splat(T(1)) / sum;
+    // the weights move by at most an ulp or so, well inside the rounding of the triple products themselves.
+    const real inv = splat(T(1)) / ((C[0] + C[1]) + C[2]);
     for (int m = 0; m < 3; ++m) f.lambda[m] = C[m] * inv;
     f.x = add(add(scale(f.lambda[0], qi), scale(f.lambda[1], qj)), scale(f.lambda[2], qk));
-    const mask degenerate = (nn == zero) | (total == zero);
-    f.use = ~degenerate & inside & (sum != zero);
+    const mask degenerate = h.nn == zero;
+    // Inside, the weights' sum is positive (triangle() says why): no test of it.
+    f.use = ~degenerate & inside;
     // Edge i-k is opposite j (weight C[1]), edge j-k opposite i (C[0]); neither or both: both are candidates.
-    const mask wrong_i = ~degenerate & ~inside & opposite_sign(C[1], total);
-    const mask wrong_j = ~degenerate & ~inside & opposite_sign(C[0], total);
+    const mask wrong_i = ~degenerate & neg_j, wrong_j = ~degenerate & neg_i;
     f.via_i = wrong_i | ~wrong_j;
     f.via_j = wrong_j | ~wrong_i;
     return f;

@@ -116,6 +116,35 @@ TEST(SimplexProjection, FirstFaceMissedGivesTheClosestVisibleEdge) {
   EXPECT_EQ(r.x, p[0]);
 }
 
+TEST(SimplexProjection, TriangleWeightsAreTripleProductsAtTheFoot) {
+  // The face weights are C_i = <r, n x b>, C_j = <r, a x n>, C_k = |n|^2 - C_i - C_j with a, b the edges at the
+  // newest vertex p2, n = a x b and r = p2 - p0 (p0 = the origin's foot on the plane), over their sum: bit for bit
+  // (the SIMD kernel repeats them). The old rule (signed areas on the best coordinate plane) rounds otherwise and
+  // fails here; both are exact in exact arithmetic.
+  testing::Rng rng(19);
+  int faces = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Vector3d u = testing::random_unit_vector(rng), e = u.cross(testing::random_unit_vector(rng)).normalized();
+    const Eigen::Vector3d f = u.cross(e), foot = 0.3 * u;
+    // Around the foot, so that most triangles hold it: their answer is the face.
+    const std::vector<Eigen::Vector3d> p = {foot + 0.4 * (-e - f) + 0.1 * testing::random_vector(rng),
+                                            foot + 0.4 * (e - f) + 0.1 * testing::random_vector(rng),
+                                            foot + 0.4 * f + 0.1 * testing::random_vector(rng)};
+    const auto r = project_origin(p.data(), 3);
+    if (r.count != 3) continue;
+    ++faces;
+    const Eigen::Vector3d a = p[0] - p[2], b = p[1] - p[2], n = cross3<double>(a, b);
+    const double nn = norm2(n);
+    const Eigen::Vector3d rk = p[2] - n * (dot3(p[2], n) / nn);
+    const double ci = dot3(rk, cross3<double>(n, b)), cj = dot3(rk, cross3<double>(a, n)), ck = (nn - ci) - cj;
+    const double inv = 1.0 / (ci + cj + ck);
+    EXPECT_EQ(r.lambda[0], ci * inv) << trial;
+    EXPECT_EQ(r.lambda[1], cj * inv) << trial;
+    EXPECT_EQ(r.lambda[2], ck * inv) << trial;
+  }
+  EXPECT_GT(faces, 150);
+}
+
 TEST(SimplexProjection, DegenerateSimplicesGiveFiniteConvexCombinations) {
   const Eigen::Vector3d a(1, 1, 1), b(2, 2, 2), c(3, 3, 3), d(1, 1, 1);
   const std::vector<std::vector<Eigen::Vector3d>> cases = {
