@@ -38,11 +38,14 @@ void validate_batch_layout(const PairBatch& b) {
 
 void validate_batch_layout(const PairBatchView& b) {
   const std::size_t n = b.size();
+  // The message is built only on failure: built eagerly for the 16 arrays it was ~8k instructions a call (half of a
+  // 16-pair call's cost, callgrind).
   const auto check = [n](const auto& span, const char* name, const char* component) {
-    std::string what = std::string("PairBatchView::") + name + component;
+    if (span.size() == n && (n == 0 || span.data() != nullptr)) return;
+    const std::string what = std::string("PairBatchView::") + name + component;
     if (span.size() != n)
       throw InputError(what + " has " + std::to_string(span.size()) + " entries, expected " + std::to_string(n));
-    if (n > 0 && span.data() == nullptr) throw InputError(what + " has " + std::to_string(n) + " entries but no data");
+    throw InputError(what + " has " + std::to_string(n) + " entries but no data");
   };
   check(b.shape_a, "shape_a", "");
   check(b.shape_b, "shape_b", "");
