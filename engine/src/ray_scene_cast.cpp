@@ -314,6 +314,18 @@ void size_unfilled(RayResults& r, std::size_t n) {
 // small pages, one per 2 MiB with huge ones; mapped once, not faulted in and cleared by the kernel for every cast.
 using PackedRay = WideRayRecord;  // one cache line
 
+// The cast's context of a packed ray whose setup status is not kWideRayInvalid (its wide record `wide`).
+RayContext context_of(const PackedRay& p, std::uint8_t status, const WideRay* wide) {
+  RayContext r;
+  r.o = Vec3<double>(p.o[0], p.o[1], p.o[2]);
+  r.d = Vec3<double>(p.d[0], p.d[1], p.d[2]);
+  r.t_max = p.t_max;
+  r.d2 = r.d.squaredNorm();
+  r.wide_ok = status == kWideRaySupported;
+  r.wide = wide;
+  return r;
+}
+
 struct CastResult {
   Hit best;
   bool found;
@@ -429,14 +441,8 @@ void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) 
         for (std::size_t l = 0; l < m; ++l) {
           found[l] = false, capped[l] = false;
           if (status[l] == kWideRayInvalid) continue;
-          const PackedRay& p = *group[l];
           RayContext& r = ctx[l];
-          r.o = Vec3<double>(p.o[0], p.o[1], p.o[2]);
-          r.d = Vec3<double>(p.d[0], p.d[1], p.d[2]);
-          r.t_max = p.t_max;
-          r.d2 = r.d.squaredNorm();
-          r.wide_ok = status[l] == kWideRaySupported;
-          r.wide = &wide[l];
+          r = context_of(*group[l], status[l], &wide[l]);
           if (r.wide_ok)
             wide_lanes |= 1u << l;
           else
@@ -530,17 +536,10 @@ void RaySceneIndex::cast(const RayBatch& rays, const RayOptions& options, RayRes
               setup(group, m, wide, status);
               caster.prepare(wide, m);
             }
-            const PackedRay& p = order.ray(k);
             CastResult& res = order.result(k);
             res.found = false, res.status = RayStatus::invalid_input;
             if (status[lane] == kWideRayInvalid) continue;
-            RayContext r;
-            r.o = Vec3<double>(p.o[0], p.o[1], p.o[2]);
-            r.d = Vec3<double>(p.d[0], p.d[1], p.d[2]);
-            r.t_max = p.t_max;
-            r.d2 = r.d.squaredNorm();
-            r.wide_ok = status[lane] == kWideRaySupported;
-            r.wide = &wide[lane];
+            RayContext r = context_of(order.ray(k), status[lane], &wide[lane]);
             bool capped = false;
             caster.closest_or_any(r, any, res.best, res.found, capped);
             res.status = capped ? RayStatus::max_iterations : RayStatus::ok;
