@@ -177,8 +177,14 @@ template <class Block> void store_block(std::size_t count, StreamRows* stream, d
       // Lane j of the line: carry lane j + 8 - shift for j < shift, this block's lane j - shift after.
       const std::int64_t shift = rows.shift[e];
       const __m512i index = _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
-      const __m512d line = _mm512_permutex2var_pd(_mm512_load_pd(rows.carry[e]), index, (__m512d)v);
-      double* const start = out[e] + at - shift;
+      // Not carried: the line's first `shift` lanes are masked off below, so the carry (never written yet in a
+      // range's first streamed block) is not read at all.
+      const __m512d previous = carried ? _mm512_load_pd(rows.carry[e]) : _mm512_setzero_pd();
+      const __m512d line = _mm512_permutex2var_pd(previous, index, (__m512d)v);
+      // The line's start may lie before the array (at < shift, its lanes masked off): integer arithmetic, since a
+      // pointer before its array is undefined even when never dereferenced.
+      double* const start = reinterpret_cast<double*>(reinterpret_cast<std::uintptr_t>(out[e] + at) -
+                                                      static_cast<std::uintptr_t>(shift) * sizeof(double));
       if (carried) _mm512_stream_pd(start, line);
       else _mm512_mask_storeu_pd(start, static_cast<__mmask8>(0xFFu << shift), line);
       _mm512_store_pd(rows.carry[e], (__m512d)v);

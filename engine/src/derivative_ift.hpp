@@ -95,7 +95,8 @@ static_assert(store_at::distance_a == 0 && store_at::distance_b == 6 && store_at
 /// How AVX-512 writes whole blocks of a large output (StoreBlock): every row in whole 64-byte lines with
 /// non-temporal stores, which write a line without first reading it and keep the output from evicting the cache.
 /// A block starts a line of the rows whose bit is set in `whole` (8 pairs: one aligned store). Another row's line
-/// starts shift[e] pairs before the block (1..7: the arrays are separate allocations): the block completes that
+/// starts shift[e] pairs before the block (1..7: the arrays are separate allocations, and rows of one array start n
+/// entries apart): the block completes that
 /// line with the last shift[e] entries of the previous block, kept in carry[e], and keeps its own in carry[e]
 /// for the next line; `carried` says that carry holds the block just before (contiguous, this task range's),
 /// otherwise only the block's own part of the line is stored (a masked, regular store). The last block's carried

@@ -47,8 +47,8 @@ void entry_rows(DerivativeResults& d, std::size_t first, double** rows);
 /// touched 120 lines per pair, which for a power-of-two batch size (arrays a multiple of 4 KB apart) all fall in
 /// one L1 set: 4.5x a witness query in wall time for 1.6x in instructions (4096 ellipsoid pairs, 1 thread). The
 /// buffer is filled in place (slot()) rather than through a PairJacobians copy and a member-pointer walk, which
-/// cost ~1100 instructions per pair. Flushes when a pair is not the next one and on destruction; one block per
-/// task range.
+/// cost ~1100 instructions per pair. Flushes when a pair is not the next one, when the block is full (AVX-512: at
+/// limit_) and on destruction; one block per task range.
 class StoreBlock {
  public:
   static constexpr int kEntries = StoreEntries;
@@ -107,7 +107,7 @@ class StoreBlock {
   // slot handed out has all its entries written before the flush reads them, except the rows normal_b_only skips,
   // which the flush then does not copy (analytic_normal_b()'s caller reads only normal_wrt_b's rows).
   alignas(64) double buf_[kEntries][kStride];
-  // entry_rows(d, 0): the output arrays' rows of pair 0, computed at the first flush (d is sized by then and not
+  // entry_rows(d, 0): the output arrays' rows of pair 0, computed in start() (d is sized by then and not
   // resized during the block's life); a block of pairs from first_ is at rows_[e] + first_. With the 120 pointers
   // rebuilt at every flush, flush() was 98.5 instructions per analytic hull pair; now it is inlined in its caller,
   // whose count did not move, and the lanes' `+ first_` costs 15 (callgrind, AVX2).
