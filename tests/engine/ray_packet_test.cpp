@@ -3,6 +3,8 @@
 // exactly the leaves it reaches alone, and a scene's closest hits are bitwise those of one ray at a time, ties
 // (duplicated objects, rays starting inside several objects) included, on every instruction set and thread count.
 #include "support/generators.hpp"
+#include "support/ray_reference.hpp"
+#include "support/same_results.hpp"
 
 #include "batchcol/rays.hpp"
 #include "batchcol/scene.hpp"
@@ -27,21 +29,6 @@ using testing::uniform;
 
 bool has_isa(int isa) { return wide_traverse_for(isa) != nullptr; }
 
-// The exact entry of the ray o + t d (t >= 0) into a box, in double; +inf when it misses.
-double exact_entry(const double o[3], const double d[3], const double lo[3], const double hi[3]) {
-  double t0 = 0.0, t1 = INFINITY;
-  for (int k = 0; k < 3; ++k) {
-    if (d[k] == 0.0) {
-      if (o[k] < lo[k] || o[k] > hi[k]) return INFINITY;
-      continue;
-    }
-    double a = (lo[k] - o[k]) / d[k], c = (hi[k] - o[k]) / d[k];
-    if (a > c) std::swap(a, c);
-    t0 = std::max(t0, a), t1 = std::min(t1, c);
-  }
-  return t0 <= t1 ? t0 : INFINITY;
-}
-
 // A stand-in for the scene's leaf tests: a ray "hits" a leaf at its exact box entry plus a per-leaf offset (so never
 // before the box, as an object inside it), and the limit falls to that hit, rounded to float (the offsets, >= 0.01,
 // exceed the rounding: the float limit stays above the exact entry, as wide_limit() keeps it above a hit).
@@ -53,7 +40,7 @@ struct Hits {
     const std::uint32_t i = bvh->leaf_object()[leaf];
     const double lo[3] = {boxes->min_x[i], boxes->min_y[i], boxes->min_z[i]};
     const double hi[3] = {boxes->max_x[i], boxes->max_y[i], boxes->max_z[i]};
-    return exact_entry(o, d, lo, hi) + offset[leaf];
+    return testing::exact_box_entry(o, d, lo, hi) + offset[leaf];
   }
 };
 
@@ -214,24 +201,11 @@ TEST(RayWidePacket, OrderFreeSceneCastInPacketsGivesTheBitsOfOneRayAtATime) {
       o.isa = sets[isa];
       RayResults whole;
       index.cast(rays, o, whole);
+      ASSERT_TRUE(testing::cast_in_parts_matches(index, rays, o, whole));
       int hits = 0, at_zero = 0;
-      for (std::size_t begin = 0; begin < rays.size(); begin += 1000) {
-        RayBatch part;
-        const std::size_t end = std::min(rays.size(), begin + 1000);
-        for (std::size_t i = begin; i < end; ++i) part.add(rays.origin[i], rays.direction[i], rays.t_max[i]);
-        RayResults r;
-        index.cast(part, o, r);
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::size_t k = i - begin;
-          ASSERT_EQ(whole.status[i], r.status[k]) << "ray " << i;
-          ASSERT_EQ(whole.hit[i], r.hit[k]) << "ray " << i;
-          ASSERT_EQ(whole.object[i], r.object[k]) << "ray " << i;
-          const double a[4] = {whole.t[i], whole.normal.x[i], whole.normal.y[i], whole.normal.z[i]};
-          const double b[4] = {r.t[k], r.normal.x[k], r.normal.y[k], r.normal.z[k]};
-          ASSERT_EQ(std::memcmp(a, b, sizeof a), 0) << "ray " << i;
-          hits += r.hit[k];
-          at_zero += r.hit[k] && r.t[k] == 0.0;
-        }
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        hits += whole.hit[i];
+        at_zero += whole.hit[i] && whole.t[i] == 0.0;
       }
       EXPECT_GT(hits, 3000);
       EXPECT_GT(at_zero, 1000);  // rays from inside objects: ties at t = 0

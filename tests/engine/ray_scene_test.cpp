@@ -2,6 +2,7 @@
 // scenes (every shape type, inflated shapes, a halfspace). Closest, any and all queries; refit after moves, rebuild
 // after additions and removals; bitwise the same answers for 1 and 2 threads; invalid rays and calls.
 #include "support/generators.hpp"
+#include "support/same_results.hpp"
 
 #include "batchcol/rays.hpp"
 #include "batchcol/scene.hpp"
@@ -347,27 +348,11 @@ TEST(RayScene, CastOrderOfLargeBatchesGivesTheSameBits) {
       RayOptions o;
       o.query = q;
       o.threads = threads;
+      SCOPED_TRACE(::testing::Message() << to_string(q) << ", " << threads << " threads");
       RayResults whole;
       index.cast(rays, o, whole);
-      int hits = 0;
-      for (std::size_t begin = 0; begin < rays.size(); begin += 1000) {
-        RayBatch part;
-        const std::size_t end = std::min(rays.size(), begin + 1000);
-        for (std::size_t i = begin; i < end; ++i) part.add(rays.origin[i], rays.direction[i], rays.t_max[i]);
-        RayResults r;
-        index.cast(part, o, r);
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::size_t k = i - begin;
-          SCOPED_TRACE(::testing::Message() << to_string(q) << ", " << threads << " threads, ray " << i);
-          ASSERT_EQ(whole.status[i], r.status[k]);
-          ASSERT_EQ(whole.hit[i], r.hit[k]);
-          ASSERT_EQ(whole.object[i], r.object[k]);
-          ASSERT_TRUE(
-              same_bits(std::vector<double>{whole.t[i], whole.normal.x[i], whole.normal.y[i], whole.normal.z[i]},
-                        std::vector<double>{r.t[k], r.normal.x[k], r.normal.y[k], r.normal.z[k]}));
-          hits += r.hit[k];
-        }
-      }
+      ASSERT_TRUE(testing::cast_in_parts_matches(index, rays, o, whole));
+      const int hits = std::count(whole.hit.begin(), whole.hit.end(), std::uint8_t{1});
       EXPECT_GT(hits, 1000);
       EXPECT_EQ(whole.status[0], RayStatus::invalid_input);
       EXPECT_EQ(whole.status[5], RayStatus::invalid_input);

@@ -2,6 +2,7 @@
 // refit, the float slab test never rejecting a box the exact ray segment touches (rays built to end exactly on a
 // box's boundary, grazing faces, edges and corners, at several scales), not being much looser than the exact test,
 // and the same visiting order on every instruction set.
+#include "support/ray_reference.hpp"
 #include "engine/src/ray_bvh.hpp"
 #include "engine/src/ray_wide_bvh.hpp"
 #include "engine/src/ray_wide_traverse.hpp"
@@ -162,17 +163,7 @@ TEST(RayWideBvh, LargeArraysAreHugePageAlignedAndKeepTheirContents) {
 // Exact reference: does the segment o + t d, t in [0, t_max], touch the closed box? Only used on rays whose
 // parameters are exact below (t_max = 1 on a boundary point) or with a relative margin.
 bool slab_hits(const double lo[3], const double hi[3], const double o[3], const double d[3], double t_max) {
-  double t0 = 0.0, t1 = t_max;
-  for (int k = 0; k < 3; ++k) {
-    if (d[k] == 0.0) {
-      if (o[k] < lo[k] || o[k] > hi[k]) return false;
-      continue;
-    }
-    double a = (lo[k] - o[k]) / d[k], c = (hi[k] - o[k]) / d[k];
-    if (a > c) std::swap(a, c);
-    t0 = std::max(t0, a), t1 = std::min(t1, c);
-  }
-  return t0 <= t1;
+  return testing::exact_box_entry(o, d, lo, hi, t_max) != INFINITY;
 }
 
 TEST(RayWideBvh, FloatTestNeverMissesABoxTheSegmentTouches) {

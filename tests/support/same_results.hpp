@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -53,6 +54,30 @@ inline void expect_same_derivatives(const DerivativeResults& want, const Derivat
                  &DerivativeResults::witness_b_wrt_a, &DerivativeResults::witness_b_wrt_b,
                  &DerivativeResults::normal_wrt_a, &DerivativeResults::normal_wrt_b})
     EXPECT_TRUE(same_bits((want.*m).data, (got.*m).data)) << label;
+}
+
+/// Casts `rays` again in parts of `part` rays (below the ordered cast's 4096-ray threshold, so in input order) and
+/// checks every ray's status, hit, object, t and normal bit for bit against `whole`, the cast of the whole batch.
+inline ::testing::AssertionResult cast_in_parts_matches(const RaySceneIndex& index, const RayBatch& rays,
+                                                        const RayOptions& options, const RayResults& whole,
+                                                        std::size_t part = 1000) {
+  for (std::size_t begin = 0; begin < rays.size(); begin += part) {
+    RayBatch some;
+    const std::size_t end = std::min(rays.size(), begin + part);
+    for (std::size_t i = begin; i < end; ++i) some.add(rays.origin[i], rays.direction[i], rays.t_max[i]);
+    RayResults r;
+    index.cast(some, options, r);
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t k = i - begin;
+      const double a[4] = {whole.t[i], whole.normal.x[i], whole.normal.y[i], whole.normal.z[i]};
+      const double b[4] = {r.t[k], r.normal.x[k], r.normal.y[k], r.normal.z[k]};
+      if (whole.status[i] != r.status[k] || whole.hit[i] != r.hit[k] || whole.object[i] != r.object[k] ||
+          std::memcmp(a, b, sizeof a) != 0)
+        return ::testing::AssertionFailure() << "ray " << i << ": the whole batch's status, hit, object, t or normal "
+                                             << "differs from its part's";
+    }
+  }
+  return ::testing::AssertionSuccess();
 }
 
 }  // namespace batchcol::testing
