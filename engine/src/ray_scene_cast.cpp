@@ -97,26 +97,30 @@ class Caster {
     return true;
   }
 
+  // Tests `obj` against r below `limit`; a hit before the best so far (before(): t, then slot) becomes the best and
+  // the new limit. The one rule of the closest / any searches, one ray at a time and in packets.
+  [[gnu::always_inline]] bool keep_nearer(const RayObject& obj, const RayContext& r, double& limit, Hit& best,
+                                          bool& found, bool& capped) const {
+    Hit h;
+    if (!test(obj, r, limit, h, capped) || (found && !before(h, best))) return false;
+    best = h, found = true, limit = best.t;
+    return true;
+  }
+
   // Closest hits of n rays of one direction octant (wide_ok) through the packet traversal: the halfspaces first, as
   // closest_or_any(), then the tree; for order_free() scenes only (the same answers as one ray at a time).
   void closest_packet(const RayContext* r, unsigned n, Hit* best, bool* found, bool* capped) const {
     double limit[kWidePacketLanes];
     float lim[kWidePacketLanes];
     const WideRay* wide[kWidePacketLanes];
-    Hit h;
     for (unsigned l = 0; l < n; ++l) {
       limit[l] = r[l].t_max;
-      for (const RayObject& obj : s_.halfspaces)
-        if (test(obj, r[l], limit[l], h, capped[l]) && (!found[l] || before(h, best[l])))
-          best[l] = h, found[l] = true, limit[l] = best[l].t;
+      for (const RayObject& obj : s_.halfspaces) keep_nearer(obj, r[l], limit[l], best[l], found[l], capped[l]);
       lim[l] = wide_limit(limit[l]);
       wide[l] = r[l].wide;
     }
     auto leaf = [&](unsigned l, std::uint32_t k, float& fl) {
-      if (test(s_.leaves[k].object, r[l], limit[l], h, capped[l]) && (!found[l] || before(h, best[l]))) {
-        best[l] = h, found[l] = true, limit[l] = best[l].t;
-        fl = wide_limit(limit[l]);
-      }
+      if (keep_nearer(s_.leaves[k].object, r[l], limit[l], best[l], found[l], capped[l])) fl = wide_limit(limit[l]);
     };
     using Leaf = decltype(leaf);
     packet_(s_.wide.nodes().data(), wide, n, lim,
@@ -254,17 +258,12 @@ class Caster {
   [[gnu::always_inline]] void closest_or_any(const RayContext& r, bool any, Hit& best, bool& found,
                                              bool& capped) const {
     double limit = r.t_max;
-    Hit h;
     for (const RayObject& obj : s_.halfspaces) {
-      if (test(obj, r, limit, h, capped) && (!found || before(h, best))) best = h, found = true, limit = best.t;
+      keep_nearer(obj, r, limit, best, found, capped);
       if (found && any) return;
     }
     traverse(r, [&] { return limit; }, [&](std::uint32_t leaf) {
-      if (test(s_.leaves[leaf].object, r, limit, h, capped) && (!found || before(h, best))) {
-        best = h, found = true, limit = best.t;
-        if (any) return false;
-      }
-      return true;
+      return !(keep_nearer(s_.leaves[leaf].object, r, limit, best, found, capped) && any);
     });
   }
 
