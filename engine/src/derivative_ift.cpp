@@ -158,6 +158,11 @@ inline __attribute__((always_inline)) V8 select_positive(const V8& z, const V8& 
 }  // namespace
 #include "derivative_lanes.inl"
 namespace {
+// The permutation of a line that starts `shift` pairs before a block: lane j takes lane j + 8 - shift of the pair
+// (carry, block), i.e. the carry's last `shift` entries, then the block's first 8 - shift.
+__m512i line_index(std::int64_t shift) {
+  return _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
+}
 // A block of `count` pairs to columns 0 .. count - 1 of out[e] + at, one register whatever the count: fewer than
 // kLanes pairs (a task range's first and last blocks, StoreBlock's line alignment) with a lane mask, whole blocks
 // with plain stores, or in whole lines with non-temporal stores (StreamRows; e is a constant in each store after
@@ -176,7 +181,7 @@ template <class Block> void store_block(std::size_t count, StreamRows* stream, d
       if ((e < 64 ? low >> e : high >> (e - 64)) & 1) return _mm512_stream_pd(out[e] + at, (__m512d)v);
       // Lane j of the line: carry lane j + 8 - shift for j < shift, this block's lane j - shift after.
       const std::int64_t shift = rows.shift[e];
-      const __m512i index = _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
+      const __m512i index = line_index(shift);
       // Not carried: the line's first `shift` lanes are masked off below, so the carry (never written yet in a
       // range's first streamed block) is not read at all.
       const __m512d previous = carried ? _mm512_load_pd(rows.carry[e]) : _mm512_setzero_pd();
@@ -193,18 +198,6 @@ template <class Block> void store_block(std::size_t count, StreamRows* stream, d
     block([out, at](int e, const V8& v) { store_lanes(out[e], at, v); });
   }
 }
-void flush_carry(StreamRows& rows, double* const* out, std::size_t at) {
-  for (int e = 0; e < StoreEntries; ++e) {
-    const std::int64_t shift = rows.shift[e];
-    if (shift == 0) continue;
-    // The line after the block's: its first `shift` lanes are the block's last.
-    const __m512i index = _mm512_add_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(8 - shift));
-    const __m512d carry = _mm512_load_pd(rows.carry[e]);
-    _mm512_mask_storeu_pd(out[e] + at + 8 - shift, static_cast<__mmask8>((1u << shift) - 1),
-                          _mm512_permutex2var_pd(carry, index, carry));
-  }
-  rows.carried = false;
-}
 template <bool kNormalB, bool kCurved, bool kGiven>
 void smooth_to(const SmoothLanes& s, std::size_t count, StreamRows* stream, double* const* out,
                std::size_t at) {
@@ -217,7 +210,18 @@ void polytope_to(const PolytopeLanes& lanes, std::size_t count, StreamRows* stre
   store_block(count, stream, out, at, [&lanes](const auto& store) { polytope_block<V8>(lanes, store); });
 }
 }  // namespace
-void flush_stream_carry(StreamRows& rows, double* const* out, std::size_t at) { flush_carry(rows, out, at); }
+void flush_stream_carry(StreamRows& rows, double* const* out, std::size_t at) {
+  for (int e = 0; e < StoreEntries; ++e) {
+    const std::int64_t shift = rows.shift[e];
+    if (shift == 0) continue;
+    // The line after the block's: its first `shift` lanes are the block's last.
+    const __m512i index = line_index(shift);
+    const __m512d carry = _mm512_load_pd(rows.carry[e]);
+    _mm512_mask_storeu_pd(out[e] + at + 8 - shift, static_cast<__mmask8>((1u << shift) - 1),
+                          _mm512_permutex2var_pd(carry, index, carry));
+  }
+  rows.carried = false;
+}
 }  // namespace lanes_avx512
 #pragma GCC pop_options
 #pragma GCC push_options
