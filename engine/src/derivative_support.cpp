@@ -384,8 +384,9 @@ void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t 
   hull_pair_features(unit, u, n, a, b, tolerance, flats, flat);
 }
 
-void hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
-                                const HullView& b, const double* tolerance, int* flats, Eigen::Vector3d* flat) {
+int hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
+                               const HullView& b, const double* tolerance, Eigen::Vector3d* flat) {
+  int flats[2];
   Eigen::Quaterniond unit[2];
   Eigen::Vector3d u[2];
   for (int s = 0; s < 2; ++s) {
@@ -393,6 +394,7 @@ void hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Ei
     u[s] = Eigen::Vector3d(d.u[s][0][j], d.u[s][1][j], d.u[s][2][j]);
   }
   hull_pair_features(unit, u, n, a, b, tolerance, flats, flat);
+  return flats[0] + 4 * flats[1];
 }
 
 // hull_pair_directions() with pair j of the block in lane j % 4 of the (j / 4)-th pair of AVX2 registers, side a and

@@ -165,16 +165,13 @@ struct HullDirections {
 void hull_directions_block(const QuatArray& ra, const QuatArray& rb, const Vec3Array& normal, std::size_t first,
                            std::size_t count, HullDirections& d);
 
-/// hull_pair_flats_avx2() with the directions of pair `first + j` of `d` (hull_directions_block()).
-void hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
-                                const HullView& b, const double* tolerance, int* flats, Eigen::Vector3d* flat);
+/// hull_pair_flats_avx2() with the directions of pair `first + j` of `d` (hull_directions_block()); the flats come
+/// back as flats_a + 4 flats_b in a register: written as two ints to memory, the caller's first read of them was one
+/// 8-byte load of two 4-byte stores, which the store buffer does not forward (perf cpu-clock, AMD EPYC Zen 4: a
+/// tenth of differentiate_pair()'s samples sat on that load).
+int hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
+                               const HullView& b, const double* tolerance, Eigen::Vector3d* flat);
 
-/// hull_pair_flats() with the directions of `d` (null: computed here): the same bits.
-inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
-                                                           const Eigen::Vector3d& n, const HullView& a,
-                                                           const HullView& b, const double tolerance[2], int flats[2],
-                                                           Eigen::Vector3d flat[2], InstructionSet isa,
-                                                           const HullDirections* d);
 
 inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
                                                            const Eigen::Vector3d& n, const HullView& a,
@@ -194,16 +191,20 @@ inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, 
     if (flats[s] == 1 && !edge_flat(unit[s], edge[s], n, flat[s])) flats[s] = 0;
 }
 
-inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
-                                                           const Eigen::Vector3d& n, const HullView& a,
-                                                           const HullView& b, const double tolerance[2], int flats[2],
-                                                           Eigen::Vector3d flat[2], InstructionSet isa,
-                                                           const HullDirections* d) {
+/// hull_pair_flats() with the directions of `d` (null: computed here), the flats returned as flats_a + 4 flats_b
+/// (hull_pair_flats_given_avx2()'s reason): the same bits.
+inline __attribute__((always_inline)) int hull_pair_flats_packed(const QuatArray& ra, const QuatArray& rb,
+                                                                 std::size_t i, const Eigen::Vector3d& n,
+                                                                 const HullView& a, const HullView& b,
+                                                                 const double tolerance[2], Eigen::Vector3d flat[2],
+                                                                 InstructionSet isa, const HullDirections* d) {
   constexpr std::uint32_t kKept = 16;
   if (d && (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count - 4 <= kKept - 4 &&
       b.vertex_count - 4 <= kKept - 4)
-    return hull_pair_flats_given_avx2(*d, i - d->first, n, a, b, tolerance, flats, flat);
+    return hull_pair_flats_given_avx2(*d, i - d->first, n, a, b, tolerance, flat);
+  int flats[2];
   hull_pair_flats(ra, rb, i, n, a, b, tolerance, flats, flat, isa);
+  return flats[0] + 4 * flats[1];
 }
 
 /// support_jacobian() of a sphere or an ellipsoid (returns false for the other types, leaving H alone) at the unit

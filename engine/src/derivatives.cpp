@@ -209,7 +209,6 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   // per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the features n exposes; an edge's
   // direction in the world orthogonal to n). A face's flats are only needed by the general path below
   // (PolytopeLanes uses n).
-  int flats[2];
   Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};
   if (directions && !directions->filled) {
@@ -217,11 +216,11 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
                           directions->block_count, *directions);
     directions->filled = true;
   }
-  hull_pair_flats(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b], tolerance, flats, flat,
-                  out.isa, directions);
-  g.flats_a = flats[0], g.flats_b = flats[1];
-  if (flats[0] == 1) g.flat_a.col(0) = flat[0];
-  if (flats[1] == 1) g.flat_b.col(0) = flat[1];
+  const int flats = hull_pair_flats_packed(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b],
+                                           tolerance, flat, out.isa, directions);
+  g.flats_a = flats & 3, g.flats_b = flats >> 2;
+  if (g.flats_a == 1) g.flat_a.col(0) = flat[0];
+  if (g.flats_b == 1) g.flat_b.col(0) = flat[1];
   const DerivativeStatus status =
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
