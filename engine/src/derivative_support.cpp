@@ -356,21 +356,92 @@ __attribute__((noinline)) std::uint32_t exposed_mask_avx2(const double* vertices
   return exposed_mask_avx2_body(vertices, count, u, tolerance);
 }
 }  // namespace
-// hull_pair_directions(), feature_of_mask() and edge_flat() are inlined here (baseline code into an AVX2 function,
-// no FMA enabled), so their SSE2 operations take the VEX three-operand forms with the bits of the baseline code.
-void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
-                          const HullView& a, const HullView& b, const double* tolerance, int* flats,
-                          Eigen::Vector3d* flat) {
-  Eigen::Quaterniond unit[2];
-  Eigen::Vector3d u[2], edge[2];
-  hull_pair_directions(Lanes2{ra.x[i], rb.x[i]}, Lanes2{ra.y[i], rb.y[i]}, Lanes2{ra.z[i], rb.z[i]},
-                       Lanes2{ra.w[i], rb.w[i]}, n, unit[0], unit[1], u[0], u[1]);
+namespace {
+// hull_pair_flats_avx2()'s steps after the directions.
+inline __attribute__((always_inline)) void hull_pair_features(const Eigen::Quaterniond* unit, const Eigen::Vector3d* u,
+                                                              const Eigen::Vector3d& n, const HullView& a,
+                                                              const HullView& b, const double* tolerance, int* flats,
+                                                              Eigen::Vector3d* flat) {
+  Eigen::Vector3d edge[2];
   const std::uint32_t mask_a = exposed_mask_avx2_body(a.vertices, a.vertex_count, u[0], tolerance[0]);
   const std::uint32_t mask_b = exposed_mask_avx2_body(b.vertices, b.vertex_count, u[1], tolerance[1]);
   flats[0] = feature_of_mask(a.vertices, mask_a, edge[0]);
   flats[1] = feature_of_mask(b.vertices, mask_b, edge[1]);
   for (int s = 0; s < 2; ++s)
     if (flats[s] == 1 && !edge_flat(unit[s], edge[s], n, flat[s])) flats[s] = 0;
+}
+}  // namespace
+
+// hull_pair_directions(), feature_of_mask() and edge_flat() are inlined here (baseline code into an AVX2 function,
+// no FMA enabled), so their SSE2 operations take the VEX three-operand forms with the bits of the baseline code.
+void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t i, const Eigen::Vector3d& n,
+                          const HullView& a, const HullView& b, const double* tolerance, int* flats,
+                          Eigen::Vector3d* flat) {
+  Eigen::Quaterniond unit[2];
+  Eigen::Vector3d u[2];
+  hull_pair_directions(Lanes2{ra.x[i], rb.x[i]}, Lanes2{ra.y[i], rb.y[i]}, Lanes2{ra.z[i], rb.z[i]},
+                       Lanes2{ra.w[i], rb.w[i]}, n, unit[0], unit[1], u[0], u[1]);
+  hull_pair_features(unit, u, n, a, b, tolerance, flats, flat);
+}
+
+int hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
+                               const HullView& b, const double* tolerance, Eigen::Vector3d* flat) {
+  int flats[2];
+  Eigen::Quaterniond unit[2];
+  Eigen::Vector3d u[2];
+  for (int s = 0; s < 2; ++s) {
+    unit[s] = Eigen::Quaterniond(d.unit[s][3][j], d.unit[s][0][j], d.unit[s][1][j], d.unit[s][2][j]);
+    u[s] = Eigen::Vector3d(d.u[s][0][j], d.u[s][1][j], d.u[s][2][j]);
+  }
+  hull_pair_features(unit, u, n, a, b, tolerance, flats, flat);
+  return flats[0] + 4 * flats[1];
+}
+
+// hull_pair_directions() with pair j of the block in lane j % 4 of the (j / 4)-th pair of AVX2 registers, side a and
+// side b in separate registers: the same operations per lane in the same order (the sign a product by +1 or -1).
+// (4-lane vectors, not 8-lane ones: GCC split 64-byte vector-extension code into halves through the stack, 121
+// instructions per pair, callgrind AVX2.)
+void hull_directions_block(const QuatArray& ra, const QuatArray& rb, const Vec3Array& normal, std::size_t first,
+                           std::size_t count, HullDirections& d) {
+  using V = double __attribute__((vector_size(32)));
+  using M = long long __attribute__((vector_size(32)));
+  constexpr std::size_t kHalf = HullDirections::kPairs / 2;
+  d.first = first;
+  for (std::size_t h = 0; h < HullDirections::kPairs; h += kHalf) {
+    // Lane j reads pair first + h + j, or the block's last pair past `count` (copies in a short tail only).
+    const auto load = [&](const std::vector<double>& c) {
+      V v;
+      if (h + kHalf <= count) {
+        std::memcpy(&v, c.data() + first + h, sizeof v);
+      } else {
+        for (std::size_t j = 0; j < kHalf; ++j) v[j] = c[first + std::min(h + j, count - 1)];
+      }
+      return v;
+    };
+    const V n0 = load(normal.x), n1 = load(normal.y), n2 = load(normal.z);
+    const auto side = [&](const QuatArray& r, double sign_value, int s) {
+      V x = load(r.x), y = load(r.y), z = load(r.z), w = load(r.w);
+      const V sum = (x * x + z * z) + (y * y + w * w);
+      const V root = (V)_mm256_sqrt_pd((__m256d)sum);  // IEEE: std::sqrt()'s and _mm_sqrt_pd()'s bits
+      const M positive = sum > 0.0;
+      const auto scale = [&](V c) { return (V)(((M)(c / root) & positive) | ((M)c & ~positive)); };
+      x = scale(x), y = scale(y), z = scale(z), w = scale(w);
+      std::memcpy(&d.unit[s][0][h], &x, sizeof x), std::memcpy(&d.unit[s][1][h], &y, sizeof y);
+      std::memcpy(&d.unit[s][2][h], &z, sizeof z), std::memcpy(&d.unit[s][3][h], &w, sizeof w);
+      const V cx = -x, cy = -y, cz = -z;
+      V uv0 = cy * n2 - cz * n1, uv1 = cz * n0 - cx * n2, uv2 = cx * n1 - cy * n0;
+      uv0 += uv0, uv1 += uv1, uv2 += uv2;
+      const V sign = V{} + sign_value;
+      const V r0 = sign * ((n0 + w * uv0) + (cy * uv2 - cz * uv1));
+      const V r1 = sign * ((n1 + w * uv1) + (cz * uv0 - cx * uv2));
+      const V r2 = sign * ((n2 + w * uv2) + (cx * uv1 - cy * uv0));
+      std::memcpy(&d.u[s][0][h], &r0, sizeof r0), std::memcpy(&d.u[s][1][h], &r1, sizeof r1);
+      std::memcpy(&d.u[s][2][h], &r2, sizeof r2);
+    };
+    side(ra, 1.0, 0);
+    side(rb, -1.0, 1);
+    if (h + kHalf >= count) break;  // the second half holds no pair of the block
+  }
 }
 #pragma GCC pop_options
 

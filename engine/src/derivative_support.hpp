@@ -142,6 +142,37 @@ void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t 
                           const HullView& a, const HullView& b, const double* tolerance, int* flats,
                           Eigen::Vector3d* flat);
 
+/// hull_pair_directions() of up to kPairs consecutive pairs at once (pair first + j in lane j), in structure of
+/// arrays: unit[s][c][j] is coefficient c (x, y, z, w) of side s's normalised quaternion, u[s][c][j] coordinate c of
+/// its local direction. Why: per pair, the square root and the four divisions that normalise the quaternions head a
+/// dependency chain through the feature scan, which one pair's ~700 instructions do not leave the out-of-order
+/// window room to overlap with the next pair's (perf cpu-clock, AMD EPYC Zen 4: hull_pair_flats_avx2 held 17% of
+/// the analytic hull run's samples for 13% of its instructions, a ninth of them on the division); eight pairs'
+/// directions in 8-lane registers compute the chains side by side.
+struct HullDirections {
+  static constexpr std::size_t kPairs = 8;
+  alignas(64) double unit[2][4][kPairs];
+  alignas(64) double u[2][3][kPairs];
+  std::size_t first = 0;
+  /// The block the caller is in (hull_pair() fills it at its first hull pair: other pairs need no directions).
+  std::size_t block_first = 0, block_count = 0;
+  bool filled = false;
+};
+
+/// Fills `d` for pairs first .. first + count - 1 (count <= kPairs; lanes past count are computed on copies of
+/// the last pair and never read) of the rotations ra (side a) and rb (side b) and the world normals `normal`:
+/// every lane does hull_pair_directions()'s operations in their order (AVX2 code: the same bits; tested).
+void hull_directions_block(const QuatArray& ra, const QuatArray& rb, const Vec3Array& normal, std::size_t first,
+                           std::size_t count, HullDirections& d);
+
+/// hull_pair_flats_avx2() with the directions of pair `first + j` of `d` (hull_directions_block()); the flats come
+/// back as flats_a + 4 flats_b in a register: written as two ints to memory, the caller's first read of them was one
+/// 8-byte load of two 4-byte stores, which the store buffer does not forward (perf cpu-clock, AMD EPYC Zen 4: a
+/// tenth of differentiate_pair()'s samples sat on that load).
+int hull_pair_flats_given_avx2(const HullDirections& d, std::size_t j, const Eigen::Vector3d& n, const HullView& a,
+                               const HullView& b, const double* tolerance, Eigen::Vector3d* flat);
+
+
 inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, const QuatArray& rb, std::size_t i,
                                                            const Eigen::Vector3d& n, const HullView& a,
                                                            const HullView& b, const double tolerance[2], int flats[2],
@@ -158,6 +189,22 @@ inline __attribute__((always_inline)) void hull_pair_flats(const QuatArray& ra, 
   flats[1] = exposed_feature(b.vertices, b.vertex_count, u[1], tolerance[1], edge[1], isa);
   for (int s = 0; s < 2; ++s)
     if (flats[s] == 1 && !edge_flat(unit[s], edge[s], n, flat[s])) flats[s] = 0;
+}
+
+/// hull_pair_flats() with the directions of `d` (null: computed here), the flats returned as flats_a + 4 flats_b
+/// (hull_pair_flats_given_avx2()'s reason): the same bits.
+inline __attribute__((always_inline)) int hull_pair_flats_packed(const QuatArray& ra, const QuatArray& rb,
+                                                                 std::size_t i, const Eigen::Vector3d& n,
+                                                                 const HullView& a, const HullView& b,
+                                                                 const double tolerance[2], Eigen::Vector3d flat[2],
+                                                                 InstructionSet isa, const HullDirections* d) {
+  constexpr std::uint32_t kKept = 16;
+  if (d && (isa == InstructionSet::avx2 || isa == InstructionSet::avx512) && a.vertex_count - 4 <= kKept - 4 &&
+      b.vertex_count - 4 <= kKept - 4)
+    return hull_pair_flats_given_avx2(*d, i - d->first, n, a, b, tolerance, flat);
+  int flats[2];
+  hull_pair_flats(ra, rb, i, n, a, b, tolerance, flats, flat, isa);
+  return flats[0] + 4 * flats[1];
 }
 
 /// support_jacobian() of a sphere or an ellipsoid (returns false for the other types, leaving H alone) at the unit

@@ -181,8 +181,10 @@ namespace {
 // features, statuses and formulas as the general path; false (nothing written) for any other pair.
 // `g`: the caller's, reused from pair to pair (every field this pair reads is written first): a PairGeometry per
 // pair zeroed its two flat matrices, 5 instructions per pair (callgrind AVX2).
+// `directions`: the block's quaternions and local directions (hull_directions_block(), computed here at the block's
+// first pair that needs them), or null.
 bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results, std::size_t i,
-               StoreBlock& out, PairGeometry& g) {
+               StoreBlock& out, PairGeometry& g, HullDirections* directions) {
   if (results.status[i] != Status::converged) return false;
   const std::uint32_t a = batch.shape_a[i], b = batch.shape_b[i];
   // The per-shape arrays grow with the table (ShapeTable::add()): types.size() is shapes.size() without its
@@ -207,14 +209,18 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   // per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the features n exposes; an edge's
   // direction in the world orthogonal to n). A face's flats are only needed by the general path below
   // (PolytopeLanes uses n).
-  int flats[2];
   Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};
-  hull_pair_flats(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b], tolerance, flats, flat,
-                  out.isa);
-  g.flats_a = flats[0], g.flats_b = flats[1];
-  if (flats[0] == 1) g.flat_a.col(0) = flat[0];
-  if (flats[1] == 1) g.flat_b.col(0) = flat[1];
+  if (directions && !directions->filled) {
+    hull_directions_block(batch.rotation_a, batch.rotation_b, results.normal, directions->block_first,
+                          directions->block_count, *directions);
+    directions->filled = true;
+  }
+  const int flats = hull_pair_flats_packed(batch.rotation_a, batch.rotation_b, i, g.normal, hulls[a], hulls[b],
+                                           tolerance, flat, out.isa, directions);
+  g.flats_a = flats & 3, g.flats_b = flats >> 2;
+  if (g.flats_a == 1) g.flat_a.col(0) = flat[0];
+  if (g.flats_b == 1) g.flat_b.col(0) = flat[1];
   const DerivativeStatus status =
       g.flats_a == 0 || g.flats_b == 0 ? DerivativeStatus::zero_curvature : DerivativeStatus::smooth;
   DerivativeResults& d = out.d;
@@ -248,8 +254,10 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
 // One pair, analytic or smoothed1. The support directions are n for a and -n for b, taken to each local frame.
 void differentiate_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResults& results,
                         const DerivativeOptions& o, InstructionSet isa, std::size_t i, StoreBlock& out,
-                        PairGeometry& hull_geometry, const double* noise) {
-  if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out, hull_geometry)) return;
+                        PairGeometry& hull_geometry, const double* noise,
+                        HullDirections* directions = nullptr) {
+  if (o.method == DerivativeMethod::analytic && hull_pair(shapes, batch, results, i, out, hull_geometry, directions))
+    return;
   DerivativeResults& d = out.d;
   PairGeometry g;
   Eigen::Matrix3d R_a, R_b;  // the analytic path sets them only where it uses them (see side())
@@ -430,8 +438,19 @@ void differentiate_results_on(const ShapeTable& shapes, const PairBatch& batch, 
     out.isa = isa;
     detail::PairGeometry hull_geometry;
     if (options.method != DerivativeMethod::smoothed1) {
-      for (std::size_t i = begin; i < end; ++i)
-        differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry, nullptr);
+      // The wide sets' hull pairs take their directions from 8 pairs computed side by side (HullDirections).
+      if (isa != InstructionSet::avx2 && isa != InstructionSet::avx512) {
+        for (std::size_t i = begin; i < end; ++i)
+          differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry, nullptr);
+        return;
+      }
+      detail::HullDirections directions;
+      for (std::size_t first = begin; first < end; first += detail::HullDirections::kPairs) {
+        const std::size_t count = std::min(detail::HullDirections::kPairs, end - first);
+        directions.block_first = first, directions.block_count = count, directions.filled = false;
+        for (std::size_t i = first; i < first + count; ++i)
+          differentiate_pair(shapes, batch, results, options, isa, i, out, hull_geometry, nullptr, &directions);
+      }
       return;
     }
     // smoothed1: the 3 normals of every antithetic pair k of both sides (counter_rng.hpp's support_noise_pair(),

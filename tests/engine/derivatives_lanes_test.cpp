@@ -142,6 +142,59 @@ TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
   EXPECT_EQ(mismatches, 0);
 }
 
+// hull_directions_block() (8 pairs' directions in AVX2 lanes, on the wide sets) must give each pair the bits of
+// hull_pair_directions(), for every block length 1..8 (the short tail reads copies of the last pair), at any start,
+// on quaternions of any magnitude, zero and unit, and normals with signed zeros.
+TEST(DerivativesLanes, HullDirectionsBlockGivesEachPairsBits) {
+  if (vector_isas_here().empty()) GTEST_SKIP() << "no AVX2 on this CPU: the block is not used";
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_int_distribution<int> pick(0, 9);
+  const auto quaternion = [&] {
+    Eigen::Quaterniond q(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
+    const int kind = pick(rng);
+    if (kind == 0) q.normalize();
+    else if (kind == 1) q.coeffs()[pick(rng) % 4] = 0.0;
+    else if (kind == 2) q.coeffs().setZero();
+    else if (kind == 3) q = Eigen::Quaterniond::Identity();
+    else q.coeffs() *= std::pow(10.0, exponent(rng));
+    return q;
+  };
+  constexpr std::size_t kPairs = 4000;
+  QuatArray ra, rb;
+  Vec3Array normal;
+  for (std::size_t i = 0; i < kPairs; ++i) {
+    ra.push_back(quaternion()), rb.push_back(quaternion());
+    Eigen::Vector3d n(coefficient(rng), coefficient(rng), coefficient(rng));
+    if (pick(rng) == 0) n[pick(rng) % 3] = pick(rng) % 2 ? 0.0 : -0.0;
+    n.normalize();
+    normal.push_back(n);
+  }
+  int mismatches = 0, compared = 0;
+  detail::HullDirections d;
+  for (std::size_t first = 0; first + 8 <= kPairs; first += 7) {
+    const std::size_t count = 1 + first % 8;
+    detail::hull_directions_block(ra, rb, normal, first, count, d);
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::size_t i = first + j;
+      Eigen::Quaterniond unit[2];
+      Eigen::Vector3d u[2];
+      detail::hull_pair_directions(ra[i], rb[i], normal[i], unit[0], unit[1], u[0], u[1]);
+      bool ok = d.first == first;
+      for (int s = 0; s < 2; ++s) {
+        const double got_unit[4] = {d.unit[s][0][j], d.unit[s][1][j], d.unit[s][2][j], d.unit[s][3][j]};
+        const double got_u[3] = {d.u[s][0][j], d.u[s][1][j], d.u[s][2][j]};
+        ok = ok && std::memcmp(got_unit, unit[s].coeffs().data(), sizeof got_unit) == 0 &&
+             std::memcmp(got_u, u[s].data(), sizeof got_u) == 0;
+      }
+      ++compared;
+      if (!ok && ++mismatches <= 3) ADD_FAILURE() << "pair " << i << " of the block at " << first << " (" << count << ")";
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(compared, 2000);
+}
+
 // edge_flat() (the rotation and projection written out) must give the bits of the Eigen expressions it replaced in
 // hull_pair(): e = unit * edge, e -= n.dot(e) * n, a flat where e.norm() > 1e-6 * length, e.normalized(); on unit
 // quaternions, edges of any length (some along n, so that no flat is left) and normals with signed zeros.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -282,6 +283,38 @@ TEST(DerivativesOptions, GradientsOnlyAreTheFullDerivativesGradients) {
   for (DerivativeMethod m : {DerivativeMethod::smoothed0, DerivativeMethod::smoothed1}) {
     o.method = m;
     expect_input_error(shapes, batch, QueryOptions{}, o, "jacobians");
+  }
+}
+
+// The eight derivative output arrays start on a 64-byte line (CacheLineAllocator): a block of eight pairs of one row
+// is then one whole-line store. Checked after differentiate() (which sizes them), resize(), a copy and a move, for
+// pair counts that are and are not multiples of 8; malloc's 16-byte alignment would leave most of them 16, 32 or 48
+// bytes into a line.
+TEST(DerivativesOptions, OutputArraysStartOnCacheLines) {
+  const auto on_line = [](const double* p) { return reinterpret_cast<std::uintptr_t>(p) % 64 == 0; };
+  const auto expect_aligned = [&](const DerivativeResults& d, const std::string& label) {
+    EXPECT_TRUE(on_line(d.distance_gradient_a.data.data()) && on_line(d.distance_gradient_b.data.data())) << label;
+    for (const Mat36Array* m : {&d.witness_a_wrt_a, &d.witness_a_wrt_b, &d.witness_b_wrt_a, &d.witness_b_wrt_b,
+                                &d.normal_wrt_a, &d.normal_wrt_b})
+      EXPECT_TRUE(on_line(m->data.data())) << label;
+  };
+  Rng rng(8);
+  ShapeTable shapes;
+  const PairBatch all = random_separated_pairs(rng, shapes, bounded_shape_types(), 24);
+  for (std::size_t n : {1u, 3u, 8u, 13u, 24u}) {
+    PairBatch batch;
+    for (std::size_t i = 0; i < n; ++i) batch.add(all.shape_a[i], all.pose_a(i), all.shape_b[i], all.pose_b(i));
+    PairResults r;
+    DerivativeResults d;
+    differentiate(shapes, batch, QueryOptions{}, DerivativeOptions{}, r, d);
+    expect_aligned(d, std::to_string(n) + " pairs, differentiate()");
+    DerivativeResults copy = d;
+    expect_aligned(copy, std::to_string(n) + " pairs, copy");
+    EXPECT_TRUE(same_bits(copy.witness_b_wrt_a.data, d.witness_b_wrt_a.data));
+    const DerivativeResults moved = std::move(copy);
+    expect_aligned(moved, std::to_string(n) + " pairs, move");
+    d.resize(n + 5, false);
+    expect_aligned(d, std::to_string(n + 5) + " pairs, resize()");
   }
 }
 

@@ -13,7 +13,9 @@
 namespace batchcol::testing {
 
 /// Same doubles bit for bit (NaN payloads included, unlike ==).
-inline bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+/// (Any allocator: the derivative arrays' storage is line-aligned.)
+template <class Allocator>
+bool same_bits(const std::vector<double, Allocator>& a, const std::vector<double, Allocator>& b) {
   // memcmp must not see the null data() of empty arrays (the levels that leave them empty), even for 0 bytes.
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }

@@ -21,7 +21,7 @@ struct DerivativesHolder {
 
 /// A (n, rows, columns) view of an engine array whose entry (r, c) of pair i is data[(columns r + c) n + i]
 /// (Vec6Array: rows 1, returned as (n, 6); Mat36Array: (n, 3, 6)). Strided, no copy.
-py::array view_soa(const std::vector<double>& data, std::size_t n, int rows, int columns, const py::handle& owner) {
+py::array view_soa(const LineAlignedDoubles& data, std::size_t n, int rows, int columns, const py::handle& owner) {
   const auto s = static_cast<py::ssize_t>(sizeof(double));
   const auto N = static_cast<py::ssize_t>(n);
   const double* p = data.empty() ? nullptr : data.data();
