@@ -21,9 +21,9 @@ struct PacketEntry {
 };
 
 // One packet's walk, a step at a time (a leaf's visits or a node's test, then the next entry), so that the caller
-// can interleave several packets: a step ends knowing the next entry, whose lines are then requested
-// (request_next()) while the other packets take a step each; every packet's own sequence of steps, and so every
-// lane's visits and limits, is the one it takes alone.
+// can interleave several packets: a step ends knowing the next entry, whose lines are then requested (a child taken
+// at once here; a popped one was requested when pushed) while the other packets take a step each; every packet's own
+// sequence of steps, and so every lane's visits and limits, is the one it takes alone.
 template <int kOctant>
 class PacketWalk {
  public:
@@ -37,11 +37,6 @@ class PacketWalk {
     top_ = 0;
     // The root with every lane; lanes >= n never pass the pop's test.
     ref_ = 0, mask_ = n >= 32 ? ~0u : (1u << n) - 1u;
-  }
-
-  // The current entry's lines (a node's seven, a leaf record's two from its ball), on trees larger than the L2.
-  void request_next() const {
-    if (rays_[0]->prefetch) prefetch_child(nodes_, ref_, *rays_[0]);
   }
 
   // Processes the current entry and moves to the next; false when the walk is over.
@@ -119,6 +114,7 @@ class PacketWalk {
     if ((reached & (reached - 1)) == 0) {  // one slot: next, with the lanes that reach it
       const int k = __builtin_ctz(reached);
       ref_ = node->child[k], mask_ = slot_lanes(std::size_t(k));
+      if (r0.prefetch) prefetch_child(nodes_, ref_, r0);
       return true;
     }
     // Ranks by key, ties to the lower slot, as the one-ray loop's rank (keys are +0, positive or +inf).
@@ -144,6 +140,7 @@ class PacketWalk {
     }
     top_ += count - 1;
     ref_ = node->child[first], mask_ = slot_lanes(first);
+    if (r0.prefetch) prefetch_child(nodes_, ref_, r0);
     return true;
   }
 
@@ -201,7 +198,6 @@ void traverse_packets_octant(const WideNode* nodes, const WideRay* const* rays, 
   while (active != 0) {
     PacketWalk<kOctant>& w = *live[i];
     if (w.step(visit, context)) {
-      w.request_next();
       ++i;
     } else if (next < count) {  // the next packet takes the finished one's place (its root is in the cache)
       w.start(nodes, rays, packets[next].first, packets[next].n, limits);
