@@ -127,9 +127,10 @@ using WideTraverse = void (*)(const WideNode* nodes, const WideRay& ray, float l
 /// 32 lanes: on 100k mixed objects x 1M ordered rays (AVX-512, 2 threads, casts alternating in one process) packets of
 /// 8 / 16 / 32 / 64 rays gave 1.05x / 1.14x / 1.26-1.28x / 1.21-1.22x the one-ray loop's rays/s (medians of 8 pairs).
 constexpr unsigned kWidePacketLanes = 32;
-/// 4 packets at once (with the pushed children's prefetch working): 0.89x the CPU seconds of one packet at a time for
-/// 9 casts of 1M rays on 100k mixed objects (AVX-512, 2 threads, whole process, loaded machine); 8 gave 0.98x of 4.
-constexpr unsigned kWidePacketStreams = 4;
+/// Packets walked at once: 100k mixed objects x 1M rays (rays --runs 9 --frames 1, 2 threads, AVX-512, farm-bench
+/// -n 5 on a loaded 2-core VM, whole-process CPU seconds): one at a time 1.24x those of 4, 8 0.98x those of 4
+/// (rays/s 1.07x), 16 1.01x those of 8.
+constexpr unsigned kWidePacketStreams = 8;
 struct WidePacket {
   unsigned first, n;  // 1 <= n <= kWidePacketLanes
 };
