@@ -48,6 +48,9 @@ constexpr std::size_t kRandomReadBytes = std::size_t(1) << 20;
 constexpr std::size_t kLargeTreeBytes = std::size_t(1) << 20;
 constexpr std::size_t kPrefetchAhead = 8;
 
+// The packet cast's window: the rays of one call of the packet traversal, kWidePacketStreams packets of one octant.
+constexpr unsigned kWidePacketWindow = kWidePacketLanes * kWidePacketStreams;
+
 bool before(const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.object.slot < b.object.slot); }
 
 struct RayContext {
@@ -107,12 +110,15 @@ class Caster {
     return true;
   }
 
-  // Closest hits of n rays of one direction octant (wide_ok) through the packet traversal: the halfspaces first, as
-  // closest_or_any(), then the tree; for order_free() scenes only (the same answers as one ray at a time).
-  void closest_packet(const RayContext* r, unsigned n, Hit* best, bool* found, bool* capped) const {
-    double limit[kWidePacketLanes];
-    float lim[kWidePacketLanes];
-    const WideRay* wide[kWidePacketLanes];
+  // Closest hits of rays of one direction octant (wide_ok) through the packet traversal, in `count` packets (slices
+  // of r, at most kWidePacketWindow rays in all): the halfspaces first, as closest_or_any(), then the tree; for
+  // order_free() scenes only (the same answers as one ray at a time).
+  void closest_packets(const RayContext* r, const WidePacket* packets, unsigned count, Hit* best, bool* found,
+                       bool* capped) const {
+    double limit[kWidePacketWindow];
+    float lim[kWidePacketWindow];
+    const WideRay* wide[kWidePacketWindow];
+    const unsigned n = packets[count - 1].first + packets[count - 1].n;
     for (unsigned l = 0; l < n; ++l) {
       limit[l] = r[l].t_max;
       for (const RayObject& obj : s_.halfspaces) keep_nearer(obj, r[l], limit[l], best[l], found[l], capped[l]);
@@ -123,7 +129,7 @@ class Caster {
       if (keep_nearer(s_.leaves[k].object, r[l], limit[l], best[l], found[l], capped[l])) fl = wide_limit(limit[l]);
     };
     using Leaf = decltype(leaf);
-    packet_(s_.wide.nodes().data(), wide, n, lim,
+    packet_(s_.wide.nodes().data(), wide, lim, packets, count,
             [](void* c, unsigned l, std::uint32_t k, float& fl) { (*static_cast<Leaf*>(c))(l, k, fl); }, &leaf);
   }
 
@@ -408,25 +414,28 @@ class RayOrder {
   CastResult* results_;
 };
 
-// The ordered cast of closest hits in packets (Caster::closest_packet): each group of kWidePacketLanes rays in cast
+// The ordered cast of closest hits in packets (Caster::closest_packets): each window of kWidePacketWindow rays in cast
 // order (neighbours in origin and direction: ray_order_keys.hpp) splits by direction octant; octants of two or more
-// rays go through the tree together, single rays and rays outside the float test's range one at a time. Groups lie
+// rays go through the tree in packets of up to kWidePacketLanes consecutive rays, the packets of one octant in one
+// call (walked at once, a step of each in turn, so one packet's cache misses overlap the others' work), single rays
+// and rays outside the float test's range one at a time. Windows lie
 // inside the fixed chunks, and each ray's answer is its own (order_free()): the same bits for any thread count.
 // Why: in this order neighbouring rays cross many of the same nodes. Counted on 100k mixed objects x 1M rays (1
 // thread): 29.6 node tests a ray; distinct nodes over aligned groups of 2 / 8 / 32 / 64 rays 23.2 / 14.1 / 8.8 / 6.9
 // a ray (sharing 1.28x / 2.10x / 3.38x / 4.29x). A packet loads and pops each node once for its rays and overlaps
 // the rays' tests (independent work) where the one-ray loop runs one dependent node step after another.
 void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) {
-  constexpr std::size_t kGroup = kWidePacketLanes;
+  constexpr std::size_t kGroup = kWidePacketWindow;
   const std::size_t n = order.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
     const WideRayRecord* group[kGroup];
     WideRay wide[kGroup];
     std::uint8_t status[kGroup];
     RayContext ctx[kGroup], packet[kGroup];
-    Hit best[kGroup];
-    bool found[kGroup], capped[kGroup];
-    unsigned lane_of[kGroup];
+    Hit best[kGroup], pb[kGroup];
+    bool found[kGroup], capped[kGroup], pf[kGroup], pc[kGroup];
+    unsigned by_octant[8][kGroup];
+    WidePacket packets[kGroup / 2];
     for (std::size_t c = range.begin(); c != range.end(); ++c) {
       const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
       for (std::size_t k = begin; k < end; k += kGroup) {
@@ -436,35 +445,35 @@ void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) 
         for (std::size_t s = 0; s < m; s += kWideRaySetupLanes)
           setup(group + s, std::min(kWideRaySetupLanes, m - s), wide + s, status + s);
         caster.prepare(wide, m);
-        std::uint32_t wide_lanes = 0;
+        unsigned per_octant[8] = {};
         for (std::size_t l = 0; l < m; ++l) {
           found[l] = false, capped[l] = false;
           if (status[l] == kWideRayInvalid) continue;
           RayContext& r = ctx[l];
           r = context_of(*group[l], status[l], &wide[l]);
           if (r.wide_ok)
-            wide_lanes |= 1u << l;
+            by_octant[wide[l].octant][per_octant[wide[l].octant]++] = unsigned(l);
           else
             caster.closest_or_any(r, false, best[l], found[l], capped[l]);
         }
-        while (wide_lanes != 0) {
-          const std::uint32_t octant = wide[__builtin_ctz(wide_lanes)].octant;
-          unsigned count = 0;
-          for (std::uint32_t b = wide_lanes; b != 0; b &= b - 1) {
-            const unsigned l = unsigned(__builtin_ctz(b));
-            if (wide[l].octant != octant) continue;
-            lane_of[count] = l, packet[count] = ctx[l], ++count;
-            wide_lanes &= ~(1u << l);
-          }
-          if (count == 1) {
+        for (unsigned o = 0; o < 8; ++o) {
+          const unsigned total = per_octant[o];
+          const unsigned* lane_of = by_octant[o];
+          if (total == 1) {
             const unsigned l = lane_of[0];
             caster.closest_or_any(ctx[l], false, best[l], found[l], capped[l]);
             continue;
           }
-          Hit pb[kWidePacketLanes];
-          bool pf[kWidePacketLanes] = {}, pc[kWidePacketLanes] = {};
-          caster.closest_packet(packet, count, pb, pf, pc);
-          for (unsigned j = 0; j < count; ++j) {
+          if (total == 0) continue;
+          // Packets of near-equal size (33 rays: 17 and 16, not 32 and a lone ray), in cast order.
+          const unsigned count = (total + kWidePacketLanes - 1) / kWidePacketLanes;
+          for (unsigned p = 0, first = 0; p < count; ++p) {
+            packets[p].first = first, packets[p].n = (total - first) / (count - p);
+            first += packets[p].n;
+          }
+          for (unsigned j = 0; j < total; ++j) packet[j] = ctx[lane_of[j]], pf[j] = false, pc[j] = false;
+          caster.closest_packets(packet, packets, count, pb, pf, pc);
+          for (unsigned j = 0; j < total; ++j) {
             const unsigned l = lane_of[j];
             best[l] = pb[j], found[l] = pf[j], capped[l] = pc[j];
           }

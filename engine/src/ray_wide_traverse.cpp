@@ -151,9 +151,9 @@ WideTraverse wide_traverse_for(int isa) {
 
 WidePacketTraverse wide_packet_traverse_for(int isa) {
   switch (isa) {
-    case 0: return &wide_baseline::traverse_packet;
-    case 1: return wide_traverse_for(1) ? &wide_avx2::traverse_packet : nullptr;
-    case 2: return wide_traverse_for(2) ? &wide_avx512::traverse_packet : nullptr;
+    case 0: return &wide_baseline::traverse_packets;
+    case 1: return wide_traverse_for(1) ? &wide_avx2::traverse_packets : nullptr;
+    case 2: return wide_traverse_for(2) ? &wide_avx512::traverse_packets : nullptr;
     default: return nullptr;
   }
 }

@@ -118,16 +118,25 @@ using WideLeafVisit = bool (*)(void* context, std::uint32_t leaf, float& limit);
 using WideTraverse = void (*)(const WideNode* nodes, const WideRay& ray, float limit, WideLeafVisit visit,
                               void* context);
 /// Packets: up to kWidePacketLanes rays of one direction octant (the same WideRay::octant, balls and prefetch) walk
-/// the tree together (ray_wide_packet.inl): each node is loaded once for the rays that reach it. Lane l's leaves are
-/// reported as visit(context, l, leaf, limits[l]), which may lower limits[l]; nearest box first by the smallest entry
-/// over the lanes, so a lane may see its leaves in another order, and more of them, than alone (closest hits only,
-/// and only where an object's hit does not depend on the limit it is tested with).
+/// the tree together (ray_wide_packet.inl): each node is loaded once for the rays that reach it. A call takes any
+/// number of packets of one octant, as slices of its arrays (packet p: the lanes packets[p].first .. + n), and walks
+/// up to kWidePacketStreams of them at once, a step of each in turn. Lane i's leaves are reported as visit(context,
+/// i, leaf, limits[i]), which may lower limits[i]; nearest box first by the smallest entry over its packet's lanes,
+/// so a lane may see its leaves in another order, and more of them, than alone (closest hits only, and only where an
+/// object's hit does not depend on the limit it is tested with).
 /// 32 lanes: on 100k mixed objects x 1M ordered rays (AVX-512, 2 threads, casts alternating in one process) packets of
 /// 8 / 16 / 32 / 64 rays gave 1.05x / 1.14x / 1.26-1.28x / 1.21-1.22x the one-ray loop's rays/s (medians of 8 pairs).
 constexpr unsigned kWidePacketLanes = 32;
+/// Packets walked at once: 100k mixed objects x 1M rays (rays --runs 9 --frames 1, 2 threads, AVX-512, farm-bench
+/// -n 5 on a loaded 2-core VM, whole-process CPU seconds): one at a time 1.24x those of 4, 8 0.98x those of 4
+/// (rays/s 1.07x), 16 1.01x those of 8.
+constexpr unsigned kWidePacketStreams = 8;
+struct WidePacket {
+  unsigned first, n;  // 1 <= n <= kWidePacketLanes
+};
 using WidePacketVisit = void (*)(void* context, unsigned lane, std::uint32_t leaf, float& limit);
-using WidePacketTraverse = void (*)(const WideNode* nodes, const WideRay* const* rays, unsigned n, float* limits,
-                                    WidePacketVisit visit, void* context);
+using WidePacketTraverse = void (*)(const WideNode* nodes, const WideRay* const* rays, float* limits,
+                                    const WidePacket* packets, unsigned count, WidePacketVisit visit, void* context);
 /// As select_wide_traverse(isa) / wide_traverse_for(isa).
 WidePacketTraverse select_wide_packet_traverse(int isa);
 WidePacketTraverse wide_packet_traverse_for(int isa);

@@ -80,10 +80,11 @@ bool record_one(void* context, std::uint32_t leaf, float& limit) {
   return true;
 }
 
-// Random neighbouring rays through a random tree, in packets of 1 to kWidePacketLanes rays of one octant: with the
-// limit never lowered each lane reports exactly the leaves the one-ray traversal reports (as sets: the order is the
-// packet's); with the limit lowered at each "hit" (Hits), each lane's least hit and its leaf are the one-ray
-// traversal's.
+// Random neighbouring rays through a random tree, in packets of 1 to kWidePacketLanes rays of one octant, 1 to
+// 2 kWidePacketStreams + 1 packets a call (more packets than walk at once: a finished packet's place is taken by the
+// next): with the limit never lowered each lane reports exactly the leaves the one-ray traversal reports (as sets:
+// the order is the packet's); with the limit lowered at each "hit" (Hits), each lane's least hit and its leaf are the
+// one-ray traversal's.
 TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
   Rng rng(31);
   broadphase::AabbSoa boxes;
@@ -104,7 +105,7 @@ TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
   Hits hits{&boxes, &bvh, {}};
   for (std::size_t leaf = 0; leaf < n; ++leaf)
     hits.offset.push_back(leaf % 5 == 0 ? 0.01 : uniform(rng, 0.01, 2.0));  // equal offsets: ties between leaves
-  int lowered = 0;
+  int lowered = 0, calls_beyond_streams = 0;
   for (int isa = 0; isa <= 2; ++isa) {
     if (!has_isa(isa)) continue;
     SCOPED_TRACE(::testing::Message() << "isa " << isa);
@@ -113,16 +114,24 @@ TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
     ASSERT_NE(packet, nullptr);
     for (int round = 0; round < 400; ++round) {
       // Neighbouring rays (a packet's rays come from one cell of the cast order): origins near a point, directions
-      // near one, all in its octant, 1 to kWidePacketLanes of them.
-      const unsigned count = 1 + unsigned(round % kWidePacketLanes);
+      // near one, all in its octant; packets of 1 to kWidePacketLanes of them.
+      const unsigned packets_in_call = 1 + unsigned(round % (2 * kWidePacketStreams + 1));
+      std::vector<WidePacket> packets;
+      unsigned count = 0;
+      for (unsigned p = 0; p < packets_in_call; ++p) {
+        const unsigned lanes_in_packet = 1 + unsigned((round + 7 * p) % kWidePacketLanes);
+        packets.push_back({count, lanes_in_packet});
+        count += lanes_in_packet;
+      }
+      calls_beyond_streams += packets_in_call > kWidePacketStreams;
       const double base_o[3] = {uniform(rng, -14, 14), uniform(rng, -14, 14), uniform(rng, -14, 14)};
       double base_d[3] = {uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)};
       if (round % 11 == 0) base_d[round % 3] = 0.0;  // a zero component: infinite reciprocal, grazing slabs
       for (const Hits* h : {static_cast<const Hits*>(nullptr), static_cast<const Hits*>(&hits)}) {
-        Lane lanes[kWidePacketLanes], alone[kWidePacketLanes];
-        WideRay rays[kWidePacketLanes];
-        const WideRay* ptr[kWidePacketLanes];
-        float limits[kWidePacketLanes];
+        std::vector<Lane> lanes(count), alone(count);
+        std::vector<WideRay> rays(count);
+        std::vector<const WideRay*> ptr(count);
+        std::vector<float> limits(count);
         for (unsigned l = 0; l < count; ++l) {
           for (int k = 0; k < 3; ++k) {
             lanes[l].o[k] = base_o[k] + uniform(rng, -1.5, 1.5);
@@ -134,8 +143,8 @@ TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
           ptr[l] = &rays[l];
           limits[l] = l % 3 == 2 ? 20.0f : INFINITY;
         }
-        PacketContext pc{lanes, h};
-        packet(wide.nodes().data(), ptr, count, limits, &record_lane, &pc);
+        PacketContext pc{lanes.data(), h};
+        packet(wide.nodes().data(), ptr.data(), limits.data(), packets.data(), packets_in_call, &record_lane, &pc);
         for (unsigned l = 0; l < count; ++l) {
           OneContext oc{&alone[l], h};
           one(wide.nodes().data(), rays[l], l % 3 == 2 ? 20.0f : INFINITY, &record_one, &oc);
@@ -145,6 +154,7 @@ TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
             ASSERT_EQ(a, b) << "round " << round << " lane " << l;
           } else {
             ASSERT_EQ(alone[l].best_leaf, lanes[l].best_leaf) << "round " << round << " lane " << l;
+            ASSERT_EQ(alone[l].best, lanes[l].best) << "round " << round << " lane " << l;
             lowered += alone[l].best_leaf != 0xffffffffu;
           }
         }
@@ -152,6 +162,7 @@ TEST(RayWidePacket, EachLaneReachesTheLeavesItReachesAlone) {
     }
   }
   EXPECT_GT(lowered, 300);
+  EXPECT_GT(calls_beyond_streams, 100);
 }
 
 // A scene of the shapes whose closest hits are order free (exact kernels: spheres, capsules, boxes, cylinders,
