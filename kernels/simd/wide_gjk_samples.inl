@@ -211,15 +211,26 @@ template <class T> struct WideGjkSamples {
     }
     const WarmLanes r = project_warm_lanes(w, count);
     V3 x{zero, zero, zero};
-    for (int m = 0; m < count; ++m) {
-      const mask kept = r.c > G::splat_mask(m);
-      const V3 wm = vertex_of(w, r.idx[m]);
-      x = G::pick(kept, G::add(x, G::scale(r.lambda[m], wm)), x);
-      L.w[m] = G::pick(kept, wm, L.w[m]);
-      L.a[m] = G::pick(kept, vertex_of(a, r.idx[m]), L.a[m]);
-      L.b[m] = G::pick(kept, vertex_of(b, r.idx[m]), L.b[m]);
-      L.slot[m] = G::blend(kept, G::splat_mask(m), L.slot[m]);
-      L.lambda[m] = G::blend(kept, r.lambda[m], L.lambda[m]);
+    // Every lane keeps the whole simplex (a support set of `count` vertices is 0 .. count - 1 in order): the
+    // vertices go straight to their slots, without the per-lane selections below (most registers).
+    if (lane_bits(r.c == G::splat_mask(count)) == kAllLanes) {
+      for (int m = 0; m < count; ++m) {
+        x = G::add(x, G::scale(r.lambda[m], w[m]));
+        L.w[m] = w[m], L.a[m] = a[m], L.b[m] = b[m];
+        L.slot[m] = G::splat_mask(m);
+        L.lambda[m] = r.lambda[m];
+      }
+    } else {
+      for (int m = 0; m < count; ++m) {
+        const mask kept = r.c > G::splat_mask(m);
+        const V3 wm = vertex_of(w, r.idx[m]);
+        x = G::pick(kept, G::add(x, G::scale(r.lambda[m], wm)), x);
+        L.w[m] = G::pick(kept, wm, L.w[m]);
+        L.a[m] = G::pick(kept, vertex_of(a, r.idx[m]), L.a[m]);
+        L.b[m] = G::pick(kept, vertex_of(b, r.idx[m]), L.b[m]);
+        L.slot[m] = G::blend(kept, G::splat_mask(m), L.slot[m]);
+        L.lambda[m] = G::blend(kept, r.lambda[m], L.lambda[m]);
+      }
     }
     L.count = r.c;
     L.x = x;
