@@ -269,6 +269,7 @@ template <class T> struct WideGjkSamples {
           hulls(a == ShapeType::convex && b == ShapeType::convex && in_.warm != nullptr) {}
 
     void share(std::uint32_t ia, std::uint32_t ib) {
+      sides_ready = false;
       shape_a = ia;
       shape_b = ib;
       shared.core_a = core_of(shapes, ia);
@@ -288,6 +289,7 @@ template <class T> struct WideGjkSamples {
     __attribute__((always_inline)) bool load(Lanes& L, int l) {
       if (next == in.samples) return false;
       const std::size_t s = next++;
+      sides_ready = false;  // start_pose() loads lane l's sides alone
       if (in.shape_a[s] != shape_a || in.shape_b[s] != shape_b) share(in.shape_a[s], in.shape_b[s]);
       T R[9];
       for (int e = 0; e < 9; ++e) R[e] = T(in.R[e][s]);
@@ -326,6 +328,9 @@ template <class T> struct WideGjkSamples {
 
     static constexpr bool refills_together = true;
     std::uint32_t running = 0;  // lanes holding a sample (load() sets, done() clears)
+    // Every lane's sides hold `shared`'s cores (side_lanes() done since the last share() or lane-by-lane load()):
+    // a support changes only the lanes' hints. side_lanes() again cost ~75 instructions a register a side.
+    bool sides_ready = false;
     /// Starts the next samples in the lanes of `want` (lane order) and returns the lanes started. In double, lanes
     /// that end while others run are left empty until the register's last lane ends, and then every lane is
     /// loaded, W consecutive samples of one pair at a time where they are (load_all()), else lane by lane
@@ -377,8 +382,13 @@ template <class T> struct WideGjkSamples {
       for (int l = 0; l < W; ++l) L.pair[l] = std::int64_t(s0) + l, sample[l] = std::uint32_t(s0 + std::size_t(l));
       for (int e = 0; e < 9; ++e) L.R[e] = row(in.R[e]);
       for (int i = 0; i < 3; ++i) L.t[i] = row(in.t[i]);
-      side_lanes(L.A, shared.core_a);
-      side_lanes(L.B, shared.core_b);
+      if (sides_ready) {  // the pair's later registers: only the hints are fresh per sample
+        for (int l = 0; l < W; ++l) L.A.hint[l] = SupportHint{}, L.B.hint[l] = SupportHint{};
+      } else {
+        side_lanes(L.A, shared.core_a);
+        side_lanes(L.B, shared.core_b);
+        sides_ready = true;
+      }
       // gjk_limits() per lane: |t| and the scale in double, as load() computes them.
       const real tx = L.t[0], ty = L.t[1], tz = L.t[2];
       const real lane_scale = G::splat(T(shared.bounding_a + shared.bounding_b)) + wsqrt<T>((tx * tx + ty * ty) + tz * tz);
