@@ -1320,6 +1320,12 @@ template <class T> struct WideGjk {
   /// with minkowski()'s operations on the values the lane gets (the same bits): start() then computes none, where
   /// it computed one W-wide support per pass for the ~1-2 lanes refilled since the last pass (WideGjkPairs).
   template <class S, class = void> struct GivesFirst : std::false_type {};
+  /// Sources whose load_lanes() is worth batching in every run, not only boolean float ones on AVX-512
+  /// (`static constexpr bool refills_together = true`: the smoothing samples, which load W samples with vector
+  /// loads when all lanes end together, wide_gjk_samples.inl).
+  template <class S, class = void> struct RefillsTogether : std::false_type {};
+  template <class S>
+  struct RefillsTogether<S, std::void_t<decltype(S::refills_together)>> : std::bool_constant<S::refills_together> {};
   template <class S> struct GivesFirst<S, std::void_t<decltype(S::gives_first)>> : std::bool_constant<S::gives_first> {};
 
   // noinline: its callers stay small and the loop keeps its own register allocation whatever they are. Once
@@ -1330,7 +1336,8 @@ template <class T> struct WideGjk {
     // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
     // refilled together (done() reads and load() writes only its own lane, so the answers are the same).
     // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512).
-    constexpr bool batch = Boolean && has_expand_load && std::is_same_v<T, float> && LoadsLanes<Source>::value;
+    constexpr bool batch = LoadsLanes<Source>::value && (RefillsTogether<Source>::value ||
+                                                          (Boolean && has_expand_load && std::is_same_v<T, float>));
     // Lanes holding a pair, kept as bits beside L.pair (rebuilding them from L.pair and the live mask from them
     // lane by lane cost ~55 instructions per demo pair, AVX2).
     std::uint32_t active = 0;
@@ -1360,9 +1367,10 @@ template <class T> struct WideGjk {
     const auto refill_ended = [&](std::uint32_t ended) {
       if constexpr (batch) {
         if (ended == 0) return;
-        const std::uint32_t empty = ended & ~source.load_lanes(L, ended);
-        for (std::uint32_t e = empty; e != 0; e &= e - 1) L.pair[__builtin_ctz(e)] = -1;
-        active &= ~empty;
+        // A source may also start lanes it left empty before (the samples wait for a register's last lane).
+        const std::uint32_t started = source.load_lanes(L, ended);
+        for (std::uint32_t e = ended & ~started; e != 0; e &= e - 1) L.pair[__builtin_ctz(e)] = -1;
+        active = (active & ~ended) | started;
       }
     };
 

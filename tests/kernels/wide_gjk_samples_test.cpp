@@ -229,6 +229,64 @@ TEST(WideGjkSamples, AnyWarmSimplexGivesTheCertifiedAnswerWithTheSameBitsOnEvery
   check_warm<float>(1e-5);
 }
 
+// The smoothed0 layout: each pair's samples consecutive, sharing one warm simplex (the pair's). Registers whose W
+// samples are one pair's are loaded W at a time (wide_gjk_samples.inl's load_all(), its warm_start_lanes()), the
+// others lane by lane; per-sample copies of the same simplices (other pointers, the same vertex pairs) make every
+// register load lane by lane. Both must give the same bits, on every instruction set, as the scalar set (W = 1,
+// which loads every sample alone). 13 samples a pair: registers straddle pairs; 1-3 vertices, degenerate ones
+// included; zero and NaN first directions (the centres' difference).
+template <class T> void check_shared_warm(double tolerance) {
+  QueryOptions options;
+  options.level = QueryLevel::witness;
+  options.solver = resolve_solver(options.solver, options.level);
+  if (std::is_same_v<T, float>) options.precision = Precision::float32;
+  options.tolerance = tolerance;
+  Rng rng(31);
+  ShapeTable shapes;
+  const int pairs = 24, per_pair = 13;
+  const Samples s = make_samples(rng, shapes, ShapeType::convex, ShapeType::convex, pairs, per_pair, 2.0);
+  const auto& hulls = detail::ShapeTableAccess::hulls(shapes);
+  std::vector<kernels::simd::WarmSimplex> simplices(pairs), copies(s.size());
+  std::vector<const kernels::simd::WarmSimplex*> shared(s.size(), nullptr), own(s.size(), nullptr);
+  for (int p = 0; p < pairs; ++p) {
+    kernels::simd::WarmSimplex& w = simplices[std::size_t(p)];
+    const std::size_t k0 = std::size_t(p) * per_pair;
+    w.count = std::uint32_t(p % 4);  // 0: no warm start
+    for (std::uint32_t m = 0; m < w.count; ++m) {
+      const std::uint32_t na = hulls[s.shape_a[k0]].vertex_count, nb = hulls[s.shape_b[k0]].vertex_count;
+      w.a[m] = std::uint32_t(testing::uniform(rng, 0.0, double(na))) % na;
+      w.b[m] = p % 8 == 7 ? w.b[0] : std::uint32_t(testing::uniform(rng, 0.0, double(nb))) % nb;
+    }
+    for (int j = 0; j < per_pair; ++j) {
+      shared[k0 + std::size_t(j)] = &w;
+      copies[k0 + std::size_t(j)] = w;
+      own[k0 + std::size_t(j)] = &copies[k0 + std::size_t(j)];
+    }
+  }
+  const WarmRun<T> base = run_warm<T>(shapes, s, shared, options, InstructionSet::scalar);
+  int converged = 0;
+  for (Status st : base.status) converged += st == Status::converged;
+  EXPECT_GT(converged, int(s.size()) / 2);
+  for (InstructionSet isa : {InstructionSet::scalar, InstructionSet::avx2, InstructionSet::avx512}) {
+    if (!kernels::simd::cpu_has(isa)) continue;
+    for (const auto* warm : {&shared, &own}) {
+      SCOPED_TRACE(std::string(to_string(isa)) + (warm == &shared ? " shared" : " per-sample copies"));
+      const WarmRun<T> r = run_warm<T>(shapes, s, *warm, options, isa);
+      ASSERT_EQ(r.left, base.left);
+      for (std::size_t k = 0; k < s.size(); ++k) {
+        ASSERT_EQ(r.status[k], base.status[k]) << "sample " << k;
+        for (int e = 0; e < 10; ++e) ASSERT_TRUE(same(r.values[10 * k + e], base.values[10 * k + e])) << "sample " << k;
+      }
+    }
+  }
+}
+
+TEST(WideGjkSamples, OnePairsRegistersLoadedAtOnceGiveTheLaneByLaneBits) {
+  check_shared_warm<double>(1e-8);
+  check_shared_warm<double>(1e-12);
+  check_shared_warm<float>(1e-5);
+}
+
 TEST(WideGjkSamples, OverlapsAtThePenetrationLevelAreHandedBack) {
   QueryOptions options;
   options.level = QueryLevel::penetration;
