@@ -148,7 +148,7 @@ void hull_pair_flats_avx2(const QuatArray& ra, const QuatArray& rb, std::size_t 
 /// dependency chain through the feature scan, which one pair's ~700 instructions do not leave the out-of-order
 /// window room to overlap with the next pair's (perf cpu-clock, AMD EPYC Zen 4: hull_pair_flats_avx2 held 17% of
 /// the analytic hull run's samples for 13% of its instructions, a ninth of them on the division); eight pairs'
-/// directions in 8-lane registers compute the chains side by side.
+/// directions in lanes (two 4-lane halves on AVX2) compute the chains side by side.
 struct HullDirections {
   static constexpr std::size_t kPairs = 8;
   alignas(64) double unit[2][4][kPairs];

@@ -205,9 +205,9 @@ bool hull_pair(const ShapeTable& shapes, const PairBatch& batch, const PairResul
   g.normal = results.normal[i];
   if (!g.witness_a.allFinite() || !g.witness_b.allFinite() || !g.normal.allFinite()) return false;
   const auto& hulls = ShapeTableAccess::hulls(shapes);
-  // Both sides' flats in one call (hull_pair_flats(): n in each hull's frame, b's reversed, with the bits of the
-  // per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the features n exposes; an edge's
-  // direction in the world orthogonal to n). A face's flats are only needed by the general path below
+  // Both sides' flats in one call (hull_pair_flats_packed(), as hull_pair_flats(): n in each hull's frame, b's
+  // reversed, with the bits of the per-side Eigen expressions q.normalized(), sign * (unit.conjugate() * n); the
+  // features n exposes; an edge's direction in the world orthogonal to n). A face's flats are only needed by the general path below
   // (PolytopeLanes uses n).
   Eigen::Vector3d flat[2];
   const double tolerance[2] = {kExposedFeature * radii[a], kExposedFeature * radii[b]};

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <new>
 
@@ -427,7 +428,9 @@ class RayOrder {
 void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) {
   constexpr std::size_t kGroup = kWidePacketWindow;
   const std::size_t n = order.size(), chunks = (n + detail::kRayChunk - 1) / detail::kRayChunk;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+  // A window's buffers (~110 KB for 256 rays) are on the heap, once per range of chunks: on the stack they and the
+  // packet walks took ~220 KB of the thread's stack, and the caller's own thread takes part in the cast.
+  struct Window {
     const WideRayRecord* group[kGroup];
     WideRay wide[kGroup];
     std::uint8_t status[kGroup];
@@ -436,6 +439,10 @@ void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) 
     bool found[kGroup], capped[kGroup], pf[kGroup], pc[kGroup];
     unsigned by_octant[8][kGroup];
     WidePacket packets[kGroup / 2];
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+    const std::unique_ptr<Window> window = std::make_unique<Window>();
+    auto& [group, wide, status, ctx, packet, best, pb, found, capped, pf, pc, by_octant, packets] = *window;
     for (std::size_t c = range.begin(); c != range.end(); ++c) {
       const std::size_t begin = c * detail::kRayChunk, end = std::min(n, begin + detail::kRayChunk);
       for (std::size_t k = begin; k < end; k += kGroup) {
@@ -465,7 +472,7 @@ void cast_packets(RayOrder& order, const Caster& caster, WideRecordSetup setup) 
             continue;
           }
           if (total == 0) continue;
-          // Packets of near-equal size (33 rays: 17 and 16, not 32 and a lone ray), in cast order.
+          // Packets of near-equal size (33 rays: 16 and 17, not 32 and a lone ray), in cast order.
           const unsigned count = (total + kWidePacketLanes - 1) / kWidePacketLanes;
           for (unsigned p = 0, first = 0; p < count; ++p) {
             packets[p].first = first, packets[p].n = (total - first) / (count - p);

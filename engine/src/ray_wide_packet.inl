@@ -184,14 +184,28 @@ class PacketWalk {
 // Up to kWidePacketStreams packets walk at once, a step of each in turn: a step's next entry is requested at its end
 // and loaded the next time round, so a packet's cache misses (the first node of a descent is not a pushed, already
 // requested child; neither is a leaf taken at once) overlap the other packets' steps.
+// The walks live on the heap, one block per thread kept from call to call: kWidePacketStreams walks take ~103 KB
+// (mostly each walk's worst-case stack), too much for the stack of a caller's thread, which takes part in the cast.
+// Every octant's PacketWalk has the same layout (the octant only selects code), so one block serves them all.
+struct alignas(64) PacketWalkBlock {
+  unsigned char bytes[kWidePacketStreams * sizeof(PacketWalk<0>)];
+};
+inline unsigned char* packet_walk_block() {
+  thread_local std::unique_ptr<PacketWalkBlock> block;
+  if (block == nullptr) block = std::make_unique<PacketWalkBlock>();
+  return block->bytes;
+}
+
 template <int kOctant>
 void traverse_packets_octant(const WideNode* nodes, const WideRay* const* rays, float* limits,
                              const WidePacket* packets, unsigned count, WidePacketVisit visit, void* context) {
-  PacketWalk<kOctant> walks[kWidePacketStreams];
+  static_assert(sizeof(PacketWalk<kOctant>) == sizeof(PacketWalk<0>) &&
+                std::is_trivially_destructible_v<PacketWalk<kOctant>>);
+  unsigned char* const block = packet_walk_block();
   PacketWalk<kOctant>* live[kWidePacketStreams];
   unsigned active = 0, next = 0;
   for (; active < kWidePacketStreams && next < count; ++active, ++next) {
-    live[active] = &walks[active];
+    live[active] = new (block + active * sizeof(PacketWalk<kOctant>)) PacketWalk<kOctant>;
     live[active]->start(nodes, rays, packets[next].first, packets[next].n, limits);
   }
   unsigned i = 0;

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
+#include <new>
+#include <type_traits>
 
 // The vector types cross no call boundary between instruction sets (each set's functions call only their own).
 #pragma GCC diagnostic ignored "-Wpsabi"

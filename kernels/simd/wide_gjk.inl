@@ -1309,7 +1309,9 @@ template <class T> struct WideGjk {
   }
 
   /// Sources that start several lanes at once: `std::uint32_t load_lanes(Lanes&, std::uint32_t want)` starts the
-  /// next pairs in the lanes of `want` (lane order, as load() lane by lane would) and returns the lanes it started.
+  /// next pairs in free lanes (those of `want`, in lane order, as load() lane by lane would; a RefillsTogether
+  /// source may start none of them while other lanes run, and later lanes it left empty) and returns the lanes it
+  /// started.
   template <class S, class = void> struct LoadsLanes : std::false_type {};
   template <class S>
   struct LoadsLanes<S, std::void_t<decltype(std::declval<S&>().load_lanes(std::declval<Lanes&>(), 0u))>>
@@ -1335,7 +1337,9 @@ template <class T> struct WideGjk {
   __attribute__((noinline)) static void loop(Lanes& L, Source& source, Solver solver, bool points_) {
     // Boolean runs of a source with load_lanes(): the lanes that end in one iteration are answered first, then
     // refilled together (done() reads and load() writes only its own lane, so the answers are the same).
-    // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512).
+    // Only where expand loads make that a row of single instructions (has_expand_load, AVX-512), or for sources
+    // that ask for it in every run (RefillsTogether: the smoothing samples, which may also leave ended lanes empty
+    // until their whole register can be loaded at once, and start them later).
     constexpr bool batch = LoadsLanes<Source>::value && (RefillsTogether<Source>::value ||
                                                           (Boolean && has_expand_load && std::is_same_v<T, float>));
     // Lanes holding a pair, kept as bits beside L.pair (rebuilding them from L.pair and the live mask from them
