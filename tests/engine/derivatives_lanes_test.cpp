@@ -42,6 +42,21 @@ Eigen::Matrix3d eigen_curvature(const Eigen::Quaterniond& q, const Eigen::Vector
   return H;
 }
 
+// A quaternion of any magnitude for the direction tests: unit (a tenth), with a zero coefficient, all zero,
+// identity, or scaled by 10^[-3, 3].
+Eigen::Quaterniond any_quaternion(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_int_distribution<int> pick(0, 9);
+  Eigen::Quaterniond q(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
+  const int kind = pick(rng);
+  if (kind == 0) q.normalize();
+  else if (kind == 1) q.coeffs()[pick(rng) % 4] = 0.0;
+  else if (kind == 2) q.coeffs().setZero();
+  else if (kind == 3) q = Eigen::Quaterniond::Identity();
+  else q.coeffs() *= std::pow(10.0, exponent(rng));
+  return q;
+}
+
 // Random separated geometry with sphere / ellipsoid sides on unnormalised quaternions of magnitudes 1e-3 .. 1e3
 // (and some exactly unit, some with zero coefficients): every lane of a whole block of curved sides against the
 // same block given Eigen's curvature matrices, on the baseline lanes (a partial block) and on every wide set here.
@@ -108,18 +123,9 @@ TEST(DerivativesLanes, LaneRotationsGiveEigensBits) {
 // (1e-3 .. 1e3, unit, with zero coefficients, all zero) and normals with signed zeros.
 TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
   std::mt19937_64 rng(20261127);
-  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0);
   std::uniform_int_distribution<int> pick(0, 9);
-  const auto quaternion = [&] {
-    Eigen::Quaterniond q(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
-    const int kind = pick(rng);
-    if (kind == 0) q.normalize();
-    else if (kind == 1) q.coeffs()[pick(rng) % 4] = 0.0;
-    else if (kind == 2) q.coeffs().setZero();
-    else if (kind == 3) q = Eigen::Quaterniond::Identity();
-    else q.coeffs() *= std::pow(10.0, exponent(rng));
-    return q;
-  };
+  const auto quaternion = [&] { return any_quaternion(rng); };
   const auto same = [](const double* x, const double* y, int count) { return std::memcmp(x, y, count * sizeof(double)) == 0; };
   int mismatches = 0;
   for (int trial = 0; trial < 200000; ++trial) {
@@ -148,18 +154,9 @@ TEST(DerivativesLanes, HullPairDirectionsGiveEigensBits) {
 TEST(DerivativesLanes, HullDirectionsBlockGivesEachPairsBits) {
   if (vector_isas_here().empty()) GTEST_SKIP() << "no AVX2 on this CPU: the block is not used";
   std::mt19937_64 rng(20261128);
-  std::uniform_real_distribution<double> coefficient(-1.0, 1.0), exponent(-3.0, 3.0);
+  std::uniform_real_distribution<double> coefficient(-1.0, 1.0);
   std::uniform_int_distribution<int> pick(0, 9);
-  const auto quaternion = [&] {
-    Eigen::Quaterniond q(coefficient(rng), coefficient(rng), coefficient(rng), coefficient(rng));
-    const int kind = pick(rng);
-    if (kind == 0) q.normalize();
-    else if (kind == 1) q.coeffs()[pick(rng) % 4] = 0.0;
-    else if (kind == 2) q.coeffs().setZero();
-    else if (kind == 3) q = Eigen::Quaterniond::Identity();
-    else q.coeffs() *= std::pow(10.0, exponent(rng));
-    return q;
-  };
+  const auto quaternion = [&] { return any_quaternion(rng); };
   constexpr std::size_t kPairs = 4000;
   QuatArray ra, rb;
   Vec3Array normal;

@@ -165,6 +165,15 @@ WarmRun<T> run_warm(const ShapeTable& shapes, const Samples& s, const std::vecto
   return r;
 }
 
+// Every sample of run r has the status and the ten values of run base, bit for bit.
+template <class T> void expect_same_run(const WarmRun<T>& r, const WarmRun<T>& base) {
+  ASSERT_EQ(r.left, base.left);
+  for (std::size_t k = 0; k < base.status.size(); ++k) {
+    ASSERT_EQ(r.status[k], base.status[k]) << "sample " << k;
+    for (int e = 0; e < 10; ++e) ASSERT_TRUE(same(r.values[10 * k + e], base.values[10 * k + e])) << "sample " << k;
+  }
+}
+
 // A warm simplex (the smoothed0 samples of hull pairs start from their pair's nominal simplex) changes where GJK
 // starts, not what it certifies: whatever vertex pairs it names (here random ones, degenerate and repeated
 // included), every sample converges, to the distance of the cold start within the certified tolerance (both are
@@ -215,12 +224,7 @@ template <class T> void check_warm(double tolerance) {
   for (InstructionSet isa : {InstructionSet::avx2, InstructionSet::avx512}) {
     if (!kernels::simd::cpu_has(isa)) continue;
     SCOPED_TRACE(to_string(isa));
-    const WarmRun<T> r = run_warm<T>(shapes, s, warm, options, isa);
-    ASSERT_EQ(r.left, base.left);
-    for (std::size_t k = 0; k < s.size(); ++k) {
-      ASSERT_EQ(r.status[k], base.status[k]) << "sample " << k;
-      for (int e = 0; e < 10; ++e) ASSERT_TRUE(same(r.values[10 * k + e], base.values[10 * k + e])) << "sample " << k;
-    }
+    expect_same_run(run_warm<T>(shapes, s, warm, options, isa), base);
   }
 }
 
@@ -232,8 +236,9 @@ TEST(WideGjkSamples, AnyWarmSimplexGivesTheCertifiedAnswerWithTheSameBitsOnEvery
 // The smoothed0 layout: each pair's samples consecutive, sharing one warm simplex (the pair's). Registers whose W
 // samples are one pair's are loaded W at a time (wide_gjk_samples.inl's load_all(), its warm_start_lanes()), the
 // others lane by lane; per-sample copies of the same simplices (other pointers, the same vertex pairs) make every
-// register load lane by lane. Both must give the same bits, on every instruction set, as the scalar set (W = 1,
-// which loads every sample alone). 13 samples a pair: registers straddle pairs; 1-3 vertices, degenerate ones
+// register load lane by lane. Both must give the same bits, on every instruction set, as the scalar set (W = 1: in
+// double every one-sample register is one pair's, so it loads through load_all() too; the lane-by-lane path is the
+// AVX2 / AVX-512 runs on per-sample copies, and float, which always loads lane by lane). 13 samples a pair: registers straddle pairs; 1-3 vertices, degenerate ones
 // included; zero and NaN first directions (the centres' difference).
 template <class T> void check_shared_warm(double tolerance) {
   QueryOptions options;
@@ -271,12 +276,7 @@ template <class T> void check_shared_warm(double tolerance) {
     if (!kernels::simd::cpu_has(isa)) continue;
     for (const auto* warm : {&shared, &own}) {
       SCOPED_TRACE(std::string(to_string(isa)) + (warm == &shared ? " shared" : " per-sample copies"));
-      const WarmRun<T> r = run_warm<T>(shapes, s, *warm, options, isa);
-      ASSERT_EQ(r.left, base.left);
-      for (std::size_t k = 0; k < s.size(); ++k) {
-        ASSERT_EQ(r.status[k], base.status[k]) << "sample " << k;
-        for (int e = 0; e < 10; ++e) ASSERT_TRUE(same(r.values[10 * k + e], base.values[10 * k + e])) << "sample " << k;
-      }
+      expect_same_run(run_warm<T>(shapes, s, *warm, options, isa), base);
     }
   }
 }
