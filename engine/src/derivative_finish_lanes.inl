@@ -18,8 +18,8 @@ inline __attribute__((always_inline)) V load(const double* p) {
 }
 inline __attribute__((always_inline)) void store(double* p, const V& v) { __builtin_memcpy(p, &v, sizeof v); }
 
-/// Writes the 120 derivative entries of lanes 0 .. 7 to out[e][0 .. 8) (StoreBlock's entry order).
-void finish_lanes(const FinishIn& in, double* const* out) {
+/// Writes the 120 derivative entries of lanes 0 .. 7 to out[e][at .. at + 8) (StoreBlock's entry order).
+void finish_lanes(const FinishIn& in, double* const* out, std::size_t at) {
   const V valid = load(in.valid), s_t = load(in.s_t), s_w = load(in.s_w);
   V Ra[3][3];
   for (int r = 0; r < 3; ++r)
@@ -42,7 +42,7 @@ void finish_lanes(const FinishIn& in, double* const* out) {
     V col[6], w[6];
     for (int e = 0; e < 6; ++e) col[e] = scaled(e, 0);
     twist(col, w);
-    for (int e = 0; e < 6; ++e) store(out[store_at::distance_a + e], -w[e]), store(out[store_at::distance_b + e], w[e]);
+    for (int e = 0; e < 6; ++e) store(out[store_at::distance_a + e] + at, -w[e]), store(out[store_at::distance_b + e] + at, w[e]);
   }
   constexpr int kB[3] = {store_at::witness_a_b, store_at::witness_b_b, store_at::normal_b};
   constexpr int kA[3] = {store_at::witness_a_a, store_at::witness_b_a, store_at::normal_a};
@@ -65,8 +65,8 @@ void finish_lanes(const FinishIn& in, double* const* out) {
       twist(M[j], w);
       for (int e = 0; e < 6; ++e) {
         const V m = e < 3 ? zero + (j == e ? identity : 0.0) : minus_skew[j][e - 3];  // +0.0 + c is c
-        store(out[kB[k] + 6 * j + e], w[e]);
-        store(out[kA[k] + 6 * j + e], m - w[e]);
+        store(out[kB[k] + 6 * j + e] + at, w[e]);
+        store(out[kA[k] + 6 * j + e] + at, m - w[e]);
       }
     }
   }

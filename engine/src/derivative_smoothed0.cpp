@@ -210,7 +210,11 @@ void plan_pair(const Context& c, std::size_t i, PairPlan& p) {
     // A sample moves b about its own origin by v_n = s_t Ra z_v and w = s_w Ra z_w (z in A's frame): the world
     // twist (v_n + t_b x w, w); the normal moves by J_n of that, taken back to A's frame:
     // P = [s_t Ra^T Jv Ra, s_w Ra^T (Jv [t_b]x + Jw) Ra].
-    const Mat36 J = c.predictor->normal_wrt_b[i];
+    // Read in place (entry (r, c) at data[(6 r + c) n + i]): Mat36Array::operator[]'s out-of-line copy cost 63
+    // instructions a pair (callgrind AVX2, ellipsoids M = 16).
+    const double* Jd = c.predictor->normal_wrt_b.data.data();
+    const std::size_t jn = c.predictor->normal_wrt_b.size();
+    const auto J = [&](int r, int q) { return Jd[(6 * r + q) * jn + i]; };
     const double S[3][3] = {{0.0, -tb[2], tb[1]}, {tb[2], 0.0, -tb[0]}, {-tb[1], tb[0], 0.0}};  // skew(t_b)
     double X[2][3][3];  // Jv, Jv [t_b]x + Jw
     for (int r = 0; r < 3; ++r)
@@ -437,7 +441,10 @@ namespace {
 class FinishLanes {
  public:
   static constexpr std::size_t kLanes = FinishIn::kLanes;
-  FinishLanes(DerivativeResults& d, InstructionSet isa) : d_(d), isa_(isa) {}
+  /// `d` is sized already (smoothed0() sizes it before the tasks start): the 120 output rows of pair 0 are taken
+  /// once here, a block's at rows_[k] + first_ (entry_rows() at every flush cost 94 instructions a pair, callgrind
+  /// AVX2, ellipsoids M = 16).
+  FinishLanes(DerivativeResults& d, InstructionSet isa) : isa_(isa) { entry_rows(d, 0, rows_); }
   FinishLanes(const FinishLanes&) = delete;
   FinishLanes& operator=(const FinishLanes&) = delete;
   ~FinishLanes() { flush(); }
@@ -457,28 +464,26 @@ class FinishLanes {
   }
   void flush() {
     if (count_ == 0) return;
-    double* rows[StoreEntries];
-    entry_rows(d_, first_, rows);
     if (count_ == kLanes) {
-      solve(rows);
+      solve(rows_, first_);
     } else {
       alignas(64) double buffer[StoreEntries][kLanes];
       double* buffer_rows[StoreEntries];
       for (int k = 0; k < StoreEntries; ++k) buffer_rows[k] = buffer[k];
-      solve(buffer_rows);
-      for (int k = 0; k < StoreEntries; ++k) std::copy_n(buffer[k], count_, rows[k]);
+      solve(buffer_rows, 0);
+      for (int k = 0; k < StoreEntries; ++k) std::copy_n(buffer[k], count_, rows_[k] + first_);
     }
     count_ = 0;
   }
 
  private:
-  void solve(double* const* out) const {
-    if (isa_ == InstructionSet::avx512) finish_avx512::finish_lanes(in_, out);
-    else if (isa_ == InstructionSet::avx2) finish_avx2::finish_lanes(in_, out);
-    else finish_baseline::finish_lanes(in_, out);
+  void solve(double* const* out, std::size_t at) const {
+    if (isa_ == InstructionSet::avx512) finish_avx512::finish_lanes(in_, out, at);
+    else if (isa_ == InstructionSet::avx2) finish_avx2::finish_lanes(in_, out, at);
+    else finish_baseline::finish_lanes(in_, out, at);
   }
-  DerivativeResults& d_;
   InstructionSet isa_;
+  double* rows_[StoreEntries];
   FinishIn in_{};  // value-initialised: lanes past count_ are computed (not written) on initialised numbers
   std::size_t first_ = 0, count_ = 0;
 };
