@@ -169,7 +169,8 @@ template <class T> struct WideGjkSamples {
     }
     // The best edge (first strict minimum of the squared norm, edges in project_warm()'s order).
     real best_xx = G::splat(std::numeric_limits<T>::infinity());
-    mask bc = G::splat_mask(0), bi[2] = {G::splat_mask(0), G::splat_mask(0)};  // no edge below +inf: none kept, as project_warm()
+    // bc starts at 0: with no edge below +inf no vertex is kept, as in project_warm().
+    mask bc = G::splat_mask(0), bi[2] = {G::splat_mask(0), G::splat_mask(0)};
     real bl[2] = {one, one};
     const int edges[3][2] = {{0, 1}, {0, 2}, {1, 2}};
     for (const auto& e : edges) {

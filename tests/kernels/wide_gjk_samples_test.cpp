@@ -165,6 +165,16 @@ WarmRun<T> run_warm(const ShapeTable& shapes, const Samples& s, const std::vecto
   return r;
 }
 
+// Witness-level options of precision T at `tolerance`, as the warm-sample tests run them.
+template <class T> QueryOptions warm_options(double tolerance) {
+  QueryOptions options;
+  options.level = QueryLevel::witness;
+  options.solver = resolve_solver(options.solver, options.level);
+  if (std::is_same_v<T, float>) options.precision = Precision::float32;
+  options.tolerance = tolerance;
+  return options;
+}
+
 // Every sample of run r has the status and the ten values of run base, bit for bit.
 template <class T> void expect_same_run(const WarmRun<T>& r, const WarmRun<T>& base) {
   ASSERT_EQ(r.left, base.left);
@@ -179,11 +189,7 @@ template <class T> void expect_same_run(const WarmRun<T>& r, const WarmRun<T>& b
 // included), every sample converges, to the distance of the cold start within the certified tolerance (both are
 // within max(tolerance, floor) of the exact distance), with the same bits on every instruction set.
 template <class T> void check_warm(double tolerance) {
-  QueryOptions options;
-  options.level = QueryLevel::witness;
-  options.solver = resolve_solver(options.solver, options.level);
-  if (std::is_same_v<T, float>) options.precision = Precision::float32;
-  options.tolerance = tolerance;
+  const QueryOptions options = warm_options<T>(tolerance);
   Rng rng(29);
   ShapeTable shapes;
   const Samples s = make_samples(rng, shapes, ShapeType::convex, ShapeType::convex, 12, 11, 2.0);
@@ -238,14 +244,11 @@ TEST(WideGjkSamples, AnyWarmSimplexGivesTheCertifiedAnswerWithTheSameBitsOnEvery
 // others lane by lane; per-sample copies of the same simplices (other pointers, the same vertex pairs) make every
 // register load lane by lane. Both must give the same bits, on every instruction set, as the scalar set (W = 1: in
 // double every one-sample register is one pair's, so it loads through load_all() too; the lane-by-lane path is the
-// AVX2 / AVX-512 runs on per-sample copies, and float, which always loads lane by lane). 13 samples a pair: registers straddle pairs; 1-3 vertices, degenerate ones
-// included; zero and NaN first directions (the centres' difference).
+// AVX2 / AVX-512 runs on per-sample copies, and float, which always loads lane by lane). 13 samples a pair:
+// registers straddle pairs; 1-3 vertices, degenerate ones included; zero and NaN first directions (the centres'
+// difference).
 template <class T> void check_shared_warm(double tolerance) {
-  QueryOptions options;
-  options.level = QueryLevel::witness;
-  options.solver = resolve_solver(options.solver, options.level);
-  if (std::is_same_v<T, float>) options.precision = Precision::float32;
-  options.tolerance = tolerance;
+  const QueryOptions options = warm_options<T>(tolerance);
   Rng rng(31);
   ShapeTable shapes;
   const int pairs = 24, per_pair = 13;
